@@ -1,0 +1,196 @@
+//! Ray queries behind one trait, with two backends: our own BVH
+//! ([`bvh`]) and Embree ([`embree`], when lucent is built with it).
+//!
+//! Three queries serve the integrators:
+//! - [`Accel::intersect`]: the nearest hit on a ray interval;
+//! - [`Accel::occluded`]: whether anything is hit (shadow rays);
+//! - [`Accel::hits_on_segment`]: every hit on one object along a segment,
+//!   the probe-ray query of BSSRDF importance sampling (King et al. 2013).
+//!
+//! The integrator sees only this trait, so a backend slots in without it
+//! changing.
+
+pub mod bvh;
+
+use std::sync::Arc;
+
+use crate::geometry::{Mesh, Ray};
+
+/// A ray-triangle hit. `geom` is the index of the mesh in the scene, `prim`
+/// the triangle within it; (u, v) are barycentrics of vertices 1 and 2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub geom: u32,
+    pub prim: u32,
+    pub u: f32,
+    pub v: f32,
+}
+
+/// The most hits [`Accel::hits_on_segment`] returns for one segment.
+///
+/// Beyond the bound the query still counts every distinct hit
+/// ([`ProbeHits::total`]) but keeps only `MAX_PROBE_HITS` of them: those
+/// with the smallest keys `hash(seed, geom, prim)`. That keeps a uniformly
+/// random subset that does not depend on traversal order, so the two
+/// backends agree and an estimator that picks one kept hit uniformly and
+/// weights it by `total` stays unbiased.
+pub const MAX_PROBE_HITS: usize = 64;
+
+/// The result buffer of [`Accel::hits_on_segment`], reused across queries so
+/// the hot path never allocates.
+#[derive(Clone, Debug)]
+pub struct ProbeHits {
+    seed: u32,
+    hits: [Hit; MAX_PROBE_HITS],
+    keys: [u32; MAX_PROBE_HITS],
+    len: usize,
+    total: usize,
+}
+
+impl Default for ProbeHits {
+    fn default() -> Self {
+        ProbeHits::new()
+    }
+}
+
+impl ProbeHits {
+    pub fn new() -> Self {
+        const NONE: Hit = Hit { t: 0.0, geom: 0, prim: 0, u: 0.0, v: 0.0 };
+        ProbeHits {
+            seed: 0,
+            hits: [NONE; MAX_PROBE_HITS],
+            keys: [0; MAX_PROBE_HITS],
+            len: 0,
+            total: 0,
+        }
+    }
+
+    /// Empties the buffer; `seed` selects which subset survives overflow.
+    pub fn reset(&mut self, seed: u32) {
+        self.seed = seed;
+        self.len = 0;
+        self.total = 0;
+    }
+
+    fn key(&self, geom: u32, prim: u32) -> u32 {
+        let mut x = (self.seed as u64) << 32 ^ (geom as u64) << 24 ^ prim as u64;
+        x ^= x >> 33;
+        x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        x ^= x >> 33;
+        x = x.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+        x ^= x >> 33;
+        x as u32
+    }
+
+    /// Records a hit found during traversal (in any order). A hit on the same
+    /// (geom, prim) as a kept one is a duplicate and is ignored.
+    pub fn record(&mut self, hit: Hit) {
+        if self.hits[..self.len].iter().any(|h| h.geom == hit.geom && h.prim == hit.prim) {
+            return;
+        }
+        let key = self.key(hit.geom, hit.prim);
+        self.total += 1;
+        if self.len < MAX_PROBE_HITS {
+            self.hits[self.len] = hit;
+            self.keys[self.len] = key;
+            self.len += 1;
+            return;
+        }
+        // Full: replace the kept hit with the largest key if ours is smaller.
+        let (imax, &kmax) = self.keys.iter().enumerate().max_by_key(|(_, k)| **k).unwrap();
+        if key < kmax {
+            self.hits[imax] = hit;
+            self.keys[imax] = key;
+        }
+    }
+
+    /// Sorts the kept hits by t (ties by prim), called once after traversal.
+    pub fn finish(&mut self) {
+        let n = self.len;
+        let mut idx: [usize; MAX_PROBE_HITS] = std::array::from_fn(|i| i);
+        idx[..n].sort_unstable_by(|&a, &b| {
+            let (ha, hb) = (&self.hits[a], &self.hits[b]);
+            ha.t.total_cmp(&hb.t).then(ha.geom.cmp(&hb.geom)).then(ha.prim.cmp(&hb.prim))
+        });
+        let hits = self.hits;
+        let keys = self.keys;
+        for (dst, &src) in idx[..n].iter().enumerate() {
+            self.hits[dst] = hits[src];
+            self.keys[dst] = keys[src];
+        }
+    }
+
+    /// The kept hits, sorted by t after [`finish`](Self::finish).
+    pub fn hits(&self) -> &[Hit] {
+        &self.hits[..self.len]
+    }
+    /// How many distinct hits the segment had (≥ `hits().len()`).
+    pub fn total(&self) -> usize {
+        self.total
+    }
+}
+
+/// A ray-query backend built over the scene's meshes (mesh index = `geom`).
+pub trait Accel: Send + Sync {
+    /// Short name for logs and `lucent info` ("bvh", "embree").
+    fn name(&self) -> &'static str;
+
+    /// Nearest hit with t in (tmin, tmax), or None.
+    fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit>;
+
+    /// Whether any triangle is hit with t in (tmin, tmax).
+    fn occluded(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool;
+
+    /// Every hit on mesh `geom` with t in [0, tmax], in one traversal; `out`
+    /// is reset with `seed` first and finished (sorted by t) on return.
+    fn hits_on_segment(&self, ray: &Ray, tmax: f32, geom: u32, seed: u32, out: &mut ProbeHits);
+}
+
+/// Which backend to build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    Bvh,
+    Embree,
+}
+
+impl Backend {
+    /// The default: Embree when lucent was built with it, else our BVH.
+    pub fn default_available() -> Backend {
+        if cfg!(lucent_embree) {
+            Backend::Embree
+        } else {
+            Backend::Bvh
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Bvh => "bvh",
+            Backend::Embree => "embree",
+        }
+    }
+}
+
+/// Builds the chosen backend over `meshes`. The meshes are shared (not
+/// copied) by backends that can read our buffers directly, hence the `Arc`.
+pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>, String> {
+    match backend {
+        Backend::Bvh => Ok(Box::new(bvh::Bvh::build(meshes))),
+        Backend::Embree => {
+            #[cfg(lucent_embree)]
+            {
+                embree::EmbreeAccel::build(meshes).map(|a| Box::new(a) as Box<dyn Accel>)
+            }
+            #[cfg(not(lucent_embree))]
+            {
+                Err("this lucent was built without Embree; install it with \
+                     `apt-get install -y --no-install-recommends libembree-dev` and rebuild \
+                     (cargo build --release), or use --accel bvh"
+                    .into())
+            }
+        }
+    }
+}
+
+#[cfg(lucent_embree)]
+pub mod embree;

@@ -1,0 +1,1 @@
+//! Burley normalized diffusion BSSRDF.

@@ -1,0 +1,1 @@
+//! Film: per-pixel accumulation and output.

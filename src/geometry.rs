@@ -1,0 +1,149 @@
+//! Rays, orthonormal frames and triangle meshes: the geometric vocabulary
+//! shared by the scene loader, both ray-query backends and the integrators.
+
+pub use glam::Vec3;
+
+/// A ray `o + t d`. `d` need not be normalized for the accel queries (t is in
+/// units of `|d|`), but every integrator passes unit directions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub o: Vec3,
+    pub d: Vec3,
+}
+
+impl Ray {
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        Ray { o, d }
+    }
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.o + self.d * t
+    }
+}
+
+/// An orthonormal frame (t, b, n), right-handed.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    pub t: Vec3,
+    pub b: Vec3,
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// Builds a frame around a unit normal without branches on the sign of
+    /// n.z (Duff et al. 2017, "Building an Orthonormal Basis, Revisited"),
+    /// so nearby normals get nearby tangents.
+    pub fn from_normal(n: Vec3) -> Self {
+        let sign = 1.0f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let t = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let bt = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+        Frame { t, b: bt, n }
+    }
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
+    }
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.t * v.x + self.b * v.y + self.n * v.z
+    }
+}
+
+/// An indexed triangle mesh in world space.
+///
+/// `positions` carries one hidden padding element past `vertex_count()`,
+/// because Embree reads vertices with 16-byte loads and requires the buffer
+/// to be readable 4 bytes past the last vertex; keeping it here lets Embree
+/// share our buffer instead of copying it.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    positions: Vec<Vec3>,
+    pub indices: Vec<[u32; 3]>,
+    /// Optional per-vertex shading normals (unit length), same count as vertices.
+    pub normals: Option<Vec<Vec3>>,
+}
+
+impl Mesh {
+    /// Builds a mesh; the caller guarantees indices are in range (the scene
+    /// loader validates user data before calling this).
+    pub fn new(positions: Vec<Vec3>, indices: Vec<[u32; 3]>, normals: Option<Vec<Vec3>>) -> Self {
+        let mut p = Vec::with_capacity(positions.len() + 1);
+        p.extend_from_slice(&positions);
+        p.push(Vec3::ZERO);
+        debug_assert!(indices.iter().flatten().all(|&i| (i as usize) < positions.len()));
+        Mesh { positions: p, indices, normals }
+    }
+    /// Vertex positions (without the padding element).
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions[..self.positions.len().saturating_sub(1)]
+    }
+    /// Vertex positions including one trailing padding element (for FFI sharing).
+    pub fn padded_positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+    pub fn vertex_count(&self) -> usize {
+        self.positions().len()
+    }
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len()
+    }
+    pub fn triangle(&self, prim: u32) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[prim as usize];
+        let p = &self.positions;
+        [p[a as usize], p[b as usize], p[c as usize]]
+    }
+    /// Applies `f` to every vertex position (and `g` to every normal).
+    pub fn transform(&mut self, f: impl Fn(Vec3) -> Vec3, g: impl Fn(Vec3) -> Vec3) {
+        let n = self.vertex_count();
+        for p in &mut self.positions[..n] {
+            *p = f(*p);
+        }
+        if let Some(ns) = &mut self.normals {
+            for v in ns.iter_mut() {
+                *v = g(*v).normalize_or_zero();
+            }
+        }
+    }
+    /// Flips the winding of every triangle (and normals), used when a
+    /// transform has negative determinant.
+    pub fn flip_winding(&mut self) {
+        for t in &mut self.indices {
+            t.swap(1, 2);
+        }
+    }
+    pub fn area(&self, prim: u32) -> f32 {
+        let [a, b, c] = self.triangle(prim);
+        0.5 * (b - a).cross(c - a).length()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal_for_all_octants() {
+        for &n in &[
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::X,
+            Vec3::new(0.3, -0.5, -0.81).normalize(),
+            Vec3::new(1e-8, 0.0, -1.0).normalize(),
+        ] {
+            let f = Frame::from_normal(n);
+            assert!((f.t.length() - 1.0).abs() < 1e-5);
+            assert!((f.b.length() - 1.0).abs() < 1e-5);
+            assert!(f.t.dot(f.b).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5 && f.b.dot(n).abs() < 1e-5);
+            assert!((f.t.cross(f.b) - n).length() < 1e-5);
+            let v = Vec3::new(0.2, -0.7, 0.4);
+            assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn mesh_padding_is_hidden() {
+        let m = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]], None);
+        assert_eq!(m.vertex_count(), 3);
+        assert_eq!(m.padded_positions().len(), 4);
+        assert!((m.area(0) - 0.5).abs() < 1e-7);
+    }
+}

@@ -1,0 +1,15 @@
+//! lucent: a CPU path tracer for translucent materials.
+//!
+//! Data flows one way: [`scene::load`] → [`accel::build`] →
+//! [`integrator`] (rendered in tiles by [`render`]) → [`film`] output.
+
+pub mod accel;
+pub mod bssrdf;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod lights;
+pub mod materials;
+pub mod render;
+pub mod sampling;
+pub mod scene;

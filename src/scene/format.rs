@@ -1,0 +1,1 @@
+//! Serde structures of the TOML scene format.
