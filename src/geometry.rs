@@ -69,8 +69,15 @@ impl Mesh {
         let mut p = Vec::with_capacity(positions.len() + 1);
         p.extend_from_slice(&positions);
         p.push(Vec3::ZERO);
-        debug_assert!(indices.iter().flatten().all(|&i| (i as usize) < positions.len()));
-        Mesh { positions: p, indices, normals }
+        debug_assert!(indices
+            .iter()
+            .flatten()
+            .all(|&i| (i as usize) < positions.len()));
+        Mesh {
+            positions: p,
+            indices,
+            normals,
+        }
     }
     /// Vertex positions (without the padding element).
     pub fn positions(&self) -> &[Vec3] {
@@ -132,7 +139,9 @@ mod tests {
             let f = Frame::from_normal(n);
             assert!((f.t.length() - 1.0).abs() < 1e-5);
             assert!((f.b.length() - 1.0).abs() < 1e-5);
-            assert!(f.t.dot(f.b).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5 && f.b.dot(n).abs() < 1e-5);
+            assert!(
+                f.t.dot(f.b).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5 && f.b.dot(n).abs() < 1e-5
+            );
             assert!((f.t.cross(f.b) - n).length() < 1e-5);
             let v = Vec3::new(0.2, -0.7, 0.4);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);

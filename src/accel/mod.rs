@@ -56,7 +56,13 @@ impl Default for ProbeHits {
 
 impl ProbeHits {
     pub fn new() -> Self {
-        const NONE: Hit = Hit { t: 0.0, geom: 0, prim: 0, u: 0.0, v: 0.0 };
+        const NONE: Hit = Hit {
+            t: 0.0,
+            geom: 0,
+            prim: 0,
+            u: 0.0,
+            v: 0.0,
+        };
         ProbeHits {
             seed: 0,
             hits: [NONE; MAX_PROBE_HITS],
@@ -86,7 +92,10 @@ impl ProbeHits {
     /// Records a hit found during traversal (in any order). A hit on the same
     /// (geom, prim) as a kept one is a duplicate and is ignored.
     pub fn record(&mut self, hit: Hit) {
-        if self.hits[..self.len].iter().any(|h| h.geom == hit.geom && h.prim == hit.prim) {
+        if self.hits[..self.len]
+            .iter()
+            .any(|h| h.geom == hit.geom && h.prim == hit.prim)
+        {
             return;
         }
         let key = self.key(hit.geom, hit.prim);
@@ -98,7 +107,12 @@ impl ProbeHits {
             return;
         }
         // Full: replace the kept hit with the largest key if ours is smaller.
-        let (imax, &kmax) = self.keys.iter().enumerate().max_by_key(|(_, k)| **k).unwrap();
+        let (imax, &kmax) = self
+            .keys
+            .iter()
+            .enumerate()
+            .max_by_key(|(_, k)| **k)
+            .unwrap();
         if key < kmax {
             self.hits[imax] = hit;
             self.keys[imax] = key;
@@ -111,7 +125,9 @@ impl ProbeHits {
         let mut idx: [usize; MAX_PROBE_HITS] = std::array::from_fn(|i| i);
         idx[..n].sort_unstable_by(|&a, &b| {
             let (ha, hb) = (&self.hits[a], &self.hits[b]);
-            ha.t.total_cmp(&hb.t).then(ha.geom.cmp(&hb.geom)).then(ha.prim.cmp(&hb.prim))
+            ha.t.total_cmp(&hb.t)
+                .then(ha.geom.cmp(&hb.geom))
+                .then(ha.prim.cmp(&hb.prim))
         });
         let hits = self.hits;
         let keys = self.keys;
@@ -136,10 +152,10 @@ pub trait Accel: Send + Sync {
     /// Short name for logs and `lucent info` ("bvh", "embree").
     fn name(&self) -> &'static str;
 
-    /// Nearest hit with t in (tmin, tmax), or None.
+    /// Nearest hit with t in [tmin, tmax] (inclusive, as Embree), or None.
     fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit>;
 
-    /// Whether any triangle is hit with t in (tmin, tmax).
+    /// Whether any triangle is hit with t in [tmin, tmax].
     fn occluded(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool;
 
     /// Every hit on mesh `geom` with t in [0, tmax], in one traversal; `out`

@@ -17,7 +17,11 @@ pub struct SpecularSample {
 /// Refracts `wo` (pointing away from the surface) about +z with relative
 /// index `eta`; None on total internal reflection.
 pub fn refract(wo: Vec3, eta: f32) -> Option<(Vec3, f32)> {
-    let (cos_i, etap, n) = if wo.z > 0.0 { (wo.z, eta, 1.0) } else { (-wo.z, 1.0 / eta, -1.0) };
+    let (cos_i, etap, n) = if wo.z > 0.0 {
+        (wo.z, eta, 1.0)
+    } else {
+        (-wo.z, 1.0 / eta, -1.0)
+    };
     let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (etap * etap);
     if sin2_t >= 1.0 {
         return None;
@@ -30,11 +34,23 @@ pub fn refract(wo: Vec3, eta: f32) -> Option<(Vec3, f32)> {
 pub fn sample(eta: f32, wo: Vec3, u: f32) -> SpecularSample {
     let fr = fresnel::dielectric(wo.z, eta);
     if u < fr {
-        return SpecularSample { wi: Vec3::new(-wo.x, -wo.y, wo.z), weight: 1.0, transmitted: false };
+        return SpecularSample {
+            wi: Vec3::new(-wo.x, -wo.y, wo.z),
+            weight: 1.0,
+            transmitted: false,
+        };
     }
     match refract(wo, eta) {
-        Some((wi, etap)) => SpecularSample { wi, weight: 1.0 / (etap * etap), transmitted: true },
-        None => SpecularSample { wi: Vec3::new(-wo.x, -wo.y, wo.z), weight: 1.0, transmitted: false },
+        Some((wi, etap)) => SpecularSample {
+            wi,
+            weight: 1.0 / (etap * etap),
+            transmitted: true,
+        },
+        None => SpecularSample {
+            wi: Vec3::new(-wo.x, -wo.y, wo.z),
+            weight: 1.0,
+            transmitted: false,
+        },
     }
 }
 

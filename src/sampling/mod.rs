@@ -96,7 +96,10 @@ impl Distribution1D {
     /// Returns (index, probability of that index).
     pub fn sample(&self, u: f32) -> (usize, f32) {
         let target = u as f64 * self.total;
-        let i = self.cdf.partition_point(|&c| c <= target).min(self.cdf.len() - 1);
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= target)
+            .min(self.cdf.len() - 1);
         (i, self.pmf(i))
     }
     pub fn pmf(&self, i: usize) -> f32 {

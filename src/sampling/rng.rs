@@ -31,7 +31,10 @@ impl Rng {
 
     /// A stream keyed by an arbitrary value (tests, studies, benches).
     pub fn from_key(key: u64) -> Self {
-        Rng { key: mix64(key ^ 0x243f_6a88_85a3_08d3), counter: 0 }
+        Rng {
+            key: mix64(key ^ 0x243f_6a88_85a3_08d3),
+            counter: 0,
+        }
     }
 
     #[inline]

@@ -23,7 +23,14 @@ impl Camera {
     /// Builds a camera; the caller has checked that `look_from != look_at`,
     /// `up` is not parallel to the view direction, 0 < fov_y < 180 and the
     /// resolution is non-zero.
-    pub fn new(look_from: Vec3, look_at: Vec3, up: Vec3, fov_y: f32, width: u32, height: u32) -> Self {
+    pub fn new(
+        look_from: Vec3,
+        look_at: Vec3,
+        up: Vec3,
+        fov_y: f32,
+        width: u32,
+        height: u32,
+    ) -> Self {
         let forward = (look_at - look_from).normalize();
         let right = forward.cross(up).normalize();
         let upv = right.cross(forward);
@@ -59,7 +66,14 @@ mod tests {
 
     #[test]
     fn centre_ray_looks_at_target_and_fov_is_vertical() {
-        let c = Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 90.0, 200, 100);
+        let c = Camera::new(
+            Vec3::new(0.0, 0.0, 5.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            90.0,
+            200,
+            100,
+        );
         let r = c.ray(100.0, 50.0);
         assert!((r.d - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
         let top = c.ray(100.0, 0.0);

@@ -3,7 +3,8 @@ use super::{Scene, SceneError};
 use std::path::Path;
 
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::new(path, format!("cannot read scene file: {e}")))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SceneError::new(path, format!("cannot read scene file: {e}")))?;
     load_str(&text, path)
 }
 

@@ -28,7 +28,11 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings { spp: 16, max_depth: 8, seed: 0 }
+        RenderSettings {
+            spp: 16,
+            max_depth: 8,
+            seed: 0,
+        }
     }
 }
 
@@ -76,7 +80,12 @@ pub struct SceneError {
 
 impl SceneError {
     pub fn new(file: impl Into<PathBuf>, message: impl Into<String>) -> Self {
-        SceneError { file: file.into(), line: None, field: None, message: message.into() }
+        SceneError {
+            file: file.into(),
+            line: None,
+            field: None,
+            message: message.into(),
+        }
     }
     pub fn at_line(mut self, line: usize) -> Self {
         self.line = Some(line);

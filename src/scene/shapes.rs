@@ -134,7 +134,8 @@ pub fn random_soup(n: usize, size: f32, seed: u64) -> Mesh {
     let mut rng = Rng::from_key(seed);
     let mut p = Vec::with_capacity(3 * n);
     let mut idx = Vec::with_capacity(n);
-    let mut r3 = |rng: &mut Rng| Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE;
+    let mut r3 =
+        |rng: &mut Rng| Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE;
     for i in 0..n {
         let c = r3(&mut rng);
         for _ in 0..3 {
@@ -169,7 +170,10 @@ mod tests {
         assert_eq!(s.triangle_count(), 20 * 256);
         let (vol, area) = closed_and_outward(&s);
         let pi = std::f32::consts::PI;
-        assert!((vol - 4.0 / 3.0 * pi).abs() / (4.0 / 3.0 * pi) < 0.01, "vol {vol}");
+        assert!(
+            (vol - 4.0 / 3.0 * pi).abs() / (4.0 / 3.0 * pi) < 0.01,
+            "vol {vol}"
+        );
         assert!((area - 4.0 * pi).abs() / (4.0 * pi) < 0.01, "area {area}");
         // shared vertices: Euler characteristic V − E + F = 2
         let f = s.triangle_count() as i64;

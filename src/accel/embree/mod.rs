@@ -1,0 +1,1 @@
+//! Embree backend (placeholder until the FFI lands).
