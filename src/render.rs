@@ -1,1 +1,160 @@
-//! Rendering driver.
+//! The render driver: splits the image into tiles, renders them on a rayon
+//! pool, and averages the samples of each pixel.
+//!
+//! Each sample draws from its own counter-based stream keyed by (seed,
+//! pixel, sample index) and each pixel sums its samples in index order, so
+//! the image is bitwise identical for any thread count and tile order.
+
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+
+use crate::accel::Accel;
+use crate::film::Film;
+use crate::geometry::Vec3;
+use crate::integrator::{path, Context, Counters};
+use crate::sampling::Rng;
+use crate::scene::Scene;
+
+pub const TILE: u32 = 16;
+
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    /// Samples per pixel (overrides the scene's when Some).
+    pub spp: Option<u32>,
+    /// Seed (overrides the scene's when Some).
+    pub seed: Option<u64>,
+    /// Worker threads; None: rayon's default (all cores).
+    pub threads: Option<usize>,
+    /// Draw a progress bar on stderr.
+    pub progress: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions { spp: None, seed: None, threads: None, progress: false }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct RenderStats {
+    pub seconds: f64,
+    pub samples: u64,
+    pub threads: usize,
+    pub counters: Counters,
+}
+
+impl RenderStats {
+    pub fn summary(&self, backend: &str) -> String {
+        format!(
+            "{:.2} s wall, {:.3} Msamples/s, {:.2} Mrays/s ({} rays, {} threads, {backend}){}",
+            self.seconds,
+            self.samples as f64 / self.seconds / 1e6,
+            self.counters.rays as f64 / self.seconds / 1e6,
+            self.counters.rays,
+            self.threads,
+            if self.counters.nonfinite > 0 {
+                format!(", {} non-finite samples discarded", self.counters.nonfinite)
+            } else {
+                String::new()
+            }
+        )
+    }
+}
+
+pub fn render(scene: &Scene, accel: &dyn Accel, opts: &RenderOptions) -> Result<(Film, RenderStats), String> {
+    let mut scene_settings = scene.settings;
+    if let Some(s) = opts.spp {
+        scene_settings.spp = s;
+    }
+    if let Some(s) = opts.seed {
+        scene_settings.seed = s;
+    }
+    let scene_local;
+    let scene = if scene_settings != scene.settings {
+        scene_local = Scene { settings: scene_settings, ..scene.clone() };
+        &scene_local
+    } else {
+        scene
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let threads = pool.current_num_threads();
+    let ctx = Context::new(scene, accel);
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let tiles: Vec<(u32, u32)> =
+        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
+
+    let bar = if opts.progress {
+        let b = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} tiles, eta {eta}")
+                .unwrap()
+                .progress_chars("=> "),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+
+    let start = Instant::now();
+    let results: Vec<(Vec<Vec3>, Counters)> = pool.install(|| {
+        tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                let r = render_tile(&ctx, x0, y0);
+                bar.inc(1);
+                r
+            })
+            .collect()
+    });
+    let seconds = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    let mut film = Film::new(w, h);
+    let mut counters = Counters::default();
+    for (&(x0, y0), (pixels, c)) in tiles.iter().zip(results) {
+        counters += c;
+        let tw = TILE.min(w - x0);
+        for (i, p) in pixels.into_iter().enumerate() {
+            film.set(x0 + i as u32 % tw, y0 + i as u32 / tw, p);
+        }
+    }
+    let stats =
+        RenderStats { seconds, samples: w as u64 * h as u64 * scene.settings.spp as u64, threads, counters };
+    Ok((film, stats))
+}
+
+fn render_tile(ctx: &Context, x0: u32, y0: u32) -> (Vec<Vec3>, Counters) {
+    let scene = ctx.scene;
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
+    let spp = scene.settings.spp;
+    let mut counters = Counters::default();
+    let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let pixel = y as u64 * w as u64 + x as u64;
+            let mut sum = [0f64; 3];
+            for s in 0..spp {
+                let mut rng = Rng::new(scene.settings.seed, pixel, s as u64);
+                let [jx, jy] = rng.uniform2();
+                let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
+                let l = path::radiance(ctx, ray, &mut rng, &mut counters);
+                if l.is_finite() {
+                    sum[0] += l.x as f64;
+                    sum[1] += l.y as f64;
+                    sum[2] += l.z as f64;
+                } else {
+                    counters.nonfinite += 1;
+                }
+            }
+            let n = spp.max(1) as f64;
+            out.push(Vec3::new((sum[0] / n) as f32, (sum[1] / n) as f32, (sum[2] / n) as f32));
+        }
+    }
+    (out, counters)
+}

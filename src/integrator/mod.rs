@@ -1,1 +1,71 @@
-//! Integrators.
+//! Integrators: estimators of the radiance arriving at the camera.
+//!
+//! [`path`] is the unidirectional path tracer with next-event estimation
+//! and multiple importance sampling. [`plan`] decides once per scene which
+//! effects exist, so a scene pays only for what it uses. [`interaction`]
+//! turns an accel hit into the local surface geometry shading needs.
+
+pub mod interaction;
+pub mod path;
+pub mod plan;
+
+use crate::accel::Accel;
+use crate::lights::LightSet;
+use crate::scene::Scene;
+
+pub use interaction::Interaction;
+pub use plan::Plan;
+
+/// Everything an integrator reads while rendering; built once per render.
+pub struct Context<'a> {
+    pub scene: &'a Scene,
+    pub accel: &'a dyn Accel,
+    pub lights: LightSet,
+    pub plan: Plan,
+    /// Minimum offset for spawned rays, from the scene's size.
+    pub ray_epsilon: f32,
+}
+
+impl<'a> Context<'a> {
+    pub fn new(scene: &'a Scene, accel: &'a dyn Accel) -> Self {
+        let (lo, hi) = scene_bounds(scene);
+        let extent = (hi - lo).max_element();
+        let extent = if extent.is_finite() && extent > 0.0 { extent } else { 1.0 };
+        Context {
+            scene,
+            accel,
+            lights: LightSet::new(scene),
+            plan: Plan::new(scene),
+            ray_epsilon: extent * 1e-6,
+        }
+    }
+}
+
+fn scene_bounds(scene: &Scene) -> (glam::Vec3, glam::Vec3) {
+    let mut lo = glam::Vec3::splat(f32::INFINITY);
+    let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
+    for m in scene.meshes.iter() {
+        for &p in m.positions() {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    (lo, hi)
+}
+
+/// Per-thread tallies, summed after rendering (no shared atomics in the
+/// hot loop).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Ray queries issued: nearest, shadow and probe.
+    pub rays: u64,
+    /// Samples whose radiance was not finite and was discarded.
+    pub nonfinite: u64,
+}
+
+impl std::ops::AddAssign for Counters {
+    fn add_assign(&mut self, o: Self) {
+        self.rays += o.rays;
+        self.nonfinite += o.nonfinite;
+    }
+}

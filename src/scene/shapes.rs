@@ -134,7 +134,7 @@ pub fn random_soup(n: usize, size: f32, seed: u64) -> Mesh {
     let mut rng = Rng::from_key(seed);
     let mut p = Vec::with_capacity(3 * n);
     let mut idx = Vec::with_capacity(n);
-    let mut r3 =
+    let r3 =
         |rng: &mut Rng| Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE;
     for i in 0..n {
         let c = r3(&mut rng);

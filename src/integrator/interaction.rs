@@ -1,0 +1,67 @@
+//! The local geometry at a ray hit: position, geometric and shading normals
+//! and which face the ray arrived at.
+
+use crate::accel::Hit;
+use crate::geometry::{Frame, Mesh, Ray, Vec3};
+
+#[derive(Clone, Copy, Debug)]
+pub struct Interaction {
+    pub p: Vec3,
+    /// Unit geometric normal of the front face (counter-clockwise winding).
+    pub ng: Vec3,
+    /// Unit shading normal (interpolated vertex normals when the mesh has
+    /// them), flipped into the same hemisphere as `ng`.
+    pub ns: Vec3,
+    /// The ray arrived at the front face.
+    pub front: bool,
+    pub geom: u32,
+    pub prim: u32,
+}
+
+impl Interaction {
+    pub fn new(mesh: &Mesh, ray: &Ray, hit: &Hit) -> Self {
+        let [a, b, c] = mesh.triangle(hit.prim);
+        let (u, v) = (hit.u, hit.v);
+        let p = a * (1.0 - u - v) + b * u + c * v;
+        let ng = (b - a).cross(c - a).normalize_or_zero();
+        // Degenerate triangles never hit in either backend, but keep a valid
+        // normal if one does.
+        let ng = if ng == Vec3::ZERO { -ray.d.normalize_or_zero() } else { ng };
+        let ns = match &mesh.normals {
+            Some(ns) => {
+                let [i0, i1, i2] = mesh.indices[hit.prim as usize];
+                let n = ns[i0 as usize] * (1.0 - u - v) + ns[i1 as usize] * u + ns[i2 as usize] * v;
+                let n = n.normalize_or_zero();
+                if n == Vec3::ZERO {
+                    ng
+                } else if n.dot(ng) < 0.0 {
+                    -n
+                } else {
+                    n
+                }
+            }
+            None => ng,
+        };
+        Interaction { p, ng, ns, front: ray.d.dot(ng) < 0.0, geom: hit.geom, prim: hit.prim }
+    }
+
+    /// The shading frame oriented towards the side the ray came from.
+    pub fn shading_frame_facing(&self, wo: Vec3) -> Frame {
+        let n = if wo.dot(self.ng) >= 0.0 { self.ns } else { -self.ns };
+        Frame::from_normal(n)
+    }
+
+    /// A ray leaving the surface in `dir`, its origin pushed off the
+    /// surface along the geometric normal to the side `dir` goes, by an
+    /// amount that grows with the magnitude of the coordinates (f32
+    /// rounding of the hit point) and never falls below `eps`.
+    pub fn spawn(&self, dir: Vec3, eps: f32) -> Ray {
+        Ray::new(offset_origin(self.p, self.ng, dir, eps), dir)
+    }
+}
+
+pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3, eps: f32) -> Vec3 {
+    let e = eps.max(p.abs().max_element() * 4e-6);
+    let n = if dir.dot(ng) >= 0.0 { ng } else { -ng };
+    p + n * e
+}
