@@ -1,0 +1,472 @@
+//! Material parameters of the normalized diffusion BSSRDF: per channel the
+//! surface albedo A and the profile parameter d (scene units), plus the
+//! relative index of refraction η.
+//!
+//! Three ways in (Christensen & Burley 2015, §5; `docs/bssrdf.md` §3):
+//! - a named preset from Jensen et al. 2001, "A Practical Model for
+//!   Subsurface Light Transport", Fig. 5 (σs', σa in mm⁻¹ as in pbrt-v4);
+//! - measured coefficients (σs, g, σa, A, η): σs' = σs(1 − g),
+//!   σt' = σs' + σa, σtr = √(3 σa σt'), ℓd = 1/σtr, d = ℓd / s(A);
+//! - the artist form (A, ℓ): d = ℓ / s(A).
+//!
+//! Hard cases, decided here:
+//! - **σa = 0** (Spectralon): σtr = 0 and ℓd = ∞, which would make d infinite
+//!   and the object render black (all energy lands beyond any probe). We floor
+//!   the absorption at `MIN_ABSORPTION_FRACTION`·σt', i.e. 1 − α' ≥ 1e-6,
+//!   which caps ℓd at 1/√(3·1e-6) ≈ 577 volume mean free paths. No measured
+//!   material in the table is affected (the most forward one, Cream red, has
+//!   1 − α' = 2.7e-5); Spectralon gets ℓd ≈ 50/28/39 mm: finite, white, and
+//!   the energy stays A·CDF(Rmax) ≤ A. A material with σs' = σa = 0 is an
+//!   error (no medium).
+//! - **A = 0** (Ketchup blue): the channel is inactive ([`SubsurfaceParams::active`]);
+//!   samplers never pick it and never divide by its pdf; its d is still
+//!   computed (finite) but unused. d = 0 (artist ℓ = 0) is inactive too.
+//! - **Units**: the table is in mm⁻¹; `units_per_mm` converts lengths to
+//!   scene units (a scene in metres uses 1e-3).
+
+use super::profile::Fit;
+
+/// Lower bound on σa / σt' used for σa = 0 media; see the module docs.
+pub const MIN_ABSORPTION_FRACTION: f64 = 1e-6;
+
+/// One row of the Jensen et al. 2001 table (mm⁻¹).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Preset {
+    pub name: &'static str,
+    /// Reduced scattering coefficient σs' (RGB, mm⁻¹).
+    pub sigma_s_reduced: [f64; 3],
+    /// Absorption coefficient σa (RGB, mm⁻¹).
+    pub sigma_a: [f64; 3],
+    /// Measured diffuse reflectance, used as the surface albedo A.
+    pub albedo: [f64; 3],
+    pub eta: f32,
+}
+
+const fn p(name: &'static str, s: [f64; 3], a: [f64; 3], rd: [f64; 3], eta: f32) -> Preset {
+    Preset {
+        name,
+        sigma_s_reduced: s,
+        sigma_a: a,
+        albedo: rd,
+        eta,
+    }
+}
+
+/// Jensen et al. 2001, Fig. 5 (σs', σa as in pbrt-v4's table); η = 1.3
+/// except Marble (1.5).
+pub const PRESETS: [Preset; 12] = [
+    p(
+        "Apple",
+        [2.29, 2.39, 1.97],
+        [0.0030, 0.0034, 0.046],
+        [0.85, 0.84, 0.53],
+        1.3,
+    ),
+    p(
+        "Chicken1",
+        [0.15, 0.21, 0.38],
+        [0.015, 0.077, 0.19],
+        [0.31, 0.15, 0.10],
+        1.3,
+    ),
+    p(
+        "Chicken2",
+        [0.19, 0.25, 0.32],
+        [0.018, 0.088, 0.20],
+        [0.32, 0.16, 0.10],
+        1.3,
+    ),
+    p(
+        "Cream",
+        [7.38, 5.47, 3.15],
+        [0.0002, 0.0028, 0.0163],
+        [0.98, 0.90, 0.73],
+        1.3,
+    ),
+    p(
+        "Ketchup",
+        [0.18, 0.07, 0.03],
+        [0.061, 0.97, 1.45],
+        [0.16, 0.01, 0.00],
+        1.3,
+    ),
+    p(
+        "Marble",
+        [2.19, 2.62, 3.00],
+        [0.0021, 0.0041, 0.0071],
+        [0.83, 0.79, 0.75],
+        1.5,
+    ),
+    p(
+        "Potato",
+        [0.68, 0.70, 0.55],
+        [0.0024, 0.0090, 0.12],
+        [0.77, 0.62, 0.21],
+        1.3,
+    ),
+    p(
+        "Skimmilk",
+        [0.70, 1.22, 1.90],
+        [0.0014, 0.0025, 0.0142],
+        [0.81, 0.81, 0.69],
+        1.3,
+    ),
+    p(
+        "Skin1",
+        [0.74, 0.88, 1.01],
+        [0.032, 0.17, 0.48],
+        [0.44, 0.22, 0.13],
+        1.3,
+    ),
+    p(
+        "Skin2",
+        [1.09, 1.59, 1.79],
+        [0.013, 0.070, 0.145],
+        [0.63, 0.44, 0.34],
+        1.3,
+    ),
+    p(
+        "Spectralon",
+        [11.6, 20.4, 14.9],
+        [0.0, 0.0, 0.0],
+        [1.00, 1.00, 1.00],
+        1.3,
+    ),
+    p(
+        "Wholemilk",
+        [2.55, 3.21, 3.77],
+        [0.0011, 0.0024, 0.014],
+        [0.91, 0.88, 0.76],
+        1.3,
+    ),
+];
+
+/// The preset with this name, case-insensitively.
+pub fn preset(name: &str) -> Option<&'static Preset> {
+    PRESETS.iter().find(|p| p.name.eq_ignore_ascii_case(name))
+}
+
+/// Measured coefficients in mm⁻¹. With `g = 0`, `sigma_s` is taken to be the
+/// reduced coefficient σs' already (as in the Jensen table).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measured {
+    pub sigma_s: [f64; 3],
+    pub sigma_a: [f64; 3],
+    /// Henyey–Greenstein mean cosine; σs' = σs (1 − g).
+    pub g: f64,
+    pub albedo: [f64; 3],
+    pub eta: f32,
+}
+
+/// What the renderer needs per material: per channel A and d (scene units),
+/// and η. Build with one of the constructors, which validate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SubsurfaceParams {
+    pub albedo: [f64; 3],
+    /// Profile parameter d per channel, in scene units.
+    pub d: [f64; 3],
+    /// Relative index of refraction (inside / outside).
+    pub eta: f32,
+}
+
+const CH: [&str; 3] = ["r", "g", "b"];
+
+fn check_finite_nonneg(field: &str, v: [f64; 3]) -> Result<(), String> {
+    for (c, x) in v.iter().enumerate() {
+        if !x.is_finite() || *x < 0.0 {
+            return Err(format!(
+                "{field}.{}: {x} must be finite and non-negative",
+                CH[c]
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn check_albedo(v: [f64; 3]) -> Result<(), String> {
+    for (c, x) in v.iter().enumerate() {
+        if !(0.0..=1.0).contains(x) {
+            return Err(format!("albedo.{}: {x} must be in [0, 1]", CH[c]));
+        }
+    }
+    Ok(())
+}
+
+fn check_eta(eta: f32) -> Result<(), String> {
+    if !(eta.is_finite() && eta > 0.0) {
+        return Err(format!("eta: {eta} must be finite and positive"));
+    }
+    Ok(())
+}
+
+fn check_units(units_per_mm: f64) -> Result<(), String> {
+    if !(units_per_mm.is_finite() && units_per_mm > 0.0) {
+        return Err(format!(
+            "units_per_mm: {units_per_mm} must be finite and positive"
+        ));
+    }
+    Ok(())
+}
+
+/// The diffuse mean free path ℓd = 1/σtr (mm) of one channel, with σa
+/// floored as described in the module docs.
+pub fn diffuse_mfp(sigma_s_reduced: f64, sigma_a: f64) -> f64 {
+    let st = sigma_s_reduced + sigma_a;
+    let sa = sigma_a.max(MIN_ABSORPTION_FRACTION * st);
+    let st = sigma_s_reduced + sa;
+    1.0 / (3.0 * sa * st).sqrt()
+}
+
+impl SubsurfaceParams {
+    /// A named Jensen 2001 preset (case-insensitive), lengths converted with
+    /// `units_per_mm`, d from the chosen fit.
+    pub fn from_preset(name: &str, units_per_mm: f64, fit: Fit) -> Result<Self, String> {
+        let pr = preset(name).ok_or_else(|| {
+            let names: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
+            format!(
+                "preset: unknown material \"{name}\" (known: {})",
+                names.join(", ")
+            )
+        })?;
+        Self::from_measured(
+            &Measured {
+                sigma_s: pr.sigma_s_reduced,
+                sigma_a: pr.sigma_a,
+                g: 0.0,
+                albedo: pr.albedo,
+                eta: pr.eta,
+            },
+            units_per_mm,
+            fit,
+        )
+    }
+
+    /// Measured coefficients (mm⁻¹) → per-channel (A, d). The length fed to
+    /// the fit is ℓd = 1/σtr, or 1/σt' for [`Fit::VolumeMfp`].
+    pub fn from_measured(m: &Measured, units_per_mm: f64, fit: Fit) -> Result<Self, String> {
+        check_finite_nonneg("sigma_s", m.sigma_s)?;
+        check_finite_nonneg("sigma_a", m.sigma_a)?;
+        check_albedo(m.albedo)?;
+        check_eta(m.eta)?;
+        check_units(units_per_mm)?;
+        if !(m.g.is_finite() && m.g > -1.0 && m.g < 1.0) {
+            return Err(format!("g: {} must be in (-1, 1)", m.g));
+        }
+        let mut d = [0.0; 3];
+        for c in 0..3 {
+            let ss = m.sigma_s[c] * (1.0 - m.g);
+            let sa = m.sigma_a[c];
+            if ss + sa <= 0.0 {
+                return Err(format!(
+                    "sigma_s.{0}, sigma_a.{0}: both zero, there is no medium",
+                    CH[c]
+                ));
+            }
+            let len_mm = if fit.uses_volume_mfp() {
+                1.0 / (ss + sa)
+            } else {
+                diffuse_mfp(ss, sa)
+            };
+            d[c] = len_mm * units_per_mm / fit.s(m.albedo[c]);
+        }
+        Self::checked(m.albedo, d, m.eta)
+    }
+
+    /// Artist form: albedo A and mean free path ℓ (scene units; diffuse mean
+    /// free path for the dmfp fits, volume mean free path for
+    /// [`Fit::VolumeMfp`]), d = ℓ / s(A). ℓ = 0 makes a channel inactive.
+    pub fn from_artist(
+        albedo: [f64; 3],
+        mfp: [f64; 3],
+        eta: f32,
+        fit: Fit,
+    ) -> Result<Self, String> {
+        check_albedo(albedo)?;
+        check_finite_nonneg("mfp", mfp)?;
+        check_eta(eta)?;
+        let d = std::array::from_fn(|c| mfp[c] / fit.s(albedo[c]));
+        Self::checked(albedo, d, eta)
+    }
+
+    fn checked(albedo: [f64; 3], d: [f64; 3], eta: f32) -> Result<Self, String> {
+        let p = SubsurfaceParams { albedo, d, eta };
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// Checks the invariants every consumer relies on.
+    pub fn validate(&self) -> Result<(), String> {
+        check_albedo(self.albedo)?;
+        check_finite_nonneg("d", self.d)?;
+        check_eta(self.eta)
+    }
+
+    /// Whether channel `c` scatters at all (A > 0 and d > 0). Inactive
+    /// channels are never sampled and always contribute exactly 0.
+    #[inline]
+    pub fn active(&self, c: usize) -> bool {
+        self.albedo[c] > 0.0 && self.d[c] > 0.0
+    }
+
+    /// The largest d among active channels (0 if none is active).
+    pub fn max_active_d(&self) -> f64 {
+        (0..3)
+            .filter(|&c| self.active(c))
+            .map(|c| self.d[c])
+            .fold(0.0, f64::max)
+    }
+
+    /// Scales all lengths (e.g. an object instanced at a different scale).
+    pub fn scaled(&self, k: f64) -> Self {
+        SubsurfaceParams {
+            d: self.d.map(|d| d * k),
+            ..*self
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_are_complete_and_case_insensitive() {
+        assert_eq!(PRESETS.len(), 12);
+        for pr in &PRESETS {
+            let eta = if pr.name == "Marble" { 1.5 } else { 1.3 };
+            assert_eq!(pr.eta, eta);
+            let up = SubsurfaceParams::from_preset(&pr.name.to_uppercase(), 1.0, Fit::Searchlight)
+                .unwrap();
+            let lo = SubsurfaceParams::from_preset(&pr.name.to_lowercase(), 1.0, Fit::Searchlight)
+                .unwrap();
+            assert_eq!(up, lo);
+            for c in 0..3 {
+                assert!(
+                    up.d[c].is_finite() && up.d[c] > 0.0,
+                    "{} d {:?}",
+                    pr.name,
+                    up.d
+                );
+            }
+        }
+        let e = SubsurfaceParams::from_preset("jade", 1.0, Fit::Searchlight).unwrap_err();
+        assert!(e.starts_with("preset:") && e.contains("Marble"), "{e}");
+    }
+
+    #[test]
+    fn measured_form_follows_the_formulas() {
+        // Marble red by hand: σtr = √(3 σa (σs' + σa)), d = ℓd / s(A).
+        let m = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
+        let (ss, sa, a) = (2.19f64, 0.0021f64, 0.83f64);
+        let ld = 1.0 / (3.0 * sa * (ss + sa)).sqrt();
+        let d = ld / (3.5 + 100.0 * (a - 0.33f64).powi(4));
+        assert!((m.d[0] - d).abs() < 1e-12 * d);
+        assert_eq!(m.albedo, [0.83, 0.79, 0.75]);
+        assert_eq!(m.eta, 1.5);
+        // units: a scene in metres
+        let mm = SubsurfaceParams::from_preset("marble", 1e-3, Fit::Searchlight).unwrap();
+        assert!((mm.d[0] - d * 1e-3).abs() < 1e-15);
+        // g: σs = σs'/(1 − g) gives the same result
+        let g = SubsurfaceParams::from_measured(
+            &Measured {
+                sigma_s: [2.19 / 0.2, 2.62 / 0.2, 3.0 / 0.2],
+                sigma_a: [0.0021, 0.0041, 0.0071],
+                g: 0.8,
+                albedo: [0.83, 0.79, 0.75],
+                eta: 1.5,
+            },
+            1.0,
+            Fit::Searchlight,
+        )
+        .unwrap();
+        for c in 0..3 {
+            assert!((g.d[c] - m.d[c]).abs() < 1e-9 * m.d[c]);
+        }
+        // volume mfp fit uses 1/σt'
+        let v = SubsurfaceParams::from_preset("marble", 1.0, Fit::VolumeMfp).unwrap();
+        assert!((v.d[0] - 1.0 / (ss + sa) / Fit::VolumeMfp.s(a)).abs() < 1e-12);
+        let t = SubsurfaceParams::from_preset("marble", 1.0, Fit::DiffuseTransmission).unwrap();
+        assert!((t.d[0] - ld / Fit::DiffuseTransmission.s(a)).abs() < 1e-12 * ld);
+    }
+
+    #[test]
+    fn spectralon_sigma_a_zero_is_finite() {
+        let s = SubsurfaceParams::from_preset("Spectralon", 1.0, Fit::Searchlight).unwrap();
+        for c in 0..3 {
+            assert!(s.active(c) && s.d[c].is_finite() && s.d[c] > 0.0);
+            let ld = diffuse_mfp(PRESETS[10].sigma_s_reduced[c], 0.0);
+            // capped at 1/√(3·1e-6) volume mean free paths
+            let cap = 1.0 / (3.0 * MIN_ABSORPTION_FRACTION).sqrt() / PRESETS[10].sigma_s_reduced[c];
+            assert!((ld / cap - 1.0).abs() < 1e-5, "{ld} vs {cap}");
+        }
+        // and no table material is touched by the floor
+        for pr in PRESETS.iter().filter(|p| p.name != "Spectralon") {
+            for c in 0..3 {
+                let (ss, sa) = (pr.sigma_s_reduced[c], pr.sigma_a[c]);
+                let exact = 1.0 / (3.0 * sa * (ss + sa)).sqrt();
+                assert_eq!(diffuse_mfp(ss, sa), exact, "{}", pr.name);
+            }
+        }
+    }
+
+    #[test]
+    fn ketchup_blue_is_inactive() {
+        let k = SubsurfaceParams::from_preset("ketchup", 1.0, Fit::Searchlight).unwrap();
+        assert!(k.active(0) && k.active(1) && !k.active(2));
+        assert!(k.d[2].is_finite());
+        assert_eq!(k.max_active_d(), k.d[0].max(k.d[1]));
+    }
+
+    #[test]
+    fn validation_names_the_field() {
+        let e = SubsurfaceParams::from_artist([0.5, 1.2, 0.5], [1.0; 3], 1.3, Fit::Searchlight)
+            .unwrap_err();
+        assert!(e.starts_with("albedo.g"), "{e}");
+        let e =
+            SubsurfaceParams::from_artist([0.5; 3], [1.0, f64::NAN, 1.0], 1.3, Fit::Searchlight)
+                .unwrap_err();
+        assert!(e.starts_with("mfp.g"), "{e}");
+        let e =
+            SubsurfaceParams::from_artist([0.5; 3], [1.0; 3], 0.0, Fit::Searchlight).unwrap_err();
+        assert!(e.starts_with("eta"), "{e}");
+        let e = SubsurfaceParams::from_preset("apple", -1.0, Fit::Searchlight).unwrap_err();
+        assert!(e.starts_with("units_per_mm"), "{e}");
+        let base = Measured {
+            sigma_s: [1.0; 3],
+            sigma_a: [0.1; 3],
+            g: 0.0,
+            albedo: [0.5; 3],
+            eta: 1.3,
+        };
+        let e = SubsurfaceParams::from_measured(
+            &Measured {
+                sigma_a: [0.1, -0.1, 0.1],
+                ..base
+            },
+            1.0,
+            Fit::Searchlight,
+        )
+        .unwrap_err();
+        assert!(e.starts_with("sigma_a.g"), "{e}");
+        let e =
+            SubsurfaceParams::from_measured(&Measured { g: 1.0, ..base }, 1.0, Fit::Searchlight)
+                .unwrap_err();
+        assert!(e.starts_with("g:"), "{e}");
+        let e = SubsurfaceParams::from_measured(
+            &Measured {
+                sigma_s: [0.0; 3],
+                sigma_a: [0.0, 1.0, 1.0],
+                ..base
+            },
+            1.0,
+            Fit::Searchlight,
+        )
+        .unwrap_err();
+        assert!(e.contains("no medium"), "{e}");
+        // artist form: ℓ = 0 is allowed and makes the channel inactive
+        let a = SubsurfaceParams::from_artist([0.5; 3], [1.0, 0.0, 2.0], 1.3, Fit::Searchlight)
+            .unwrap();
+        assert!(a.active(0) && !a.active(1) && a.active(2));
+        assert!((a.d[2] - 2.0 / Fit::Searchlight.s(0.5)).abs() < 1e-15);
+    }
+}
