@@ -1,0 +1,312 @@
+//! Our own BVH: the reference [`Accel`] backend.
+//!
+//! Two levels: one binned-SAH hierarchy per mesh ([`build`]) and a small
+//! top-level hierarchy over the meshes' bounds. Nearest-hit and occlusion
+//! queries walk the top level and descend into the meshes whose boxes the
+//! ray meets; [`Accel::hits_on_segment`] asks about one mesh and so walks
+//! only that mesh's tree. Triangles are tested with the watertight test of
+//! Woop et al. 2013 ([`triangle`]), with inclusive edges, so a ray through a
+//! shared edge or vertex is never lost; their vertices are copied in leaf
+//! order so that a leaf's triangles are contiguous in memory.
+//!
+//! Triangles that can never be hit (non-finite coordinates, or zero area)
+//! are left out of the hierarchy, which keeps NaN out of the SAH and box
+//! arithmetic.
+
+mod build;
+mod traverse;
+pub mod triangle;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use self::build::{PrimRef, Tree};
+use self::traverse::{traverse, RayBox, Visit};
+use self::triangle::RayTri;
+use super::{Accel, Hit, ProbeHits};
+use crate::geometry::{Mesh, Ray};
+
+/// Most triangles per leaf; the SAH usually stops earlier.
+const MAX_LEAF: usize = 8;
+
+/// A triangle's vertices, stored in leaf order.
+#[derive(Clone, Copy, Debug)]
+struct Tri {
+    p: [Vec3; 3],
+}
+
+/// One mesh's hierarchy; `tree.order[i]` is the mesh-level index of
+/// `tris[i]`.
+#[derive(Clone, Debug, Default)]
+struct MeshBvh {
+    tree: Tree,
+    tris: Vec<Tri>,
+}
+
+/// Whether a triangle can ever be hit by [`RayTri::intersect`]: finite
+/// coordinates and non-zero area. The area test is done in f64, where the
+/// cross product of f32 edge vectors is exact for all but extreme exponent
+/// ranges, so exactly collinear vertices are caught.
+pub fn can_hit(p: [Vec3; 3]) -> bool {
+    if !p.iter().all(|v| v.is_finite()) {
+        return false;
+    }
+    let e1 = p[1].as_dvec3() - p[0].as_dvec3();
+    let e2 = p[2].as_dvec3() - p[0].as_dvec3();
+    e1.cross(e2) != glam::DVec3::ZERO
+}
+
+impl MeshBvh {
+    fn build(mesh: &Mesh) -> Self {
+        let prims: Vec<PrimRef> = (0..mesh.triangle_count() as u32)
+            .into_par_iter()
+            .filter_map(|id| {
+                let p = mesh.triangle(id);
+                can_hit(p).then(|| PrimRef {
+                    lo: p[0].min(p[1]).min(p[2]),
+                    hi: p[0].max(p[1]).max(p[2]),
+                    id,
+                })
+            })
+            .collect();
+        let tree = build::build(prims, MAX_LEAF);
+        let tris = tree
+            .order
+            .par_iter()
+            .map(|&id| Tri {
+                p: mesh.triangle(id),
+            })
+            .collect();
+        MeshBvh { tree, tris }
+    }
+}
+
+/// The BVH backend. See the module documentation.
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    /// Over mesh bounds; leaves hold one mesh each, `top.order` maps them
+    /// to mesh indices.
+    top: Tree,
+    meshes: Vec<MeshBvh>,
+}
+
+impl Bvh {
+    /// Builds the hierarchies; mesh `i` is `geom` `i`.
+    pub fn build(meshes: &[Mesh]) -> Self {
+        // Meshes build one after another, each in parallel inside: a scene
+        // is usually one big mesh and a few small ones.
+        let built: Vec<MeshBvh> = meshes.iter().map(MeshBvh::build).collect();
+        let prims: Vec<PrimRef> = built
+            .iter()
+            .enumerate()
+            .filter(|(_, m)| !m.tree.pairs.is_empty())
+            .map(|(i, m)| {
+                let n = m.tree.node(0);
+                PrimRef {
+                    lo: Vec3::from(n.b[0]),
+                    hi: Vec3::from(n.b[1]),
+                    id: i as u32,
+                }
+            })
+            .collect();
+        Bvh {
+            top: build::build(prims, 1),
+            meshes: built,
+        }
+    }
+
+    /// Node count and depth of each mesh's tree, for logs and tuning.
+    pub fn stats(&self) -> Vec<(usize, usize)> {
+        self.meshes
+            .iter()
+            .map(|m| (m.tree.node_count(), m.tree.depth()))
+            .collect()
+    }
+}
+
+/// Rays the traversal should not see: NaN or infinite origin or
+/// direction (NaN slab distances would make every box look hit).
+#[inline(always)]
+fn bad_ray(ray: &Ray) -> bool {
+    !(ray.o.is_finite() && ray.d.is_finite())
+}
+
+impl Accel for Bvh {
+    fn name(&self) -> &'static str {
+        "bvh"
+    }
+
+    fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
+        if bad_ray(ray) || tmin.is_nan() || tmax.is_nan() || tmin > tmax {
+            return None;
+        }
+        let rb = RayBox::new(ray);
+        let rt = RayTri::new(ray);
+        // (geom, leaf-order index, u, v) of the nearest hit so far; its t is
+        // the running tmax.
+        let mut best: Option<(u32, u32, f32, f32)> = None;
+        let mut t = tmax;
+        traverse(&self.top, &rb, tmin, &mut t, |first, count, t| {
+            for k in first..first + count {
+                let g = self.top.order[k as usize];
+                let m = &self.meshes[g as usize];
+                traverse(&m.tree, &rb, tmin, t, |first, count, t| {
+                    for i in first..first + count {
+                        let p = &m.tris[i as usize].p;
+                        if let Some((th, u, v)) = rt.intersect(p[0], p[1], p[2], tmin, *t) {
+                            *t = th;
+                            best = Some((g, i, u, v));
+                        }
+                    }
+                    Visit::Continue
+                });
+            }
+            Visit::Continue
+        });
+        best.map(|(geom, i, u, v)| Hit {
+            t,
+            geom,
+            prim: self.meshes[geom as usize].tree.order[i as usize],
+            u,
+            v,
+        })
+    }
+
+    fn occluded(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
+        if bad_ray(ray) || tmin.is_nan() || tmax.is_nan() || tmin > tmax {
+            return false;
+        }
+        let rb = RayBox::new(ray);
+        let rt = RayTri::new(ray);
+        let mut t = tmax;
+        traverse(&self.top, &rb, tmin, &mut t, |first, count, t| {
+            for k in first..first + count {
+                let m = &self.meshes[self.top.order[k as usize] as usize];
+                let hit = traverse(&m.tree, &rb, tmin, t, |first, count, t| {
+                    let any = m.tris[first as usize..(first + count) as usize]
+                        .iter()
+                        .any(|tri| {
+                            let p = &tri.p;
+                            rt.intersect(p[0], p[1], p[2], tmin, *t).is_some()
+                        });
+                    if any {
+                        Visit::Stop
+                    } else {
+                        Visit::Continue
+                    }
+                });
+                if hit {
+                    return Visit::Stop;
+                }
+            }
+            Visit::Continue
+        })
+    }
+
+    fn hits_on_segment(&self, ray: &Ray, tmax: f32, geom: u32, seed: u32, out: &mut ProbeHits) {
+        out.reset(seed);
+        if let Some(m) = self.meshes.get(geom as usize) {
+            if !bad_ray(ray) && tmax >= 0.0 {
+                let rb = RayBox::new(ray);
+                let rt = RayTri::new(ray);
+                let mut t = tmax;
+                traverse(&m.tree, &rb, 0.0, &mut t, |first, count, t| {
+                    for i in first..first + count {
+                        let p = &m.tris[i as usize].p;
+                        if let Some((th, u, v)) = rt.intersect(p[0], p[1], p[2], 0.0, *t) {
+                            out.record(Hit {
+                                t: th,
+                                geom,
+                                prim: m.tree.order[i as usize],
+                                u,
+                                v,
+                            });
+                        }
+                    }
+                    Visit::Continue
+                });
+            }
+        }
+        out.finish();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::shapes;
+
+    #[test]
+    fn sphere_is_hit_from_outside_and_inside() {
+        let bvh = Bvh::build(&[shapes::sphere(3)]);
+        // Off the axes: the z axis meets the sphere at shared vertices,
+        // where the inclusive edges hit every triangle around them.
+        let r = Ray::new(Vec3::new(0.0123, 0.0456, -5.0), Vec3::Z);
+        let h = bvh.intersect(&r, 0.0, f32::INFINITY).unwrap();
+        assert!((h.t - 4.0).abs() < 0.02, "t {}", h.t);
+        let inside = Ray::new(Vec3::ZERO, Vec3::new(0.3, -0.2, 0.9).normalize());
+        let h = bvh.intersect(&inside, 0.0, f32::INFINITY).unwrap();
+        assert!((h.t - 1.0).abs() < 0.02);
+        assert!(bvh.occluded(&inside, 0.0, 2.0));
+        assert!(!bvh.occluded(&inside, 0.0, 0.9));
+        let mut out = ProbeHits::new();
+        bvh.hits_on_segment(&r, 10.0, 0, 1, &mut out);
+        assert_eq!(out.total(), 2);
+        assert!(out.hits()[0].t < out.hits()[1].t);
+    }
+
+    #[test]
+    fn nearest_hit_picks_the_right_mesh() {
+        let mut near = shapes::quad();
+        near.transform(|p| p + Vec3::Z, |n| n);
+        let far = shapes::quad();
+        let bvh = Bvh::build(&[far, Mesh::default(), near]);
+        let r = Ray::new(Vec3::new(0.1, 0.2, 3.0), -Vec3::Z);
+        let h = bvh.intersect(&r, 0.0, 10.0).unwrap();
+        assert_eq!(h.geom, 2);
+        assert!((h.t - 2.0).abs() < 1e-6);
+        // beyond the near quad: the far one
+        let h = bvh.intersect(&r, 2.5, 10.0).unwrap();
+        assert_eq!(h.geom, 0);
+        let mut out = ProbeHits::new();
+        bvh.hits_on_segment(&r, 10.0, 0, 0, &mut out);
+        assert_eq!((out.total(), out.hits()[0].geom), (1, 0));
+        bvh.hits_on_segment(&r, 10.0, 1, 0, &mut out);
+        assert_eq!(out.total(), 0);
+        bvh.hits_on_segment(&r, 10.0, 7, 0, &mut out);
+        assert_eq!(out.total(), 0);
+    }
+
+    #[test]
+    fn bad_rays_and_intervals_hit_nothing() {
+        let bvh = Bvh::build(&[shapes::cuboid()]);
+        let o = Vec3::new(0.0, 0.0, -5.0);
+        for r in [
+            Ray::new(o, Vec3::ZERO),
+            Ray::new(o, Vec3::new(f32::NAN, 0.0, 1.0)),
+            Ray::new(Vec3::new(f32::NAN, 0.0, 0.0), Vec3::Z),
+            Ray::new(o, Vec3::new(0.0, 0.0, f32::INFINITY)),
+        ] {
+            assert!(bvh.intersect(&r, 0.0, f32::INFINITY).is_none());
+            assert!(!bvh.occluded(&r, 0.0, f32::INFINITY));
+        }
+        let r = Ray::new(o, Vec3::Z);
+        assert!(bvh.intersect(&r, 0.0, f32::INFINITY).is_some());
+        assert!(bvh.intersect(&r, 5.0, 1.0).is_none());
+        assert!(bvh.intersect(&r, f32::NAN, 10.0).is_none());
+    }
+
+    #[test]
+    fn unhittable_triangles_are_left_out() {
+        let nan = Vec3::new(f32::NAN, 0.0, 0.0);
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, nan, Vec3::new(2.0, 0.0, 0.0)];
+        // good, NaN, repeated vertex, collinear
+        let idx = vec![[0, 1, 2], [0, 3, 1], [0, 0, 2], [0, 1, 4]];
+        let bvh = Bvh::build(&[Mesh::new(p, idx, None)]);
+        assert_eq!(bvh.meshes[0].tris.len(), 1);
+        let h = bvh
+            .intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z), 0.0, 9.0)
+            .unwrap();
+        assert_eq!(h.prim, 0);
+    }
+}

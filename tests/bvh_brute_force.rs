@@ -1,0 +1,433 @@
+//! The BVH against a brute-force loop over every triangle with the same
+//! triangle test: nearest hit, occlusion and probe-segment hit lists must
+//! agree exactly on random soups, multi-mesh scenes, exact grids (rays
+//! through shared vertices and edges), degenerate input and overflowing
+//! probe segments.
+
+use lucent::accel::bvh::triangle::RayTri;
+use lucent::accel::bvh::{can_hit, Bvh};
+use lucent::accel::{Accel, Hit, ProbeHits, MAX_PROBE_HITS};
+use lucent::geometry::{Mesh, Ray, Vec3};
+use lucent::sampling::Rng;
+use lucent::scene::shapes;
+
+/// The reference: every triangle that can be hit, in order.
+struct Brute<'a> {
+    meshes: &'a [Mesh],
+    tris: Vec<(u32, u32, [Vec3; 3])>,
+}
+
+impl<'a> Brute<'a> {
+    fn new(meshes: &'a [Mesh]) -> Self {
+        let tris = meshes
+            .iter()
+            .enumerate()
+            .flat_map(|(g, m)| {
+                (0..m.triangle_count() as u32).filter_map(move |i| {
+                    let p = m.triangle(i);
+                    can_hit(p).then_some((g as u32, i, p))
+                })
+            })
+            .collect();
+        Brute { meshes, tris }
+    }
+    fn test(&self, ray: &Ray, p: [Vec3; 3], tmin: f32, tmax: f32) -> Option<(f32, f32, f32)> {
+        RayTri::new(ray).intersect(p[0], p[1], p[2], tmin, tmax)
+    }
+    fn all(&self, ray: &Ray, tmin: f32, tmax: f32) -> Vec<Hit> {
+        let rt = RayTri::new(ray);
+        let mut v: Vec<Hit> = self
+            .tris
+            .iter()
+            .filter_map(|&(geom, prim, p)| {
+                rt.intersect(p[0], p[1], p[2], tmin, tmax)
+                    .map(|(t, u, v)| Hit {
+                        t,
+                        geom,
+                        prim,
+                        u,
+                        v,
+                    })
+            })
+            .collect();
+        v.sort_by(|a, b| {
+            a.t.total_cmp(&b.t)
+                .then(a.geom.cmp(&b.geom))
+                .then(a.prim.cmp(&b.prim))
+        });
+        v
+    }
+    fn nearest(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
+        self.all(ray, tmin, tmax).first().copied()
+    }
+    fn segment(&self, ray: &Ray, tmax: f32, geom: u32, seed: u32) -> ProbeHits {
+        probe(&self.all(ray, 0.0, tmax), geom, seed)
+    }
+}
+
+/// What hits_on_segment should return, given every hit on the segment.
+fn probe(all: &[Hit], geom: u32, seed: u32) -> ProbeHits {
+    let mut out = ProbeHits::new();
+    out.reset(seed);
+    for h in all.iter().filter(|h| h.geom == geom) {
+        out.record(*h);
+    }
+    out.finish();
+    out
+}
+
+/// Checks all three queries of `bvh` against brute force on one ray.
+fn compare(bvh: &Bvh, brute: &Brute, ray: &Ray, tmin: f32, tmax: f32, seed: u32) {
+    let want = brute.nearest(ray, tmin, tmax);
+    let got = bvh.intersect(ray, tmin, tmax);
+    match (want, got) {
+        (None, None) => {}
+        (Some(w), Some(g)) => {
+            assert_eq!(
+                w.t.to_bits(),
+                g.t.to_bits(),
+                "t differs: {ray:?} {w:?} {g:?}"
+            );
+            if (w.geom, w.prim) == (g.geom, g.prim) {
+                assert_eq!((w.u, w.v), (g.u, g.v));
+            } else {
+                // An exact tie: the BVH's triangle must really hit at w.t.
+                let p = brute.meshes[g.geom as usize].triangle(g.prim);
+                let again = brute.test(ray, p, tmin, tmax).map(|h| h.0);
+                assert_eq!(again, Some(w.t), "not a tie: {ray:?} {w:?} {g:?}");
+            }
+        }
+        _ => panic!("nearest differs on {ray:?} [{tmin}, {tmax}]: want {want:?}, got {got:?}"),
+    }
+    assert_eq!(
+        bvh.occluded(ray, tmin, tmax),
+        want.is_some(),
+        "occluded differs on {ray:?} [{tmin}, {tmax}]"
+    );
+    let mut out = ProbeHits::new();
+    let all = brute.all(ray, 0.0, tmax);
+    for geom in 0..brute.meshes.len() as u32 {
+        bvh.hits_on_segment(ray, tmax, geom, seed, &mut out);
+        let w = probe(&all, geom, seed);
+        assert_eq!(
+            out.total(),
+            w.total(),
+            "segment total on {ray:?} geom {geom}"
+        );
+        assert_eq!(out.hits(), w.hits(), "segment hits on {ray:?} geom {geom}");
+    }
+}
+
+fn r3(rng: &mut Rng) -> Vec3 {
+    Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE
+}
+
+/// A random ray: origin inside or outside the unit cube, random direction
+/// and length, sometimes with zeroed components; a random interval.
+fn random_query(rng: &mut Rng) -> (Ray, f32, f32) {
+    let o = if rng.uniform() < 0.5 {
+        r3(rng) * 1.2
+    } else {
+        r3(rng).normalize_or(Vec3::X) * 3.0
+    };
+    // Aim near the geometry half of the time, anywhere otherwise.
+    let mut d = if rng.uniform() < 0.5 {
+        r3(rng) * 0.8 - o
+    } else {
+        r3(rng)
+    };
+    match (rng.uniform() * 8.0) as u32 {
+        0 => d.x = 0.0,
+        1 => {
+            d.y = 0.0;
+            d.z = -0.0;
+        }
+        2 => {
+            d.x = 0.0;
+            d.z = 0.0;
+        }
+        _ => {}
+    }
+    if d == Vec3::ZERO {
+        d = Vec3::Y;
+    }
+    d *= 0.1 + 10.0 * rng.uniform();
+    let len = 4.0 / d.length();
+    let (tmin, tmax) = match (rng.uniform() * 4.0) as u32 {
+        0 => (0.0, f32::INFINITY),
+        1 => (0.0, rng.uniform() * len),
+        2 => {
+            let a = rng.uniform() * len;
+            (a, a + rng.uniform() * len)
+        }
+        _ => (rng.uniform() * 0.5 * len, f32::INFINITY),
+    };
+    (Ray::new(o, d), tmin, tmax)
+}
+
+fn run_random(meshes: &[Mesh], rays: usize, seed: u64) {
+    let bvh = Bvh::build(meshes);
+    let brute = Brute::new(meshes);
+    let mut rng = Rng::from_key(seed);
+    let mut hits = 0;
+    for i in 0..rays {
+        let (ray, tmin, tmax) = random_query(&mut rng);
+        compare(&bvh, &brute, &ray, tmin, tmax, i as u32);
+        hits += bvh.intersect(&ray, tmin, tmax).is_some() as usize;
+    }
+    // The comparison means little if nothing (or everything) was hit.
+    if meshes.iter().map(Mesh::triangle_count).sum::<usize>() >= 100 {
+        assert!(hits > rays / 10 && hits < rays, "{hits} of {rays} rays hit");
+    }
+}
+
+#[test]
+fn random_soups_of_several_sizes() {
+    for (n, size, rays) in [
+        (1, 1.0, 2000),
+        (5, 0.8, 2000),
+        (100, 0.5, 3000),
+        (1000, 0.3, 3000),
+        (20_000, 0.1, 2000),
+    ] {
+        run_random(
+            &[shapes::random_soup(n, size, n as u64)],
+            rays,
+            7 + n as u64,
+        );
+    }
+}
+
+#[test]
+fn multiple_meshes() {
+    let mut moved = shapes::sphere(3);
+    moved.transform(|p| p * 0.5 + Vec3::new(0.3, 0.0, 0.2), |n| n);
+    let meshes = vec![
+        shapes::random_soup(500, 0.4, 1),
+        Mesh::default(),
+        shapes::random_soup(2000, 0.2, 2),
+        moved,
+        shapes::cuboid(),
+        shapes::random_soup(3, 2.0, 3),
+    ];
+    run_random(&meshes, 3000, 99);
+}
+
+#[test]
+fn closed_surfaces_are_hit_twice_along_through_segments() {
+    // A big tessellated surface also exercises the parallel build.
+    let meshes = vec![shapes::displaced_sphere(5, 0.1)];
+    run_random(&meshes, 1000, 5);
+}
+
+/// An n×n grid of unit squares in the plane `axis` = `level`, with exact
+/// integer coordinates offset by `base`, two triangles per square.
+fn grid(n: u32, axis: usize, level: f32, base: f32) -> Mesh {
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let mut v = Vec3::splat(level);
+            v[(axis + 1) % 3] = base + i as f32;
+            v[(axis + 2) % 3] = base + j as f32;
+            p.push(v);
+        }
+    }
+    let mut idx = Vec::new();
+    let at = |i: u32, j: u32| j * (n + 1) + i;
+    for j in 0..n {
+        for i in 0..n {
+            // alternate the diagonal so vertices have 4, 6 or 8 triangles
+            if (i + j) % 2 == 0 {
+                idx.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                idx.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            } else {
+                idx.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+                idx.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+    }
+    Mesh::new(p, idx, None)
+}
+
+#[test]
+fn rays_through_shared_vertices_and_edges_of_a_grid_hit() {
+    let n = 16u32;
+    for (axis, base) in [(2usize, 0.0f32), (0, -8.0), (1, 1000.0)] {
+        let meshes = vec![grid(n, axis, 0.5, base)];
+        let bvh = Bvh::build(&meshes);
+        let brute = Brute::new(&meshes);
+        let mut checked = 0;
+        // every vertex, edge midpoint and square centre, including the border
+        for j2 in 0..=2 * n {
+            for i2 in 0..=2 * n {
+                let mut target = Vec3::splat(0.5);
+                target[(axis + 1) % 3] = base + i2 as f32 * 0.5;
+                target[(axis + 2) % 3] = base + j2 as f32 * 0.5;
+                for s in [1.0f32, -1.0] {
+                    let mut d = Vec3::ZERO;
+                    d[axis] = s;
+                    let ray = Ray::new(target - d * 2.0, d);
+                    let h = bvh.intersect(&ray, 0.0, f32::INFINITY);
+                    assert_eq!(h.map(|h| h.t), Some(2.0), "lost {ray:?}");
+                    assert!(bvh.occluded(&ray, 0.0, 2.0));
+                    assert!(!bvh.occluded(&ray, 0.0, 1.999));
+                    let mut out = ProbeHits::new();
+                    bvh.hits_on_segment(&ray, 4.0, 0, 3, &mut out);
+                    // every triangle touching the point, and nothing else
+                    let touching = brute.all(&ray, 0.0, 4.0);
+                    assert!(!touching.is_empty());
+                    assert_eq!(out.hits(), &touching[..], "{ray:?}");
+                    if i2 % 2 == 0 && j2 % 2 == 0 && i2 > 0 && j2 > 0 && i2 < 2 * n && j2 < 2 * n {
+                        assert!(out.total() >= 4, "inner vertex: {} hits", out.total());
+                    }
+                    compare(&bvh, &brute, &ray, 0.0, f32::INFINITY, 1);
+                    checked += 1;
+                }
+            }
+        }
+        assert_eq!(checked, 2 * (2 * n + 1) * (2 * n + 1));
+    }
+}
+
+#[test]
+fn oblique_rays_through_grid_vertices_are_not_lost() {
+    let meshes = vec![grid(9, 2, 0.0, 0.0)];
+    let bvh = Bvh::build(&meshes);
+    let brute = Brute::new(&meshes);
+    let mut rng = Rng::from_key(4);
+    for _ in 0..4000 {
+        // Inner vertices only: a ray through a border vertex may
+        // legitimately pass just outside the mesh after rounding.
+        let target = Vec3::new(
+            1.0 + (rng.uniform() * 7.0).floor(),
+            1.0 + (rng.uniform() * 7.0).floor(),
+            0.0,
+        );
+        let mut o = r3(&mut rng) * 6.0;
+        o.z = if o.z.abs() < 0.1 { 1.0 } else { o.z };
+        let ray = Ray::new(o, target - o);
+        let h = bvh.intersect(&ray, 0.0, f32::INFINITY);
+        assert!(h.is_some(), "lost {ray:?} -> {target:?}");
+        compare(&bvh, &brute, &ray, 0.0, f32::INFINITY, 2);
+    }
+}
+
+#[test]
+fn empty_scenes_hit_nothing() {
+    for meshes in [vec![], vec![Mesh::default(), Mesh::default()]] {
+        let bvh = Bvh::build(&meshes);
+        let ray = Ray::new(Vec3::ZERO, Vec3::X);
+        assert!(bvh.intersect(&ray, 0.0, f32::INFINITY).is_none());
+        assert!(!bvh.occluded(&ray, 0.0, f32::INFINITY));
+        let mut out = ProbeHits::new();
+        for geom in 0..3 {
+            bvh.hits_on_segment(&ray, 10.0, geom, 0, &mut out);
+            assert_eq!((out.total(), out.hits().len()), (0, 0));
+        }
+    }
+}
+
+#[test]
+fn degenerate_triangles_never_hit() {
+    // A good triangle plus, along the same rays, degenerate ones: repeated
+    // vertices, collinear vertices (exact integers, so exactly collinear),
+    // a point, and NaN and infinite coordinates.
+    let p = vec![
+        Vec3::new(-4.0, -4.0, 0.0),
+        Vec3::new(4.0, -4.0, 0.0),
+        Vec3::new(0.0, 4.0, 0.0),
+        Vec3::new(-1.0, -1.0, 1.0),
+        Vec3::new(1.0, 1.0, 1.0),
+        Vec3::new(3.0, 3.0, 1.0),
+        Vec3::new(0.0, 0.0, 2.0),
+        Vec3::new(f32::NAN, 0.0, 3.0),
+        Vec3::new(1.0, f32::INFINITY, 3.0),
+        Vec3::new(-1.0, 1.0, -1.0),
+        Vec3::new(1.0, -1.0, -1.0),
+        Vec3::new(3.0, -3.0, -1.0),
+    ];
+    let idx = vec![
+        [0, 1, 2],
+        [3, 4, 5],
+        [3, 3, 4],
+        [6, 6, 6],
+        [7, 0, 1],
+        [8, 1, 2],
+        [9, 10, 11],
+        [4, 5, 4],
+        [7, 7, 7],
+    ];
+    let meshes = vec![Mesh::new(p, idx, None)];
+    let bvh = Bvh::build(&meshes);
+    let brute = Brute::new(&meshes);
+    let mut rng = Rng::from_key(8);
+    let mut out = ProbeHits::new();
+    for _ in 0..5000 {
+        // aim at points on the degenerate triangles, from anywhere
+        let target = match (rng.uniform() * 3.0) as u32 {
+            0 => Vec3::new(-1.0, -1.0, 1.0) + Vec3::new(1.0, 1.0, 0.0) * 4.0 * rng.uniform(),
+            1 => Vec3::new(0.0, 0.0, 2.0),
+            _ => Vec3::new(-1.0, 1.0, -1.0) + Vec3::new(1.0, -1.0, 0.0) * 4.0 * rng.uniform(),
+        };
+        let o = r3(&mut rng) * 10.0;
+        let ray = Ray::new(o, target - o);
+        if let Some(h) = bvh.intersect(&ray, 0.0, f32::INFINITY) {
+            assert_eq!(h.prim, 0, "{ray:?}");
+        }
+        bvh.hits_on_segment(&ray, 100.0, 0, 0, &mut out);
+        assert!(out.hits().iter().all(|h| h.prim == 0) && out.total() <= 1);
+        compare(&bvh, &brute, &ray, 0.0, f32::INFINITY, 0);
+    }
+    // The degenerate ones really are degenerate for the triangle test too.
+    let m = &meshes[0];
+    for prim in 1..m.triangle_count() as u32 {
+        assert!(!can_hit(m.triangle(prim)), "prim {prim}");
+    }
+}
+
+#[test]
+fn probe_segment_through_200_quads_overflows_like_brute_force() {
+    let mut p = Vec::new();
+    let mut idx = Vec::new();
+    for k in 0..200u32 {
+        let z = k as f32 * 0.01;
+        for (x, y) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            p.push(Vec3::new(x, y, z));
+        }
+        let b = 4 * k;
+        idx.push([b, b + 1, b + 2]);
+        idx.push([b, b + 2, b + 3]);
+    }
+    // A second mesh on the same segment must not be counted.
+    let meshes = vec![Mesh::new(p, idx, None), shapes::quad()];
+    let bvh = Bvh::build(&meshes);
+    let brute = Brute::new(&meshes);
+    // off the quads' diagonals: one triangle per quad
+    let ray = Ray::new(Vec3::new(0.3, -0.5, -1.0), Vec3::Z);
+    let mut out = ProbeHits::new();
+    let mut kept_sets = Vec::new();
+    for seed in 0..8 {
+        bvh.hits_on_segment(&ray, 4.0, 0, seed, &mut out);
+        assert_eq!(out.total(), 200);
+        assert_eq!(out.hits().len(), MAX_PROBE_HITS);
+        assert_eq!(out.hits(), brute.segment(&ray, 4.0, 0, seed).hits());
+        for w in out.hits().windows(2) {
+            assert!(w[0].t <= w[1].t);
+        }
+        for h in out.hits() {
+            assert_eq!(h.geom, 0);
+            let q = meshes[0].triangle(h.prim);
+            let again = brute.test(&ray, q, 0.0, 4.0).unwrap();
+            assert_eq!(again, (h.t, h.u, h.v));
+            assert!((h.t - (1.0 + (h.prim / 2) as f32 * 0.01)).abs() < 1e-5);
+        }
+        kept_sets.push(out.hits().iter().map(|h| h.prim).collect::<Vec<_>>());
+    }
+    // The seed selects the subset.
+    kept_sets.dedup();
+    assert!(kept_sets.len() > 1);
+    // Shorter segments count only what they cross.
+    bvh.hits_on_segment(&ray, 1.5, 0, 0, &mut out);
+    assert_eq!(out.total(), 51);
+    assert_eq!(out.hits().len(), 51);
+}
