@@ -1,1 +1,245 @@
-//! Serde structures of the TOML scene format.
+//! Serde structures of the TOML scene format (`docs/scene-format.md`).
+//!
+//! These types only describe the *shape* of a scene file: every table
+//! rejects unknown keys, and every value that [`super::load`] validates
+//! afterwards is wrapped in [`Spanned`] so a rejected value can be reported
+//! with its line. Range checks, name resolution and conversion to a
+//! [`super::Scene`] live in `load.rs`.
+//!
+//! Materials and shapes are flat tables with a `type` key rather than serde
+//! internally-tagged enums: serde buffers internally-tagged content, which
+//! throws the spans away. Instead each table lists the union of the keys of
+//! its types, and `load.rs` checks that only the keys of the given `type`
+//! are present. A new material type is one more [`MaterialKind`] variant,
+//! its keys here, and one more match arm in the loader.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::ops::Range;
+
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use serde::Deserialize;
+pub use toml::Spanned;
+
+/// Three numbers: a point, a direction or an RGB triple.
+pub type Triple = [f64; 3];
+
+/// The whole file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Scene units per millimetre (subsurface parameters are in mm).
+    pub units_per_mm: Option<Spanned<f64>>,
+    pub camera: Spanned<CameraDef>,
+    #[serde(default)]
+    pub render: RenderDef,
+    #[serde(default)]
+    pub materials: BTreeMap<String, Spanned<MaterialDef>>,
+    #[serde(default)]
+    pub shapes: Vec<Spanned<ShapeDef>>,
+    pub environment: Option<EnvironmentDef>,
+}
+
+/// `[camera]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDef {
+    pub look_from: Spanned<Triple>,
+    pub look_at: Spanned<Triple>,
+    pub up: Option<Spanned<Triple>>,
+    /// Vertical field of view in degrees.
+    pub fov_y: Option<Spanned<f64>>,
+    /// `[width, height]` in pixels.
+    pub resolution: Spanned<[u32; 2]>,
+}
+
+/// `[render]`; every key is optional.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderDef {
+    pub spp: Option<Spanned<u32>>,
+    pub max_depth: Option<Spanned<u32>>,
+    pub seed: Option<u64>,
+}
+
+/// `[environment]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDef {
+    pub radiance: Spanned<Triple>,
+}
+
+/// The `type` of a `[materials.NAME]` table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MaterialKind {
+    Diffuse,
+    Dielectric,
+}
+
+impl MaterialKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            MaterialKind::Diffuse => "diffuse",
+            MaterialKind::Dielectric => "dielectric",
+        }
+    }
+}
+
+/// `[materials.NAME]`: the keys of all material types; which of them a
+/// given `type` accepts is checked by the loader.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDef {
+    #[serde(rename = "type")]
+    pub kind: Spanned<MaterialKind>,
+    pub albedo: Option<Spanned<Triple>>,
+    pub eta: Option<Spanned<f64>>,
+}
+
+impl MaterialDef {
+    /// The optional keys that are present, with their spans.
+    pub fn present_keys(&self) -> Vec<(&'static str, Range<usize>)> {
+        let mut v = Vec::new();
+        if let Some(x) = &self.albedo {
+            v.push(("albedo", x.span()));
+        }
+        if let Some(x) = &self.eta {
+            v.push(("eta", x.span()));
+        }
+        v
+    }
+}
+
+/// The `type` of a `[[shapes]]` entry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShapeKind {
+    Obj,
+    Sphere,
+    Quad,
+    Box,
+}
+
+impl ShapeKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            ShapeKind::Obj => "obj",
+            ShapeKind::Sphere => "sphere",
+            ShapeKind::Quad => "quad",
+            ShapeKind::Box => "box",
+        }
+    }
+}
+
+/// One `[[shapes]]` entry: the keys of all shape types (type-specific ones
+/// checked by the loader) plus the common material, emission, name and
+/// transform.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeDef {
+    #[serde(rename = "type")]
+    pub kind: Spanned<ShapeKind>,
+    pub name: Option<String>,
+    /// `obj`: path of the OBJ file, relative to the scene file's directory.
+    pub file: Option<Spanned<String>>,
+    /// `sphere`: icosphere subdivision level.
+    pub subdivisions: Option<Spanned<u32>>,
+    pub material: Spanned<String>,
+    pub emission: Option<Spanned<Triple>>,
+    pub scale: Option<Spanned<Scale>>,
+    pub rotate: Option<Vec<Spanned<Rotation>>>,
+    pub translate: Option<Spanned<Triple>>,
+}
+
+impl ShapeDef {
+    /// The type-specific keys that are present, with their spans.
+    pub fn present_type_keys(&self) -> Vec<(&'static str, Range<usize>)> {
+        let mut v = Vec::new();
+        if let Some(x) = &self.file {
+            v.push(("file", x.span()));
+        }
+        if let Some(x) = &self.subdivisions {
+            v.push(("subdivisions", x.span()));
+        }
+        v
+    }
+}
+
+/// `scale`: one number (uniform) or `[x, y, z]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scale(pub Triple);
+
+impl<'de> Deserialize<'de> for Scale {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Scale;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number or an array [x, y, z] of 3 numbers")
+            }
+            fn visit_f64<E: de::Error>(self, s: f64) -> Result<Scale, E> {
+                Ok(Scale([s; 3]))
+            }
+            fn visit_i64<E: de::Error>(self, s: i64) -> Result<Scale, E> {
+                Ok(Scale([s as f64; 3]))
+            }
+            fn visit_u64<E: de::Error>(self, s: u64) -> Result<Scale, E> {
+                Ok(Scale([s as f64; 3]))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Scale, A::Error> {
+                let [x, y, z] = numbers::<A, 3>(seq, &self)?;
+                Ok(Scale([x, y, z]))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// One rotation of `rotate`: `[angle_degrees, axis_x, axis_y, axis_z]`,
+/// counter-clockwise about the axis (right-hand rule).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rotation {
+    pub angle_deg: f64,
+    pub axis: Triple,
+}
+
+impl<'de> Deserialize<'de> for Rotation {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Rotation;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a rotation [angle_degrees, axis_x, axis_y, axis_z]")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Rotation, A::Error> {
+                let [a, x, y, z] = numbers::<A, 4>(seq, &self)?;
+                Ok(Rotation {
+                    angle_deg: a,
+                    axis: [x, y, z],
+                })
+            }
+        }
+        d.deserialize_seq(V)
+    }
+}
+
+/// Reads exactly `N` numbers from `seq`, reporting a wrong length with the
+/// visitor's own `expecting` text.
+fn numbers<'de, A: SeqAccess<'de>, const N: usize>(
+    mut seq: A,
+    exp: &dyn de::Expected,
+) -> Result<[f64; N], A::Error> {
+    let mut out = [0.0; N];
+    for (i, slot) in out.iter_mut().enumerate() {
+        *slot = seq
+            .next_element()?
+            .ok_or_else(|| de::Error::invalid_length(i, exp))?;
+    }
+    if seq.next_element::<de::IgnoredAny>()?.is_some() {
+        return Err(de::Error::custom(format_args!(
+            "more than {N} elements, expected {exp}"
+        )));
+    }
+    Ok(out)
+}

@@ -7,6 +7,7 @@ pub mod camera;
 pub mod format;
 pub mod load;
 pub mod shapes;
+pub mod transform;
 
 use std::fmt;
 use std::path::PathBuf;
