@@ -1,0 +1,478 @@
+//! Malformed scene files and OBJ meshes must fail with a `SceneError` that
+//! names the file and the line and/or field, with a message saying what was
+//! expected; and the `lucent render` CLI must turn such errors into exit
+//! code 2 without writing an output file.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use lucent::scene::{load, SceneError};
+
+const CAM: &str = "[camera]\nlook_from = [0, 1, 5]\nlook_at = [0, 1, 0]\nresolution = [32, 32]\n";
+const MAT: &str = "[materials.white]\ntype = \"diffuse\"\nalbedo = [0.8, 0.8, 0.8]\n";
+
+/// Which file the error must name.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum In {
+    Scene,
+    Obj,
+}
+
+struct Case {
+    name: &'static str,
+    scene: String,
+    /// Written as `mesh.obj` next to the scene.
+    obj: Option<&'static str>,
+    fragment: &'static str,
+    file: In,
+    /// The error's line is the first line of the named file containing this
+    /// text; None: the error must have no line.
+    line_of: Option<&'static str>,
+    field: Option<&'static str>,
+}
+
+fn case(
+    name: &'static str,
+    scene: impl Into<String>,
+    fragment: &'static str,
+    line_of: Option<&'static str>,
+    field: Option<&'static str>,
+) -> Case {
+    Case {
+        name,
+        scene: scene.into(),
+        obj: None,
+        fragment,
+        file: In::Scene,
+        line_of,
+        field,
+    }
+}
+
+fn obj_case(
+    name: &'static str,
+    obj: &'static str,
+    fragment: &'static str,
+    line_of: Option<&'static str>,
+) -> Case {
+    Case {
+        name,
+        scene: format!(
+            "{CAM}{MAT}[[shapes]]\ntype = \"obj\"\nfile = \"mesh.obj\"\nmaterial = \"white\"\n"
+        ),
+        obj: Some(obj),
+        fragment,
+        file: In::Obj,
+        line_of,
+        field: None,
+    }
+}
+
+fn shape(extra: &str) -> String {
+    format!("{CAM}{MAT}[[shapes]]\ntype = \"quad\"\nmaterial = \"white\"\n{extra}")
+}
+
+fn cases() -> Vec<Case> {
+    vec![
+        // --- TOML syntax and structure
+        case("syntax error", "[camera\nlook_from = [0, 0, 1]\n", "invalid table header", Some("[camera"), None),
+        case("unknown top-level key", format!("sampels = 4\n{CAM}"), "unknown field `sampels`", Some("sampels"), Some("sampels")),
+        case("unknown camera key", format!("{CAM}fov = 30\n"), "unknown field `fov`", Some("fov ="), Some("camera.fov")),
+        case("unknown render key", format!("{CAM}[render]\nsamples = 4\n"), "unknown field `samples`", Some("samples"), Some("render.samples")),
+        case("missing camera", MAT, "missing field `camera`", None, Some("camera")),
+        case(
+            "missing resolution",
+            "[camera]\nlook_from = [0, 1, 5]\nlook_at = [0, 1, 0]\n",
+            "missing field `resolution`",
+            Some("[camera]"),
+            Some("camera.resolution"),
+        ),
+        case(
+            "wrong type for resolution",
+            "[camera]\nlook_from = [0, 1, 5]\nlook_at = [0, 1, 0]\nresolution = \"512x512\"\n",
+            "expected an array of length 2",
+            Some("resolution"),
+            Some("camera.resolution"),
+        ),
+        case(
+            "negative resolution",
+            "[camera]\nlook_from = [0, 1, 5]\nlook_at = [0, 1, 0]\nresolution = [512, -1]\n",
+            "expected u32",
+            Some("resolution"),
+            Some("camera.resolution"),
+        ),
+        case(
+            "wrong arity",
+            "[camera]\nlook_from = [0, 1]\nlook_at = [0, 1, 0]\nresolution = [8, 8]\n",
+            "invalid length 2",
+            Some("look_from"),
+            Some("camera.look_from"),
+        ),
+        // --- camera and render values
+        case(
+            "zero resolution",
+            "[camera]\nlook_from = [0, 1, 5]\nlook_at = [0, 1, 0]\nresolution = [0, 512]\n",
+            "each in 1..=",
+            Some("resolution"),
+            Some("camera.resolution"),
+        ),
+        case("fov 180", format!("{CAM}fov_y = 180\n"), "strictly between 0 and 180", Some("fov_y"), Some("camera.fov_y")),
+        case("fov negative", format!("{CAM}fov_y = -5.0\n"), "strictly between 0 and 180", Some("fov_y"), Some("camera.fov_y")),
+        case("fov nan", format!("{CAM}fov_y = nan\n"), "expected a finite number", Some("fov_y"), Some("camera.fov_y")),
+        case(
+            "look_from inf",
+            "[camera]\nlook_from = [0, inf, 5]\nlook_at = [0, 1, 0]\nresolution = [8, 8]\n",
+            "expected finite numbers",
+            Some("look_from"),
+            Some("camera.look_from"),
+        ),
+        case(
+            "look_from overflows f32",
+            "[camera]\nlook_from = [0, 1e300, 5]\nlook_at = [0, 1, 0]\nresolution = [8, 8]\n",
+            "expected finite numbers",
+            Some("look_from"),
+            Some("camera.look_from"),
+        ),
+        case(
+            "look_from equals look_at",
+            "[camera]\nlook_from = [1, 2, 3]\nlook_at = [1, 2, 3]\nresolution = [8, 8]\n",
+            "must differ",
+            Some("look_at"),
+            Some("camera.look_at"),
+        ),
+        case("up parallel to view", format!("{CAM}up = [0, 0, -2]\n"), "not parallel", Some("up ="), Some("camera.up")),
+        case(
+            "default up parallel to view",
+            "[camera]\nlook_from = [0, 5, 0]\nlook_at = [0, 0, 0]\nresolution = [8, 8]\n",
+            "not parallel",
+            Some("[camera]"),
+            Some("camera.up"),
+        ),
+        case("spp zero", format!("{CAM}[render]\nspp = 0\n"), "at least 1 sample", Some("spp"), Some("render.spp")),
+        case("max_depth zero", format!("{CAM}[render]\nmax_depth = 0\n"), "at least 1", Some("max_depth"), Some("render.max_depth")),
+        case("seed negative", format!("{CAM}[render]\nseed = -3\n"), "expected u64", Some("seed"), Some("render.seed")),
+        case("units_per_mm zero", format!("units_per_mm = 0\n{CAM}"), "expected a number > 0", Some("units_per_mm"), Some("units_per_mm")),
+        case("units_per_mm inf", format!("units_per_mm = inf\n{CAM}"), "finite", Some("units_per_mm"), Some("units_per_mm")),
+        case(
+            "environment negative",
+            format!("{CAM}[environment]\nradiance = [0.1, -0.1, 0]\n"),
+            ">= 0",
+            Some("radiance"),
+            Some("environment.radiance"),
+        ),
+        // --- materials
+        case(
+            "material without type",
+            format!("{CAM}[materials.red]\nalbedo = [1, 0, 0]\n"),
+            "missing field `type`",
+            Some("[materials.red]"),
+            Some("materials.red.type"),
+        ),
+        case(
+            "unknown material type",
+            format!("{CAM}[materials.chrome]\ntype = \"metal\"\n"),
+            "unknown variant `metal`, expected `diffuse` or `dielectric`",
+            Some("metal"),
+            Some("materials.chrome.type"),
+        ),
+        case(
+            "unknown material key",
+            format!("{CAM}[materials.red]\ntype = \"diffuse\"\ncolour = [1, 0, 0]\n"),
+            "unknown field `colour`",
+            Some("colour"),
+            Some("materials.red.colour"),
+        ),
+        case(
+            "diffuse without albedo",
+            format!("{CAM}[materials.red]\ntype = \"diffuse\"\n"),
+            "missing field `albedo`",
+            Some("[materials.red]"),
+            Some("materials.red.albedo"),
+        ),
+        case(
+            "albedo above 1",
+            format!("{CAM}[materials.red]\ntype = \"diffuse\"\nalbedo = [1.2, 0, 0]\n"),
+            "in [0, 1]",
+            Some("albedo"),
+            Some("materials.red.albedo"),
+        ),
+        case(
+            "albedo nan",
+            format!("{CAM}[materials.red]\ntype = \"diffuse\"\nalbedo = [nan, 0, 0]\n"),
+            "finite",
+            Some("albedo"),
+            Some("materials.red.albedo"),
+        ),
+        case(
+            "eta zero",
+            format!("{CAM}[materials.glass]\ntype = \"dielectric\"\neta = 0.0\n"),
+            "expected a number > 0",
+            Some("eta"),
+            Some("materials.glass.eta"),
+        ),
+        case(
+            "eta on diffuse",
+            format!("{CAM}[materials.red]\ntype = \"diffuse\"\nalbedo = [1, 0, 0]\neta = 1.5\n"),
+            "does not apply to type \"diffuse\"",
+            Some("eta"),
+            Some("materials.red.eta"),
+        ),
+        // --- shapes
+        case(
+            "unknown material name",
+            format!("{CAM}{MAT}[[shapes]]\ntype = \"quad\"\nmaterial = \"gold\"\n"),
+            "unknown material \"gold\" (defined: white)",
+            Some("gold"),
+            Some("shapes[0].material"),
+        ),
+        case(
+            "shape without material",
+            format!("{CAM}{MAT}[[shapes]]\ntype = \"box\"\n[[shapes]]\ntype = \"quad\"\nmaterial = \"white\"\n"),
+            "missing field `material`",
+            Some("[[shapes]]"),
+            Some("shapes[0].material"),
+        ),
+        case(
+            "unknown shape type",
+            format!("{CAM}{MAT}[[shapes]]\ntype = \"quad\"\nmaterial = \"white\"\n[[shapes]]\ntype = \"cone\"\nmaterial = \"white\"\n"),
+            "unknown variant `cone`",
+            Some("cone"),
+            Some("shapes[1].type"),
+        ),
+        case("negative emission", shape("emission = [1, 1, -0.5]\n"), ">= 0", Some("emission"), Some("shapes[0].emission")),
+        case("infinite emission", shape("emission = [inf, 1, 1]\n"), "finite", Some("emission"), Some("shapes[0].emission")),
+        case("zero scale", shape("scale = [1, 0, 1]\n"), "non-zero", Some("scale"), Some("shapes[0].scale")),
+        case("scale string", shape("scale = \"big\"\n"), "expected a number or an array [x, y, z]", Some("scale"), Some("shapes[0].scale")),
+        case("rotate not a list", shape("rotate = [90, 1, 0, 0]\n"), "expected a rotation [angle_degrees", Some("rotate"), Some("shapes[0].rotate")),
+        case("rotate zero axis", shape("rotate = [[45, 0, 0, 0]]\n"), "axis must be non-zero", Some("rotate"), Some("shapes[0].rotate[0]")),
+        case("rotate nan angle", shape("rotate = [[0, 0, 1, 0], [nan, 0, 1, 0]]\n"), "finite", Some("rotate"), Some("shapes[0].rotate[1]")),
+        case("translate nan", shape("translate = [0, nan, 0]\n"), "finite", Some("translate"), Some("shapes[0].translate")),
+        case("subdivisions on a quad", shape("subdivisions = 3\n"), "does not apply to type \"quad\"", Some("subdivisions"), Some("shapes[0].subdivisions")),
+        case(
+            "too many subdivisions",
+            format!("{CAM}{MAT}[[shapes]]\ntype = \"sphere\"\nmaterial = \"white\"\nsubdivisions = 12\n"),
+            "at most 9",
+            Some("subdivisions"),
+            Some("shapes[0].subdivisions"),
+        ),
+        case(
+            "obj without file",
+            format!("{CAM}{MAT}[[shapes]]\ntype = \"obj\"\nmaterial = \"white\"\n"),
+            "missing field `file`",
+            Some("[[shapes]]"),
+            Some("shapes[0].file"),
+        ),
+        case(
+            "missing obj file",
+            format!("{CAM}{MAT}[[shapes]]\ntype = \"obj\"\nfile = \"nowhere/x.obj\"\nmaterial = \"white\"\n"),
+            "cannot read OBJ file",
+            Some("nowhere"),
+            Some("shapes[0].file"),
+        ),
+        // --- OBJ contents: the error names the OBJ file and its line
+        obj_case("obj nan vertex", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n", "non-finite number `nan`", Some("nan")),
+        obj_case("obj inf normal", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 inf\nf 1//1 2//1 3//1\n", "non-finite", Some("vn")),
+        obj_case("obj vertex overflows f32", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n", "non-finite", Some("1e39")),
+        obj_case("obj garbage number", "v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n", "expected a number", Some("1 x")),
+        obj_case("obj short vertex", "v 0 0\nf 1 1 1\n", "needs 3 numbers", Some("v 0 0")),
+        obj_case("obj index out of range", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "index 9 out of range", Some("f 1 2 9")),
+        obj_case("obj index zero", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "index 0 out of range", Some("f 0")),
+        obj_case("obj relative index too far back", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "index -4 out of range", Some("f -1")),
+        obj_case("obj forward reference", "v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n", "index 3 out of range", Some("f 1")),
+        obj_case(
+            "obj texcoord index zero",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/0 2/1 3/1\n",
+            "texture coordinate index 0 out of range",
+            Some("f 1/0"),
+        ),
+        obj_case(
+            "obj normal index out of range",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n",
+            "normal index 2 out of range",
+            Some("f 1//"),
+        ),
+        obj_case("obj huge index", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999999\n", "not an integer", Some("f 1")),
+        obj_case("obj malformed vertex ref", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n", "malformed face vertex", Some("f 1/")),
+        obj_case("obj two-vertex face", "v 0 0 0\nv 1 0 0\nf 1 2\n", "at least 3", Some("f 1 2")),
+        obj_case("obj zero normal", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n", "zero-length normal", Some("vn")),
+        obj_case("obj without faces", "# only vertices\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", "no triangles", None),
+        obj_case("obj empty", "", "no triangles", None),
+    ]
+}
+
+fn line_containing(text: &str, needle: &str) -> usize {
+    let at = text
+        .find(needle)
+        .unwrap_or_else(|| panic!("test bug: {needle:?} not in {text:?}"));
+    text[..at].matches('\n').count() + 1
+}
+
+fn write_case(dir: &Path, c: &Case) -> (PathBuf, PathBuf) {
+    let scene = dir.join("scene.toml");
+    let obj = dir.join("mesh.obj");
+    std::fs::write(&scene, &c.scene).unwrap();
+    if let Some(o) = c.obj {
+        std::fs::write(&obj, o).unwrap();
+    }
+    (scene, obj)
+}
+
+#[test]
+fn malformed_inputs_are_located_errors() {
+    let cases = cases();
+    assert!(cases.len() >= 20);
+    let mut failures = Vec::new();
+    for c in &cases {
+        let dir = tempfile::tempdir().unwrap();
+        let (scene, obj) = write_case(dir.path(), c);
+        let err: SceneError = match load(&scene) {
+            Ok(_) => {
+                failures.push(format!("{}: loaded without error", c.name));
+                continue;
+            }
+            Err(e) => e,
+        };
+        let shown = err.to_string();
+        let (file, text) = match c.file {
+            In::Scene => (&scene, c.scene.as_str()),
+            In::Obj => (&obj, c.obj.unwrap()),
+        };
+        let mut problems = Vec::new();
+        if &err.file != file {
+            problems.push(format!("file {:?}, expected {:?}", err.file, file));
+        }
+        if !shown.starts_with(&file.display().to_string()) {
+            problems.push("display does not start with the file".into());
+        }
+        if !err.message.contains(c.fragment) {
+            problems.push(format!("message lacks {:?}", c.fragment));
+        }
+        let want_line = c.line_of.map(|n| line_containing(text, n));
+        if err.line != want_line {
+            problems.push(format!("line {:?}, expected {:?}", err.line, want_line));
+        }
+        if err.field.as_deref() != c.field {
+            problems.push(format!("field {:?}, expected {:?}", err.field, c.field));
+        }
+        if err.line.is_none() && err.field.is_none() && c.file == In::Scene {
+            problems.push("neither line nor field".into());
+        }
+        if let Some(l) = err.line {
+            if !shown.contains(&format!(":{l}: ")) {
+                problems.push("display lacks the line".into());
+            }
+        }
+        if let Some(f) = &err.field {
+            if !shown.contains(&format!("`{f}`")) {
+                problems.push("display lacks the field".into());
+            }
+        }
+        if !problems.is_empty() {
+            failures.push(format!(
+                "{}: {}\n    got: {shown}",
+                c.name,
+                problems.join("; ")
+            ));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases failed:\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn unreadable_scene_file_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("absent.toml");
+    let err = load(&missing).unwrap_err();
+    assert_eq!(err.file, missing);
+    assert!(err.message.contains("cannot read scene file"), "{err}");
+    // A directory is not readable as a scene either.
+    let err = load(dir.path()).unwrap_err();
+    assert!(err.message.contains("cannot read scene file"), "{err}");
+}
+
+// --- The CLI: `lucent render scene.toml -o out.exr` exits with code 2 on a
+// scene error, prints the located error, and writes no output file.
+
+fn run_cli(scene_text: &str, obj: Option<&str>) -> (Option<i32>, String, bool) {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, scene_text).unwrap();
+    if let Some(o) = obj {
+        std::fs::write(dir.path().join("mesh.obj"), o).unwrap();
+    }
+    let out = dir.path().join("out.exr");
+    let res = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .arg("render")
+        .arg(&scene)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .expect("run lucent");
+    (
+        res.status.code(),
+        String::from_utf8_lossy(&res.stderr).into_owned(),
+        out.exists(),
+    )
+}
+
+#[test]
+fn cli_exits_2_on_scene_errors_without_writing_output() {
+    let rows: Vec<(String, Option<&str>, &str)> = vec![
+        (format!("{CAM}fov_y = 0\n"), None, "scene.toml:5"),
+        (
+            format!("{CAM}{MAT}[[shapes]]\ntype = \"quad\"\nmaterial = \"gold\"\n"),
+            None,
+            "unknown material \"gold\"",
+        ),
+        ("[camera\n".to_string(), None, "invalid table header"),
+        (
+            format!(
+                "{CAM}{MAT}[[shapes]]\ntype = \"obj\"\nfile = \"mesh.obj\"\nmaterial = \"white\"\n"
+            ),
+            Some("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n"),
+            "mesh.obj:4",
+        ),
+    ];
+    for (scene, obj, fragment) in rows {
+        let (code, stderr, wrote) = run_cli(&scene, obj);
+        assert_eq!(
+            code,
+            Some(2),
+            "exit code for {fragment:?}; stderr: {stderr}"
+        );
+        assert!(
+            stderr.contains(fragment),
+            "stderr lacks {fragment:?}: {stderr}"
+        );
+        assert!(
+            !wrote,
+            "output written despite a scene error ({fragment:?})"
+        );
+    }
+}
+
+#[test]
+fn cli_exits_2_on_a_missing_scene_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.exr");
+    let res = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["render"])
+        .arg(dir.path().join("nope.toml"))
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .expect("run lucent");
+    let stderr = String::from_utf8_lossy(&res.stderr);
+    assert_eq!(res.status.code(), Some(2), "stderr: {stderr}");
+    assert!(
+        stderr.contains("nope.toml") && stderr.contains("cannot read scene file"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
