@@ -326,6 +326,8 @@ impl SubsurfaceParams {
 }
 
 #[cfg(test)]
+// Tests index parallel per-channel arrays by channel number.
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
 

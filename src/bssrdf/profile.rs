@@ -178,6 +178,8 @@ impl Fit {
 }
 
 #[cfg(test)]
+// Tests index parallel per-channel arrays by channel number.
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
 

@@ -401,6 +401,8 @@ impl RadialDist {
 }
 
 #[cfg(test)]
+// Tests index parallel per-channel arrays by channel number.
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
     use crate::sampling::Rng;
