@@ -237,7 +237,11 @@ impl EmbreeAccel {
                     "Embree: mesh {i} has vertex index {bad} but only {nv} vertices"
                 ));
             }
-            debug_assert_eq!(m.padded_positions().len(), nv + 1);
+            // Embree's 16-byte vertex loads need the padding element
+            // (`Mesh::default()` has none, but also no vertices to index).
+            if m.triangle_count() > 0 && m.padded_positions().len() <= nv {
+                return Err(format!("Embree: mesh {i} lacks its padding vertex"));
+            }
         }
 
         let device = Device::new()?;
