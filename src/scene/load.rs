@@ -1052,6 +1052,21 @@ mod tests {
     }
 
     #[test]
+    fn the_documented_example_loads() {
+        // The complete example of docs/scene-format.md, resolved as if it
+        // were in scenes/ (it uses meshes/bunny.obj).
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let doc = std::fs::read_to_string(root.join("docs/scene-format.md")).unwrap();
+        let start = doc.find("```toml\n").expect("example block") + "```toml\n".len();
+        let end = start + doc[start..].find("```").unwrap();
+        let s = load_str(&doc[start..end], &root.join("scenes/example.toml")).unwrap();
+        assert_eq!(s.objects.len(), 5);
+        assert_eq!(s.meshes[4].triangle_count(), 3674);
+        assert_eq!(s.settings.seed, 1);
+        assert!(s.environment.is_some());
+    }
+
+    #[test]
     fn key_paths_follow_headers_arrays_and_strings() {
         let t =
             "a = 1\n[camera]\nlook_from = [\n  0, # ] comment\n  1,\n  2]\nname = \"x = [ #\"\n\
