@@ -480,13 +480,25 @@ mod tests {
 
     /// Runs n probes at xo and averages the weights (None counts as 0).
     fn run(s: &ProbeSampler, accel: &Brute, xo: Vec3, frame: &Frame, n: usize, key: u64) -> Stats {
+        run_on(s, accel, &accel.meshes[0], xo, frame, n, key)
+    }
+
+    fn run_on(
+        s: &ProbeSampler,
+        accel: &dyn Accel,
+        mesh: &Mesh,
+        xo: Vec3,
+        frame: &Frame,
+        n: usize,
+        key: u64,
+    ) -> Stats {
         let mut rng = Rng::from_key(key);
         let mut hits = ProbeHits::new();
         let (mut s1, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
         let (mut max, mut found) = (0.0f64, 0);
         for _ in 0..n {
             let u = ProbeRandoms::from_rng(&mut rng);
-            if let Some(ps) = s.sample(xo, frame, &u, accel, 0, &accel.meshes[0], &mut hits) {
+            if let Some(ps) = s.sample(xo, frame, &u, accel, 0, mesh, &mut hits) {
                 found += 1;
                 assert!(ps.normal.is_finite() && (ps.normal.length() - 1.0).abs() < 1e-5);
                 assert!(ps.point.is_finite());
@@ -654,6 +666,37 @@ mod tests {
         let s = ProbeSampler::new(&params, &ProbeOptions::default()).unwrap();
         assert_eq!(s.planar_reflectance()[2], 0.0);
         assert_eq!(s.rd(0.5)[2], 0.0);
+    }
+
+    #[test]
+    fn spectralon_renders_finite_white_and_not_above_a() {
+        // σa = 0: d comes from the absorption floor (params.rs); a flat slab
+        // reflects A·CDF(Rmax) = 0.999 ≤ A = 1, and exactly A renormalized.
+        let params =
+            SubsurfaceParams::from_preset("spectralon", 1.0, profile::Fit::Searchlight).unwrap();
+        let accel = Brute {
+            meshes: vec![planes(1000.0, &[0.0])],
+        };
+        for renormalize in [false, true] {
+            let opts = ProbeOptions {
+                renormalize,
+                ..ProbeOptions::default()
+            };
+            let s = ProbeSampler::new(&params, &opts).unwrap();
+            assert!(s.rmax().is_finite() && s.rmax() < 100.0, "{}", s.rmax());
+            let st = run(
+                &s,
+                &accel,
+                Vec3::new(0.37, -0.21, 0.0),
+                &tilted(20.0),
+                40_000,
+                5,
+            );
+            assert_close(&st, s.planar_reflectance(), "spectralon");
+            for c in 0..3 {
+                assert!(st.mean[c] > 0.95 && s.planar_reflectance()[c] <= 1.0 + 1e-12);
+            }
+        }
     }
 
     #[test]
@@ -914,6 +957,61 @@ mod tests {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn real_bvh_backend_gives_the_same_energy() {
+        // The same ground truths through lucent's BVH (watertight test,
+        // two-level tree) instead of the brute-force loop: a tilted-frame
+        // plane, and 100 stacked planes (probe-hit overflow).
+        use crate::accel::{build, Backend};
+        use std::sync::Arc;
+        let params = SubsurfaceParams {
+            albedo: [0.9, 0.6, 0.4],
+            d: [1.0, 0.35, 0.1],
+            eta: 1.3,
+        };
+        let xo = Vec3::new(0.31, -0.17, 0.0);
+        let zs: Vec<f32> = (0..100).map(|k| -(k as f32) * 0.15).collect();
+        for (mesh, stacked) in [(planes(100.0, &[0.0]), false), (planes(60.0, &zs), true)] {
+            let meshes = Arc::new(vec![mesh]);
+            let bvh = build(&meshes, Backend::Bvh).unwrap();
+            for opts in [
+                ProbeOptions::default(),
+                ProbeOptions::seed(RadiusSampler::table(256)),
+                ProbeOptions {
+                    channel: ChannelStrategy::Single,
+                    radius: RadiusSampler::Mixture,
+                    renormalize: true,
+                    ..ProbeOptions::default()
+                },
+            ] {
+                let s = ProbeSampler::new(&params, &opts).unwrap();
+                let rm = s.rmax();
+                let truth: [f64; 3] = if stacked {
+                    std::array::from_fn(|c| {
+                        let d = params.d[c];
+                        let k = s.planar_reflectance()[c] / profile::cdf(rm, d);
+                        k * zs
+                            .iter()
+                            .map(|&z| {
+                                (profile::cdf(rm, d) - profile::cdf((z.abs() as f64).min(rm), d))
+                                    .max(0.0)
+                            })
+                            .sum::<f64>()
+                    })
+                } else {
+                    s.planar_reflectance()
+                };
+                let frame = if stacked {
+                    Frame::from_normal(Vec3::Z)
+                } else {
+                    tilted(40.0)
+                };
+                let st = run_on(&s, bvh.as_ref(), &meshes[0], xo, &frame, 40_000, 77);
+                assert_close(&st, truth, &format!("bvh stacked={stacked} {opts:?}"));
             }
         }
     }

@@ -750,6 +750,91 @@ mod tests {
     }
 
     #[test]
+    fn seed_table_pdf_bias_vs_size() {
+        // The seed samples with the table but divides by the profile, R(r).
+        // Its bias is ∫ f (p_table/p_R − 1) dA: zero for f ∝ R (a flat
+        // plane) but not for other integrands. Measured by quadrature for
+        // f = R(r; 1.7 d) (a channel mismatch, as curved geometry causes).
+        // Our Table pdf is the table's own density, so ours is unbiased at
+        // every size (`estimators_integrate_known_functions`).
+        let (d, rmax) = (1.0, profile::quantile(0.999));
+        let f = |r: f64| profile::profile(r, 1.7 * d);
+        let truth = profile::cdf(rmax, 1.7 * d);
+        let mut prev = [f64::INFINITY; 2];
+        for &n in &[16usize, 64, 256, 1024] {
+            let mut rel = [0.0; 2];
+            for (k, spacing) in [TableSpacing::Uniform, TableSpacing::Tail]
+                .into_iter()
+                .enumerate()
+            {
+                let table =
+                    RadialDist::new(RadiusSampler::Table { size: n, spacing }, d, rmax).unwrap();
+                let exact = RadialDist::new(RadiusSampler::Analytic, d, rmax).unwrap();
+                // ∫ f/p_R · p_T 2πr dr, cell by cell on the table's nodes
+                let Kind::Table { table: t, .. } = &table.kind else {
+                    unreachable!()
+                };
+                let mut e = 0.0;
+                let mut edges: Vec<f64> = t
+                    .nodes
+                    .iter()
+                    .map(|x| x * d)
+                    .filter(|&x| x < rmax)
+                    .collect();
+                edges.push(rmax);
+                for w in edges.windows(2) {
+                    let m = 64;
+                    let h = (w[1] - w[0]) / m as f64;
+                    for i in 0..m {
+                        let r = w[0] + (i as f64 + 0.5) * h;
+                        e += f(r) / exact.pdf(r) * table.pdf(r) * 2.0 * PI * r * h;
+                    }
+                }
+                rel[k] = e / truth - 1.0;
+            }
+            println!(
+                "seed table estimator (pdf = R), n={n:5}: relative bias uniform-spaced {:+.2e}, tail-spaced {:+.2e}",
+                rel[0], rel[1]
+            );
+            if n <= 256 {
+                assert!(rel[0].abs() < prev[0] && rel[1].abs() < prev[1]);
+            }
+            prev = [rel[0].abs(), rel[1].abs()];
+            if n == 16 {
+                assert!(rel[0].abs() > 1e-3, "{rel:?}");
+            }
+        }
+    }
+
+    /// Cost per sample (sample + its pdf), and per pdf evaluation. Run with
+    /// `cargo test --release --lib bench_radius -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn bench_radius_samplers() {
+        use std::hint::black_box;
+        use std::time::Instant;
+        let n = 20_000_000;
+        for s in all_samplers() {
+            let dist = RadialDist::new(s, 1.0, profile::quantile(0.999)).unwrap();
+            let mut rng = Rng::from_key(1);
+            let t0 = Instant::now();
+            let mut acc = 0.0;
+            for _ in 0..n {
+                let (r, p) = dist.sample(rng.uniform_f64());
+                acc += r + p;
+            }
+            let ns_sample = t0.elapsed().as_nanos() as f64 / n as f64;
+            let t0 = Instant::now();
+            for i in 0..n {
+                acc += dist.pdf(black_box(i as f64 * 1e-6));
+            }
+            let ns_pdf = t0.elapsed().as_nanos() as f64 / n as f64;
+            black_box(acc);
+            println!("{s:?}: {ns_sample:.1} ns/sample (incl. rng + pdf), {ns_pdf:.1} ns/pdf");
+        }
+    }
+
+    #[test]
     fn parse_and_validate() {
         assert_eq!(
             RadiusSampler::parse("Analytic"),
