@@ -557,7 +557,25 @@ fn check_obj(text: &str) -> Result<(), (usize, String)> {
         };
         match tag {
             "v" => {
-                numbers(words, 3, "v")?;
+                // tobj reads `x y z`, `x y z w` (dividing by w) or
+                // `x y z r g b`, and rejects other counts.
+                let v = numbers(words, 3, "v")?;
+                match v.len() {
+                    3 | 6 => {}
+                    4 if v[3] != 0.0 && v[..3].iter().all(|x| (x / v[3]).is_finite()) => {}
+                    4 => {
+                        return Err((
+                            ln,
+                            format!("`v` has weight w = {} that makes it non-finite", v[3]),
+                        ))
+                    }
+                    n => {
+                        return Err((
+                            ln,
+                            format!("`v` has {n} numbers, expected x y z, x y z w or x y z r g b"),
+                        ))
+                    }
+                }
                 nv += 1;
             }
             "vt" => {
@@ -695,6 +713,14 @@ pub(crate) fn key_path_at(text: &str, offset: usize) -> Option<String> {
             i = end;
         } else {
             let eq = scan_key_until(b, i, b'=');
+            if b.get(eq) != Some(&b'=') {
+                // Not a key-value pair (a syntax error): no field to name.
+                if (start..eq.max(start + 1)).contains(&offset) {
+                    return None;
+                }
+                i = eq.max(start + 1);
+                continue;
+            }
             let key = normalize_key(&text[start..eq]);
             let end = skip_value(b, (eq + 1).min(b.len()));
             if (start..end.max(start + 1)).contains(&offset) {
@@ -970,7 +996,7 @@ mod tests {
         .unwrap();
         std::fs::write(
             dir.path().join("b.obj"),
-            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1 2 4\n",
+            "v 0 0 0\nv 2 0 0 2\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1 2 4\n",
         )
         .unwrap();
         let text = format!(
@@ -998,6 +1024,8 @@ mod tests {
         }
         // Only some vertices have normals: fall back to geometric normals.
         assert_eq!(s.meshes[1].triangle_count(), 2);
+        // `v x y z w` is divided by w.
+        assert_eq!(s.meshes[1].positions()[1], Vec3::X);
         assert!(s.meshes[1].normals.is_none());
     }
 
