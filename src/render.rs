@@ -14,6 +14,7 @@ use crate::accel::Accel;
 use crate::film::Film;
 use crate::geometry::Vec3;
 use crate::integrator::{path, Context, Counters};
+use crate::integrator::path::Scratch;
 use crate::sampling::Rng;
 use crate::scene::Scene;
 
@@ -134,6 +135,7 @@ fn render_tile(ctx: &Context, x0: u32, y0: u32) -> (Vec<Vec3>, Counters) {
     let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
     let spp = scene.settings.spp;
     let mut counters = Counters::default();
+    let mut scratch = Scratch::default();
     let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
     for y in y0..y1 {
         for x in x0..x1 {
@@ -143,7 +145,7 @@ fn render_tile(ctx: &Context, x0: u32, y0: u32) -> (Vec<Vec3>, Counters) {
                 let mut rng = Rng::new(scene.settings.seed, pixel, s as u64);
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                let l = path::radiance(ctx, ray, &mut rng, &mut counters);
+                let l = path::radiance(ctx, ray, &mut rng, &mut scratch, &mut counters);
                 if l.is_finite() {
                     sum[0] += l.x as f64;
                     sum[1] += l.y as f64;

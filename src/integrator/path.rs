@@ -1,34 +1,95 @@
 //! Unidirectional path tracing (Kajiya 1986) of the rendering equation
 //!
-//!   L(x, ωo) = Le(x, ωo) + ∫ f(x, ωo, ωi) L(x', −ωi) |cos θi| dωi,
+//!   L(x, ωo) = Le(x, ωo) + ∫ f(x, ωo, ωi) L(x, ωi) |cos θi| dωi,
 //!
-//! estimated along one path per sample. At each diffuse vertex the direct
-//! part of the integral is estimated twice — by sampling a point on an
-//! area light (next-event estimation) and by sampling the BSDF and finding
-//! a light — and the two are combined with the power heuristic (Veach 1997,
-//! §9.2). Paths end at `max_depth` bounces or by Russian roulette once
-//! their throughput is small (pbrt-v4 §13.1.1).
+//! extended at subsurface objects by the BSSRDF's area integral
+//!
+//!   L(xo, ωo) = ∫_A ∫ S(xi, ωi; xo, ωo) L(xi, ωi) cos θi dωi dA(xi),
+//!
+//! both estimated along one path per sample. At each vertex with a
+//! non-specular lobe the direct part of the inner integral is estimated
+//! twice — by sampling a point on an area light (next-event estimation)
+//! and by sampling the lobe — and the two are combined with the power
+//! heuristic (Veach 1997, §9.2). The area integral is estimated with one
+//! probe ray (King et al. 2013; [`crate::bssrdf::probe`]). Paths end at
+//! `max_depth` bounces or by Russian roulette once their throughput is
+//! small (pbrt-v4 §13.1.1).
 
 use super::interaction::offset_origin;
 use super::{Context, Counters, Interaction};
+use crate::accel::ProbeHits;
+use crate::bssrdf::ProbeRandoms;
 use crate::geometry::{Frame, Ray, Vec3};
-use crate::materials::{dielectric, diffuse, Material};
-use crate::sampling::{power, Rng};
+use crate::materials::{dielectric, diffuse, fresnel, Material, Subsurface};
+use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Rng};
 
 /// Bounces after which Russian roulette may end a path.
 const RR_START: u32 = 3;
 
-/// The radiance arriving along `ray` (from the camera): one sample of L.
-pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, counters: &mut Counters) -> Vec3 {
+/// Per-thread buffers the integrator reuses so the hot path never allocates.
+#[derive(Default)]
+pub struct Scratch {
+    pub probe_hits: ProbeHits,
+}
+
+/// A non-specular lobe at a path vertex, in a local frame whose z axis is
+/// the normal on the side light leaves towards.
+#[derive(Clone, Copy)]
+enum Lobe<'a> {
+    /// Lambertian reflection, ρ/π.
+    Diffuse(Vec3),
+    /// The entry-point lobe of a subsurface material (Sw or 1/π), outward
+    /// side only; its spectral weight was already applied by the probe.
+    SubsurfaceEntry(&'a Subsurface),
+}
+
+impl Lobe<'_> {
+    /// f(ωo, ωi) per steradian (ωo, ωi local; z > 0 is the lit side).
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        match self {
+            Lobe::Diffuse(albedo) => diffuse::eval(*albedo, wo, wi),
+            Lobe::SubsurfaceEntry(ss) => Vec3::splat(ss.lobe(wi.z)),
+        }
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self {
+            Lobe::Diffuse(_) => diffuse::pdf(wo, wi),
+            Lobe::SubsurfaceEntry(_) => cosine_hemisphere_pdf(wi.z),
+        }
+    }
+    /// Samples ωi; returns (ωi, f |cos| / pdf, pdf).
+    fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<(Vec3, Vec3, f32)> {
+        match self {
+            Lobe::Diffuse(albedo) => diffuse::sample(*albedo, wo, u),
+            Lobe::SubsurfaceEntry(ss) => {
+                let wi = cosine_hemisphere(u);
+                let pdf = cosine_hemisphere_pdf(wi.z);
+                (pdf > 0.0).then(|| (wi, Vec3::splat(ss.lobe(wi.z) * wi.z / pdf), pdf))
+            }
+        }
+    }
+}
+
+/// A vertex where a non-specular lobe scatters: position, geometric normal
+/// facing the lit side, and the shading frame.
+struct Vertex<'a> {
+    p: Vec3,
+    ng: Vec3,
+    frame: Frame,
+    wo_local: Vec3,
+    lobe: Lobe<'a>,
+}
+
+/// The radiance arriving along `camera_ray`: one sample of L.
+pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, scratch: &mut Scratch, counters: &mut Counters) -> Vec3 {
     let scene = ctx.scene;
-    let eps = ctx.ray_epsilon;
     let mut l = Vec3::ZERO;
-    // Path throughput: product of f |cos| / pdf along the path so far.
+    // Path throughput: the product of f |cos| / pdf (and BSSRDF weights).
     let mut beta = Vec3::ONE;
     let mut ray = camera_ray;
-    // Where the last non-specular vertex was and the solid-angle pdf its
-    // BSDF sampling gave the current ray; None after the camera or a
-    // specular bounce (no light sampling competed for this direction).
+    // The last non-specular vertex and the solid-angle pdf with which its
+    // lobe sampled the current ray; None after the camera or a specular
+    // bounce, where no light sample competed for this direction.
     let mut prev: Option<(Vec3, f32)> = None;
 
     for depth in 0..=scene.settings.max_depth {
@@ -44,99 +105,146 @@ pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, counters: &mut Co
         let si = Interaction::new(mesh, &ray, &hit);
         let wo = -ray.d;
 
-        // Le: emitted radiance, MIS-weighted against next-event estimation.
+        // Le, MIS-weighted against next-event estimation.
         if let (Some(le), true) = (object.emission, si.front) {
-            let w = match prev {
-                None => 1.0,
-                Some((p0, pdf_bsdf)) => {
-                    let cos_l = wo.dot(si.ng);
-                    let pdf_light =
-                        ctx.lights.pdf_area(&scene.meshes, hit.geom, hit.prim) * (si.p - p0).length_squared() / cos_l;
-                    power(pdf_bsdf, pdf_light)
-                }
-            };
-            l += beta * le * w;
+            l += beta * le * emission_weight(ctx, &si, wo, prev);
         }
         if depth == scene.settings.max_depth {
             break;
         }
 
-        match &scene.materials[object.material] {
+        let vertex = match &scene.materials[object.material] {
             Material::Diffuse { albedo } => {
                 let frame = si.shading_frame_facing(wo);
-                let wo_local = frame.to_local(wo);
-                if ctx.plan.area_lights {
-                    l += beta * direct_lighting(ctx, &si, &frame, *albedo, wo_local, rng, counters);
-                }
-                let Some((wi_local, weight, pdf)) = diffuse::sample(*albedo, wo_local, rng.uniform2()) else {
-                    break;
-                };
-                let wi = frame.to_world(wi_local);
-                // A shading normal can send wi through the geometric surface;
-                // such a path would leak light, so it ends here.
-                if wi.dot(si.ng) * wo.dot(si.ng) <= 0.0 {
-                    break;
-                }
-                beta *= weight;
-                prev = Some((si.p, pdf));
-                ray = si.spawn(wi, eps);
+                let ng = if wo.dot(si.ng) >= 0.0 { si.ng } else { -si.ng };
+                Vertex { p: si.p, ng, wo_local: frame.to_local(wo), frame, lobe: Lobe::Diffuse(*albedo) }
             }
             Material::Dielectric { eta } => {
                 let frame = Frame::from_normal(si.ng);
                 let s = dielectric::sample(*eta, frame.to_local(wo), rng.uniform());
                 beta *= s.weight;
                 prev = None;
-                ray = si.spawn(frame.to_world(s.wi), eps);
+                ray = si.spawn(frame.to_world(s.wi), ctx.ray_epsilon);
+                if !roulette(depth, &mut beta, rng) {
+                    break;
+                }
+                continue;
             }
-        }
+            Material::Subsurface(ss) => {
+                // Boundary at xo: the normal facing the camera is "outside"
+                // (a mesh wound inside-out is read consistently the other way).
+                let n_out = if si.front { si.ng } else { -si.ng };
+                let fr = fresnel::dielectric(wo.dot(n_out).max(0.0), ss.eta());
+                if ss.specular && rng.uniform() < fr {
+                    // Specular reflection with probability Fr: weight 1.
+                    let wi = (2.0 * wo.dot(n_out)) * n_out - wo;
+                    prev = None;
+                    ray = si.spawn(wi, ctx.ray_epsilon);
+                    if !roulette(depth, &mut beta, rng) {
+                        break;
+                    }
+                    continue;
+                }
+                if !ss.specular {
+                    beta *= 1.0 - fr;
+                }
+                // The area integral: one entry point xi from a probe ray.
+                let frame_o = si.shading_frame_facing(wo);
+                let u = ProbeRandoms::from_rng(rng);
+                counters.rays += 1;
+                let Some(ps) =
+                    ss.probe.sample(si.p, &frame_o, &u, ctx.accel, hit.geom, mesh, &mut scratch.probe_hits)
+                else {
+                    break;
+                };
+                beta *= ps.weight;
+                let n_in = if si.front { ps.normal } else { -ps.normal };
+                let frame = Frame::from_normal(n_in);
+                Vertex { p: ps.point, ng: n_in, frame, wo_local: Vec3::Z, lobe: Lobe::SubsurfaceEntry(ss) }
+            }
+        };
 
-        if depth >= RR_START {
-            let survive = beta.max_element().min(1.0);
-            if survive <= 0.0 || rng.uniform() >= survive {
-                break;
-            }
-            beta /= survive;
+        // Next-event estimation, then continue by sampling the lobe.
+        if ctx.plan.area_lights {
+            l += beta * direct_lighting(ctx, &vertex, rng, counters);
+        }
+        let Some((wi_local, weight, pdf)) = vertex.lobe.sample(vertex.wo_local, rng.uniform2()) else {
+            break;
+        };
+        let wi = vertex.frame.to_world(wi_local);
+        // A shading normal can send ωi through the geometric surface; such a
+        // path would leak light through it, so it ends here.
+        if wi.dot(vertex.ng) <= 0.0 {
+            break;
+        }
+        beta *= weight;
+        prev = Some((vertex.p, pdf));
+        ray = Ray::new(offset_origin(vertex.p, vertex.ng, wi, ctx.ray_epsilon), wi);
+        if !roulette(depth, &mut beta, rng) {
+            break;
         }
     }
     l
 }
 
-/// Next-event estimation at a diffuse vertex: one light sample, weighted by
-/// the power heuristic against BSDF sampling of the same direction.
-fn direct_lighting(
-    ctx: &Context,
-    si: &Interaction,
-    frame: &Frame,
-    albedo: Vec3,
-    wo_local: Vec3,
-    rng: &mut Rng,
-    counters: &mut Counters,
-) -> Vec3 {
+/// Russian roulette after `RR_START` bounces: survive with probability
+/// min(1, max β) and reweight; false ends the path.
+fn roulette(depth: u32, beta: &mut Vec3, rng: &mut Rng) -> bool {
+    if depth < RR_START {
+        return true;
+    }
+    let survive = beta.max_element().min(1.0);
+    if survive <= 0.0 || rng.uniform() >= survive {
+        return false;
+    }
+    *beta /= survive;
+    true
+}
+
+/// The MIS weight of emission found by lobe sampling from `prev`.
+fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3, f32)>) -> f32 {
+    match prev {
+        None => 1.0,
+        Some((p0, pdf_lobe)) => {
+            let cos_l = wo.dot(si.ng);
+            let pdf_light =
+                ctx.lights.pdf_area(&ctx.scene.meshes, si.geom, si.prim) * (si.p - p0).length_squared() / cos_l;
+            power(pdf_lobe, pdf_light)
+        }
+    }
+}
+
+/// Next-event estimation at a vertex: one light sample, weighted by the
+/// power heuristic against lobe sampling of the same direction.
+fn direct_lighting(ctx: &Context, v: &Vertex, rng: &mut Rng, counters: &mut Counters) -> Vec3 {
     let u_pick = rng.uniform();
     let u = rng.uniform2();
     let Some(ls) = ctx.lights.sample(ctx.scene, u_pick, u) else {
         return Vec3::ZERO;
     };
-    let to_light = ls.point - si.p;
+    let to_light = ls.point - v.p;
     let dist2 = to_light.length_squared();
     if dist2 <= 0.0 {
         return Vec3::ZERO;
     }
     let wi = to_light / dist2.sqrt();
     let cos_l = -wi.dot(ls.normal);
-    let wi_local = frame.to_local(wi);
-    let f = diffuse::eval(albedo, wo_local, wi_local);
-    if cos_l <= 0.0 || f == Vec3::ZERO || wi.dot(si.ng) * wo_local.z.signum() * frame.n.dot(si.ng).signum() <= 0.0 {
+    if cos_l <= 0.0 || wi.dot(v.ng) <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let wi_local = v.frame.to_local(wi);
+    let f = v.lobe.eval(v.wo_local, wi_local);
+    if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
     let pdf_light = ls.pdf_area * dist2 / cos_l;
     counters.rays += 1;
-    let origin = offset_origin(si.p, si.ng, wi, ctx.ray_epsilon);
+    let origin = offset_origin(v.p, v.ng, wi, ctx.ray_epsilon);
     // t is in units of |d| = the distance to the light point; stop just short
     // of it so the light's own triangle does not shadow itself.
     if ctx.accel.occluded(&Ray::new(origin, ls.point - origin), 0.0, 1.0 - 1e-4) {
         return Vec3::ZERO;
     }
-    let w = power(pdf_light, diffuse::pdf(wo_local, wi_local));
+    let w = power(pdf_light, v.lobe.pdf(v.wo_local, wi_local));
     f * ls.radiance * (wi_local.z.abs() * w / pdf_light)
 }

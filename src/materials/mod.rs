@@ -4,8 +4,12 @@
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
+pub mod subsurface;
+
+use std::sync::Arc;
 
 use crate::geometry::Vec3;
+pub use subsurface::Subsurface;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {
@@ -14,4 +18,6 @@ pub enum Material {
     /// A smooth dielectric interface with relative index of refraction η
     /// (inside over outside): specular reflection and refraction.
     Dielectric { eta: f32 },
+    /// A dielectric boundary over a scattering medium: the Burley BSSRDF.
+    Subsurface(Arc<Subsurface>),
 }
