@@ -12,7 +12,7 @@
 #[doc(hidden)]
 pub mod ffi;
 
-use std::ffi::{c_char, c_void, CStr};
+use std::ffi::{c_char, c_void, CStr, CString};
 use std::marker::PhantomData;
 use std::ptr;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -39,7 +39,7 @@ pub fn live_objects() -> (usize, usize) {
 pub fn version() -> String {
     static VERSION: OnceLock<String> = OnceLock::new();
     VERSION
-        .get_or_init(|| match Device::new() {
+        .get_or_init(|| match Device::new(1) {
             Ok(d) => {
                 let p = |prop| d.property(prop);
                 format!(
@@ -112,9 +112,12 @@ struct Device {
 }
 
 impl Device {
-    fn new() -> Result<Device, String> {
-        // SAFETY: a null config string asks for the defaults.
-        let raw = unsafe { ffi::rtcNewDevice(ptr::null()) };
+    /// A device whose builds use at most `threads` threads (Embree's own
+    /// TBB pool, which does not know about rayon).
+    fn new(threads: usize) -> Result<Device, String> {
+        let config = CString::new(format!("threads={}", threads.max(1))).expect("no NUL");
+        // SAFETY: `config` is a NUL-terminated string alive for the call.
+        let raw = unsafe { ffi::rtcNewDevice(config.as_ptr()) };
         if raw.is_null() {
             // SAFETY: with a null device, rtcGetDeviceError returns the error
             // of the failed rtcNewDevice on this thread.
@@ -218,7 +221,7 @@ unsafe impl Sync for EmbreeAccel {}
 
 impl EmbreeAccel {
     /// Builds and commits an Embree scene over `meshes`, sharing their
-    /// buffers. Fails (without leaking) if Embree reports any error or if a
+    /// buffers, with `rayon::current_num_threads()` build threads. Fails (without leaking) if Embree reports any error or if a
     /// mesh cannot be shared safely (index out of range, too many elements).
     pub fn build(meshes: &Arc<Vec<Mesh>>) -> Result<EmbreeAccel, String> {
         if meshes.len() >= ffi::RTC_INVALID_GEOMETRY_ID as usize {
@@ -244,7 +247,10 @@ impl EmbreeAccel {
             }
         }
 
-        let device = Device::new()?;
+        // Build with as many threads as the rayon pool we are called from
+        // (all cores by default; one inside a one-thread pool), so
+        // `--threads` and the benchmarks' pools bound Embree's build too.
+        let device = Device::new(rayon::current_num_threads())?;
         if device.property(ffi::RTC_DEVICE_PROPERTY_TRIANGLE_GEOMETRY_SUPPORTED) == 0
             || device.property(ffi::RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0
         {
