@@ -99,14 +99,11 @@ impl Bvh {
         let prims: Vec<PrimRef> = built
             .iter()
             .enumerate()
-            .filter(|(_, m)| !m.tree.pairs.is_empty())
-            .map(|(i, m)| {
-                let n = m.tree.node(0);
-                PrimRef {
-                    lo: Vec3::from(n.b[0]),
-                    hi: Vec3::from(n.b[1]),
-                    id: i as u32,
-                }
+            .filter(|(_, m)| !m.tree.is_empty())
+            .map(|(i, m)| PrimRef {
+                lo: Vec3::from(m.tree.bounds[0]),
+                hi: Vec3::from(m.tree.bounds[1]),
+                id: i as u32,
             })
             .collect();
         Bvh {
@@ -115,11 +112,12 @@ impl Bvh {
         }
     }
 
-    /// Node count and depth of each mesh's tree, for logs and tuning.
+    /// 4-wide node count and depth of each mesh's tree, for logs and
+    /// tuning.
     pub fn stats(&self) -> Vec<(usize, usize)> {
         self.meshes
             .iter()
-            .map(|m| (m.tree.node_count(), m.tree.depth()))
+            .map(|m| (m.tree.nodes.len(), m.tree.depth()))
             .collect()
     }
 }
@@ -146,11 +144,11 @@ impl Accel for Bvh {
         // the running tmax.
         let mut best: Option<(u32, u32, f32, f32)> = None;
         let mut t = tmax;
-        traverse(&self.top, &rb, tmin, &mut t, |first, count, t| {
+        traverse(&self.top, &[()], &rb, tmin, &mut t, |first, count, t| {
             for k in first..first + count {
                 let g = self.top.order[k as usize];
                 let m = &self.meshes[g as usize];
-                traverse(&m.tree, &rb, tmin, t, |first, count, t| {
+                traverse(&m.tree, &m.tris, &rb, tmin, t, |first, count, t| {
                     for i in first..first + count {
                         let p = &m.tris[i as usize].p;
                         if let Some((th, u, v)) = rt.intersect(p[0], p[1], p[2], tmin, *t) {
@@ -179,10 +177,10 @@ impl Accel for Bvh {
         let rb = RayBox::new(ray);
         let rt = RayTri::new(ray);
         let mut t = tmax;
-        traverse(&self.top, &rb, tmin, &mut t, |first, count, t| {
+        traverse(&self.top, &[()], &rb, tmin, &mut t, |first, count, t| {
             for k in first..first + count {
                 let m = &self.meshes[self.top.order[k as usize] as usize];
-                let hit = traverse(&m.tree, &rb, tmin, t, |first, count, t| {
+                let hit = traverse(&m.tree, &m.tris, &rb, tmin, t, |first, count, t| {
                     let any = m.tris[first as usize..(first + count) as usize]
                         .iter()
                         .any(|tri| {
@@ -210,7 +208,7 @@ impl Accel for Bvh {
                 let rb = RayBox::new(ray);
                 let rt = RayTri::new(ray);
                 let mut t = tmax;
-                traverse(&m.tree, &rb, 0.0, &mut t, |first, count, t| {
+                traverse(&m.tree, &m.tris, &rb, 0.0, &mut t, |first, count, t| {
                     for i in first..first + count {
                         let p = &m.tris[i as usize].p;
                         if let Some((th, u, v)) = rt.intersect(p[0], p[1], p[2], 0.0, *t) {

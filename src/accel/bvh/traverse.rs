@@ -1,5 +1,5 @@
-//! Stack-based, front-to-back traversal of a [`Tree`](super::build::Tree)
-//! with a robust ray/box slab test.
+//! Stack-based, front-to-back traversal of a 4-wide [`Tree`](super::build::Tree)
+//! with a robust ray/box slab test, four boxes at a time.
 //!
 //! The slab test (Kay & Kajiya 1986) picks each axis's near and far plane by
 //! the sign of the direction, as Williams et al. 2005 ("An Efficient and
@@ -12,7 +12,7 @@
 //! ("Robust BVH Ray Traversal", JCGT 2(2)), so that rounding in the slab
 //! distances never culls a box the triangle test would hit.
 
-use super::build::{Node, Tree, STACK};
+use super::build::{is_leaf, leaf_range, Node4, NodeRef, Tree, MAX_DEPTH};
 use crate::geometry::Ray;
 
 /// Relative slack on the box interval: covers the ≤ 3 ulp error of each
@@ -20,45 +20,103 @@ use crate::geometry::Ray;
 /// triangle test's own t, with a wide margin; it costs nothing measurable.
 const SLACK: f32 = 1.0 / (1 << 18) as f32;
 
+/// Each 4-wide level pushes at most three siblings.
+const STACK: usize = 3 * MAX_DEPTH + 1;
+
 /// A ray prepared for box tests.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct RayBox {
     o: [f32; 3],
     inv: [f32; 3],
-    /// 1 where the direction is negative: the near plane is then `b[1]`.
+    /// Row of [`Node4::b`] holding each axis's near plane (`hi` when the
+    /// direction is negative) and far plane.
     near: [usize; 3],
+    far: [usize; 3],
 }
 
 impl RayBox {
     pub fn new(ray: &Ray) -> Self {
         let d = ray.d.to_array();
+        let neg = d.map(|x| x.is_sign_negative() as usize);
         RayBox {
             o: ray.o.to_array(),
             inv: d.map(|x| 1.0 / x),
-            near: d.map(|x| x.is_sign_negative() as usize),
+            near: [neg[0], 2 + neg[1], 4 + neg[2]],
+            far: [1 - neg[0], 3 - neg[1], 5 - neg[2]],
         }
     }
 
-    /// Entry distance if the ray meets the node's box within [tmin, tmax].
-    #[inline(always)]
-    pub fn hit(&self, n: &Node, tmin: f32, tmax: f32) -> Option<f32> {
+    /// Whether the ray meets the box `b` (`[lo, hi]`) within [tmin, tmax].
+    pub fn hit1(&self, b: &[[f32; 3]; 2], tmin: f32, tmax: f32) -> bool {
         let mut lo = tmin;
         let mut hi = tmax;
         for a in 0..3 {
-            let tn = (n.b[self.near[a]][a] - self.o[a]) * self.inv[a];
-            let tf = (n.b[1 - self.near[a]][a] - self.o[a]) * self.inv[a];
-            // Comparisons are false for NaN, so NaN leaves lo/hi as they are.
+            let tn = (b[self.near[a] & 1][a] - self.o[a]) * self.inv[a];
+            let tf = (b[self.far[a] & 1][a] - self.o[a]) * self.inv[a];
             lo = if tn > lo { tn } else { lo };
             hi = if tf < hi { tf } else { hi };
         }
-        // An infinite lo or hi makes one side NaN (∞ − ∞), which fails the
-        // comparison: exactly the cases where the slab was missed.
-        if lo - lo.abs() * SLACK <= hi + hi.abs() * SLACK {
-            Some(lo)
-        } else {
-            None
+        accept(lo, hi)
+    }
+
+    /// Entry distances of the node's four boxes, and which of them the ray
+    /// meets within [tmin, tmax]. Written lane by lane in a shape the
+    /// compiler turns into 4-wide SSE (`maxps`/`minps` have exactly the
+    /// NaN behaviour of the `if` expressions below).
+    #[inline(always)]
+    pub fn hit4(&self, n: &Node4, tmin: f32, tmax: f32) -> ([f32; 4], [bool; 4]) {
+        let mut lo = [tmin; 4];
+        let mut hi = [tmax; 4];
+        for a in 0..3 {
+            let rn = &n.b[self.near[a]];
+            let rf = &n.b[self.far[a]];
+            for k in 0..4 {
+                let tn = (rn[k] - self.o[a]) * self.inv[a];
+                let tf = (rf[k] - self.o[a]) * self.inv[a];
+                // Comparisons are false for NaN, so NaN leaves lo/hi as they are.
+                lo[k] = if tn > lo[k] { tn } else { lo[k] };
+                hi[k] = if tf < hi[k] { tf } else { hi[k] };
+            }
+        }
+        let mut hit = [false; 4];
+        for k in 0..4 {
+            hit[k] = accept(lo[k], hi[k]);
+        }
+        (lo, hit)
+    }
+}
+
+/// The widened interval test. An infinite lo or hi makes one side NaN
+/// (∞ − ∞), which fails the comparison: exactly the cases where a slab was
+/// missed (or the box is an empty lane).
+#[inline(always)]
+fn accept(lo: f32, hi: f32) -> bool {
+    lo - lo.abs() * SLACK <= hi + hi.abs() * SLACK
+}
+
+/// Asks the cache for the line holding `p` (and, with `two`, the next one).
+///
+/// Incoherent rays spend most of their time waiting for node and triangle
+/// loads; fetching every hit child while the nearest is processed overlaps
+/// those misses.
+#[inline(always)]
+fn prefetch<T>(p: &T, two: bool) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let p = p as *const T as *const i8;
+        // SAFETY: a prefetch is a hint that never faults, whatever the
+        // address; `p` is a valid reference anyway and `p + 64` stays
+        // within (or one line past) the same allocation.
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(p);
+            if two {
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
+            }
         }
     }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (p, two);
 }
 
 /// What a leaf visit asks of the traversal.
@@ -70,55 +128,69 @@ pub(super) enum Visit {
 /// Visits, nearest box first, every leaf whose box the ray meets within
 /// [tmin, *tmax]. `leaf(first, count, tmax)` may shrink `*tmax` (nearest
 /// hit): boxes entered beyond it are then skipped, also when popped from
-/// the stack. Returns true if a leaf asked to stop.
+/// the stack. Returns true if a leaf asked to stop. `leaf_data` is what
+/// leaves index (triangles), prefetched when a leaf's box is hit.
 #[inline(always)]
-pub(super) fn traverse(
+pub(super) fn traverse<L>(
     tree: &Tree,
+    leaf_data: &[L],
     ray: &RayBox,
     tmin: f32,
     tmax: &mut f32,
     mut leaf: impl FnMut(u32, u32, &mut f32) -> Visit,
 ) -> bool {
-    if tree.pairs.is_empty() {
+    if tree.is_empty() || !ray.hit1(&tree.bounds, tmin, *tmax) {
         return false;
     }
-    let root = tree.node(0);
-    if ray.hit(root, tmin, *tmax).is_none() {
-        return false;
-    }
-    let mut stack_node = [0u32; STACK];
+    let mut stack_ref = [0 as NodeRef; STACK];
     let mut stack_t = [0f32; STACK];
     let mut sp = 0usize;
-    let mut node = root;
+    let mut r = tree.root;
     loop {
-        if node.count > 0 {
-            if let Visit::Stop = leaf(node.offset, node.count as u32, tmax) {
-                return true;
+        // Descend from r to a leaf or a dead end.
+        loop {
+            if is_leaf(r) {
+                let (first, count) = leaf_range(r);
+                if let Visit::Stop = leaf(first, count, tmax) {
+                    return true;
+                }
+                break;
             }
-        } else {
-            let c = node.offset;
-            let pair = &tree.pairs[(c >> 1) as usize].0;
-            let h0 = ray.hit(&pair[0], tmin, *tmax);
-            let h1 = ray.hit(&pair[1], tmin, *tmax);
-            match (h0, h1) {
-                (Some(t0), Some(t1)) => {
-                    let (near, far, tfar) = if t1 < t0 { (1, 0, t0) } else { (0, 1, t1) };
-                    stack_node[sp] = c + far;
-                    stack_t[sp] = tfar;
-                    sp += 1;
-                    node = &pair[near];
-                    continue;
+            let n = &tree.nodes[r as usize];
+            let (t, hit) = ray.hit4(n, tmin, *tmax);
+            // Hit children, sorted nearest first (insertion sort of ≤ 4).
+            let mut kids = [(0 as NodeRef, 0f32); 4];
+            let mut m = 0;
+            for k in 0..4 {
+                if hit[k] {
+                    let mut j = m;
+                    while j > 0 && kids[j - 1].1 > t[k] {
+                        kids[j] = kids[j - 1];
+                        j -= 1;
+                    }
+                    let c = n.child[k];
+                    kids[j] = (c, t[k]);
+                    m += 1;
+                    if is_leaf(c) {
+                        let (first, count) = leaf_range(c);
+                        if let Some(d) = leaf_data.get(first as usize) {
+                            prefetch(d, count > 1);
+                        }
+                    } else {
+                        prefetch(&tree.nodes[c as usize], true);
+                    }
                 }
-                (Some(_), None) => {
-                    node = &pair[0];
-                    continue;
-                }
-                (None, Some(_)) => {
-                    node = &pair[1];
-                    continue;
-                }
-                (None, None) => {}
             }
+            if m == 0 {
+                break;
+            }
+            // Push the far ones, farthest first, and go on with the nearest.
+            for &(c, tc) in kids[1..m].iter().rev() {
+                stack_ref[sp] = c;
+                stack_t[sp] = tc;
+                sp += 1;
+            }
+            r = kids[0].0;
         }
         // Pop the next box that still starts within the interval.
         loop {
@@ -127,7 +199,7 @@ pub(super) fn traverse(
             }
             sp -= 1;
             if stack_t[sp] - stack_t[sp].abs() * SLACK <= *tmax {
-                node = tree.node(stack_node[sp]);
+                r = stack_ref[sp];
                 break;
             }
         }
