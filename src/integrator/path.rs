@@ -136,8 +136,15 @@ pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, scratch: &mut Scr
                 let n_out = if si.front { si.ng } else { -si.ng };
                 let fr = fresnel::dielectric(wo.dot(n_out).max(0.0), ss.eta());
                 if ss.specular && rng.uniform() < fr {
-                    // Specular reflection with probability Fr: weight 1.
-                    let wi = (2.0 * wo.dot(n_out)) * n_out - wo;
+                    // Specular reflection with probability Fr: weight 1. The
+                    // shading normal keeps highlights smooth on tessellated
+                    // meshes; where it would reflect below the surface the
+                    // geometric normal is used instead.
+                    let ns_out = if si.ns.dot(n_out) >= 0.0 { si.ns } else { -si.ns };
+                    let mut wi = (2.0 * wo.dot(ns_out)) * ns_out - wo;
+                    if wi.dot(n_out) <= 0.0 {
+                        wi = (2.0 * wo.dot(n_out)) * n_out - wo;
+                    }
                     prev = None;
                     ray = si.spawn(wi, ctx.ray_epsilon);
                     if !roulette(depth, &mut beta, rng) {

@@ -75,6 +75,7 @@ pub struct EnvironmentDef {
 pub enum MaterialKind {
     Diffuse,
     Dielectric,
+    Subsurface,
 }
 
 impl MaterialKind {
@@ -82,6 +83,7 @@ impl MaterialKind {
         match self {
             MaterialKind::Diffuse => "diffuse",
             MaterialKind::Dielectric => "dielectric",
+            MaterialKind::Subsurface => "subsurface",
         }
     }
 }
@@ -95,18 +97,47 @@ pub struct MaterialDef {
     pub kind: Spanned<MaterialKind>,
     pub albedo: Option<Spanned<Triple>>,
     pub eta: Option<Spanned<f64>>,
+    // subsurface: parameters (one of three forms)
+    pub preset: Option<Spanned<String>>,
+    pub sigma_s_prime: Option<Spanned<Triple>>,
+    pub sigma_a: Option<Spanned<Triple>>,
+    pub g: Option<Spanned<f64>>,
+    pub dmfp: Option<Spanned<Triple>>,
+    pub fit: Option<Spanned<String>>,
+    // subsurface: sampling options
+    pub radius: Option<Spanned<String>>,
+    pub rmax_quantile: Option<Spanned<f64>>,
+    pub axes: Option<Spanned<String>>,
+    pub channel: Option<Spanned<String>>,
+    pub renormalize: Option<Spanned<bool>>,
+    pub exit_sw: Option<Spanned<bool>>,
+    pub specular: Option<Spanned<bool>>,
 }
 
 impl MaterialDef {
     /// The optional keys that are present, with their spans.
     pub fn present_keys(&self) -> Vec<(&'static str, Range<usize>)> {
         let mut v = Vec::new();
-        if let Some(x) = &self.albedo {
-            v.push(("albedo", x.span()));
-        }
-        if let Some(x) = &self.eta {
-            v.push(("eta", x.span()));
-        }
+        let mut add = |k: &'static str, span: Option<Range<usize>>| {
+            if let Some(span) = span {
+                v.push((k, span));
+            }
+        };
+        add("albedo", self.albedo.as_ref().map(|x| x.span()));
+        add("eta", self.eta.as_ref().map(|x| x.span()));
+        add("preset", self.preset.as_ref().map(|x| x.span()));
+        add("sigma_s_prime", self.sigma_s_prime.as_ref().map(|x| x.span()));
+        add("sigma_a", self.sigma_a.as_ref().map(|x| x.span()));
+        add("g", self.g.as_ref().map(|x| x.span()));
+        add("dmfp", self.dmfp.as_ref().map(|x| x.span()));
+        add("fit", self.fit.as_ref().map(|x| x.span()));
+        add("radius", self.radius.as_ref().map(|x| x.span()));
+        add("rmax_quantile", self.rmax_quantile.as_ref().map(|x| x.span()));
+        add("axes", self.axes.as_ref().map(|x| x.span()));
+        add("channel", self.channel.as_ref().map(|x| x.span()));
+        add("renormalize", self.renormalize.as_ref().map(|x| x.span()));
+        add("exit_sw", self.exit_sw.as_ref().map(|x| x.span()));
+        add("specular", self.specular.as_ref().map(|x| x.span()));
         v
     }
 }
