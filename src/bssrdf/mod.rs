@@ -12,6 +12,21 @@
 //!
 //! The separable BSSRDF is S = C·Ft(xi, wi)·Rd(|xo − xi|)·Ft(xo, wo) with
 //! Rd = A·R; the integrator applies the directional factors.
+//!
+//! Use from an integrator, per material once and per path vertex:
+//!
+//! ```text
+//! let params = SubsurfaceParams::from_preset("marble", units_per_mm, Fit::Searchlight)?;
+//! let sampler = ProbeSampler::new(&params, &ProbeOptions::default())?;   // once
+//! let c = sw_normalization(params.eta);                                    // once
+//! // at exit point xo with shading frame `frame` on mesh `geom`:
+//! let u = ProbeRandoms::from_rng(rng);
+//! if let Some(ps) = sampler.sample(xo, &frame, &u, accel, geom, &mesh, &mut probe_hits) {
+//!     // ps.weight = Rd / pdf × hit count (RGB); light arriving at ps.point
+//!     // (normal ps.normal) through the lobe sw(cos, eta, c) contributes
+//!     // Ft(xo, wo) · ps.weight · ∫ Li sw cos dω.
+//! }
+//! ```
 
 pub mod fresnel_moment;
 pub mod params;

@@ -23,6 +23,16 @@
 //!   computed (finite) but unused. d = 0 (artist ℓ = 0) is inactive too.
 //! - **Units**: the table is in mm⁻¹; `units_per_mm` converts lengths to
 //!   scene units (a scene in metres uses 1e-3).
+//!
+//! Every constructor also records the volumetric [`Medium`] (σs, σa, g in
+//! scene units) that the brute-force random walk
+//! ([`crate::integrator::randomwalk`]) simulates. The preset and measured
+//! forms carry it directly (unfloored: the walk handles σa = 0 exactly).
+//! The artist form has none, so one is derived by inverting the classical
+//! dipole's total diffuse reflectance (Jensen et al. 2001, eq. 5; the same
+//! relation the Jensen table's Rd column follows, `docs/bssrdf.md` §3):
+//! α' is found by bisection so that Rd(α', η) = A, then σt' from the given
+//! length (σtr = 1/ℓd, or σt' = 1/ℓ for [`Fit::VolumeMfp`]), with g = 0.
 
 use super::profile::Fit;
 
@@ -167,6 +177,93 @@ pub struct SubsurfaceParams {
     pub d: [f64; 3],
     /// Relative index of refraction (inside / outside).
     pub eta: f32,
+    /// The homogeneous medium the profile approximates, for the random-walk
+    /// reference; None only for hand-built parameters.
+    pub medium: Option<Medium>,
+}
+
+/// A homogeneous scattering medium in scene units (coefficients per scene
+/// unit = mm⁻¹ / units_per_mm), with a Henyey–Greenstein phase function.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Medium {
+    /// Scattering coefficient σs (not reduced): σs' = σs (1 − g).
+    pub sigma_s: [f64; 3],
+    pub sigma_a: [f64; 3],
+    /// Henyey–Greenstein mean cosine.
+    pub g: f64,
+}
+
+/// Optically thick stand-in for a zero-length (artist ℓ = 0) channel: a
+/// purely absorbing medium this many times denser than the shortest
+/// non-zero length (or 1e9 per scene unit when every length is 0).
+const ZERO_LENGTH_DENSITY: f64 = 1e6;
+
+impl Medium {
+    /// σt = σs + σa per channel.
+    pub fn sigma_t(&self) -> [f64; 3] {
+        std::array::from_fn(|c| self.sigma_s[c] + self.sigma_a[c])
+    }
+
+    /// The medium whose dipole diffuse reflectance is `albedo` and whose
+    /// diffuse mean free path (or, with `volume_mfp`, volume mean free path
+    /// 1/σt') is `mfp` (scene units), g = 0. See the module docs.
+    pub fn from_reflectance(albedo: [f64; 3], mfp: [f64; 3], eta: f32, volume_mfp: bool) -> Medium {
+        let shortest = mfp.iter().copied().filter(|&l| l > 0.0).fold(f64::INFINITY, f64::min);
+        let dense = if shortest.is_finite() { ZERO_LENGTH_DENSITY / shortest } else { 1e9 };
+        let mut m = Medium { sigma_s: [0.0; 3], sigma_a: [0.0; 3], g: 0.0 };
+        for c in 0..3 {
+            if mfp[c] <= 0.0 {
+                m.sigma_a[c] = dense;
+                continue;
+            }
+            let a = invert_dipole_reflectance(albedo[c], eta as f64);
+            let st = if volume_mfp {
+                1.0 / mfp[c]
+            } else {
+                // σtr = σt' √(3(1 − α')) = 1/ℓd
+                1.0 / (mfp[c] * (3.0 * (1.0 - a)).sqrt())
+            };
+            m.sigma_s[c] = a * st;
+            m.sigma_a[c] = (1.0 - a) * st;
+        }
+        m
+    }
+}
+
+/// Diffuse Fresnel reflectance Fdr(η), the Egan & Hilgeman polynomial fit
+/// the dipole's boundary condition uses (Jensen et al. 2001, §2.4).
+fn fdr(eta: f64) -> f64 {
+    if eta >= 1.0 {
+        -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
+    } else {
+        -0.4399 + 0.7099 / eta - 0.3319 / (eta * eta) + 0.0636 / (eta * eta * eta)
+    }
+}
+
+/// Total diffuse reflectance of the classical dipole for reduced albedo α'
+/// at relative index η (Jensen et al. 2001, eq. 5 integrated; Jensen &
+/// Buhler 2002 eq. 2): Rd = α'/2 (1 + e^{−4/3 A √(3(1−α'))}) e^{−√(3(1−α'))},
+/// A = (1 + Fdr)/(1 − Fdr). Increasing in α' from 0 to Rd(1) = 1.
+pub fn dipole_reflectance(alpha: f64, eta: f64) -> f64 {
+    let fd = fdr(eta);
+    let big_a = (1.0 + fd) / (1.0 - fd);
+    let s = (3.0 * (1.0 - alpha).max(0.0)).sqrt();
+    0.5 * alpha * (1.0 + (-4.0 / 3.0 * big_a * s).exp()) * (-s).exp()
+}
+
+/// The α' with `dipole_reflectance(α', η) = rd` (bisection to f64 precision),
+/// capped at 1 − [`MIN_ABSORPTION_FRACTION`] like the diffusion side.
+pub fn invert_dipole_reflectance(rd: f64, eta: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if dipole_reflectance(mid, eta) < rd {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (0.5 * (lo + hi)).min(1.0 - MIN_ABSORPTION_FRACTION)
 }
 
 const CH: [&str; 3] = ["r", "g", "b"];
@@ -269,7 +366,12 @@ impl SubsurfaceParams {
             };
             d[c] = len_mm * units_per_mm / fit.s(m.albedo[c]);
         }
-        Self::checked(m.albedo, d, m.eta)
+        let medium = Medium {
+            sigma_s: m.sigma_s.map(|s| s / units_per_mm),
+            sigma_a: m.sigma_a.map(|s| s / units_per_mm),
+            g: m.g,
+        };
+        Self::checked(m.albedo, d, m.eta, medium)
     }
 
     /// Artist form: albedo A and mean free path ℓ (scene units; diffuse mean
@@ -285,11 +387,12 @@ impl SubsurfaceParams {
         check_finite_nonneg("mfp", mfp)?;
         check_eta(eta)?;
         let d = std::array::from_fn(|c| mfp[c] / fit.s(albedo[c]));
-        Self::checked(albedo, d, eta)
+        let medium = Medium::from_reflectance(albedo, mfp, eta, fit.uses_volume_mfp());
+        Self::checked(albedo, d, eta, medium)
     }
 
-    fn checked(albedo: [f64; 3], d: [f64; 3], eta: f32) -> Result<Self, String> {
-        let p = SubsurfaceParams { albedo, d, eta };
+    fn checked(albedo: [f64; 3], d: [f64; 3], eta: f32, medium: Medium) -> Result<Self, String> {
+        let p = SubsurfaceParams { albedo, d, eta, medium: Some(medium) };
         p.validate()?;
         Ok(p)
     }
@@ -320,6 +423,11 @@ impl SubsurfaceParams {
     pub fn scaled(&self, k: f64) -> Self {
         SubsurfaceParams {
             d: self.d.map(|d| d * k),
+            medium: self.medium.map(|m| Medium {
+                sigma_s: m.sigma_s.map(|s| s / k),
+                sigma_a: m.sigma_a.map(|s| s / k),
+                g: m.g,
+            }),
             ..*self
         }
     }

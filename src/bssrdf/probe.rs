@@ -574,6 +574,7 @@ mod tests {
             albedo: [0.8, 0.5, 0.3],
             d: d.map(|d| d * scale),
             eta: 1.3,
+            medium: None,
         }
     }
 
@@ -708,6 +709,7 @@ mod tests {
             albedo: [0.9, 0.6, 0.4],
             d: [1.0, 0.8, 0.5],
             eta: 1.3,
+            medium: None,
         };
         // 3 planes, then 100 (more than MAX_PROBE_HITS = 64: the query keeps a
         // random 64 and counts them all)
@@ -803,6 +805,7 @@ mod tests {
             albedo: [0.8, 0.8, 0.8],
             d: [1.0, 0.7, 0.4],
             eta: 1.3,
+            medium: None,
         };
         let accel = Brute {
             meshes: vec![planes(100.0, &[0.0])],
@@ -846,6 +849,7 @@ mod tests {
             albedo: [0.8, 0.5, 0.3],
             d: [1.0, 0.35, 0.1],
             eta: 1.3,
+            medium: None,
         };
         // the only surface is far beyond Rmax
         let accel = Brute {
@@ -877,6 +881,7 @@ mod tests {
             albedo: [0.0; 3],
             d: [1.0; 3],
             eta: 1.3,
+            medium: None,
         };
         let s = ProbeSampler::new(&black, &ProbeOptions::default()).unwrap();
         assert_eq!(s.rmax(), 0.0);
@@ -920,6 +925,7 @@ mod tests {
             albedo: [0.8, 0.5, 0.3],
             d: [1.0, 0.35, 0.1],
             eta: 1.3,
+            medium: None,
         };
         let accel = Brute {
             meshes: vec![planes(100.0, &[0.0])],
@@ -972,6 +978,7 @@ mod tests {
             albedo: [0.9, 0.6, 0.4],
             d: [1.0, 0.35, 0.1],
             eta: 1.3,
+            medium: None,
         };
         let xo = Vec3::new(0.31, -0.17, 0.0);
         let zs: Vec<f32> = (0..100).map(|k| -(k as f32) * 0.15).collect();
@@ -1016,12 +1023,49 @@ mod tests {
         }
     }
 
+    /// Relative standard deviation per probe sample and cost per probe
+    /// (2-triangle brute-force accel, so mostly the estimator's own cost),
+    /// for every sampler on a plane seen with an aligned and a 60°-tilted
+    /// shading frame. Run with
+    /// `cargo test --lib bench_probe -- --ignored --nocapture --test-threads=1`.
+    #[test]
+    #[ignore]
+    fn bench_probe_variance_and_cost() {
+        use std::time::Instant;
+        let params =
+            SubsurfaceParams::from_preset("marble", 1.0, profile::Fit::Searchlight).unwrap();
+        let accel = Brute {
+            meshes: vec![planes(1000.0, &[0.0])],
+        };
+        let xo = Vec3::new(0.37, -0.21, 0.0);
+        for deg in [0.0f32, 60.0] {
+            for opts in all_options().into_iter().filter(|o| !o.renormalize) {
+                let s = ProbeSampler::new(&params, &opts).unwrap();
+                let n = 200_000;
+                let t0 = Instant::now();
+                let st = run(&s, &accel, xo, &tilted(deg), n, 9);
+                let ns = t0.elapsed().as_nanos() as f64 / n as f64;
+                let rel: Vec<String> = (0..3)
+                    .map(|c| format!("{:.2}", st.se[c] * (n as f64).sqrt() / st.mean[c]))
+                    .collect();
+                println!(
+                    "tilt {deg:2}° {:?} {:?} {:?}: rel. sd/sample [{}], {ns:.0} ns/probe",
+                    opts.axes,
+                    opts.channel,
+                    opts.radius,
+                    rel.join(", ")
+                );
+            }
+        }
+    }
+
     #[test]
     fn options_validate() {
         let p = SubsurfaceParams {
             albedo: [0.5; 3],
             d: [1.0; 3],
             eta: 1.3,
+            medium: None,
         };
         for q in [0.0, 1.0, f64::NAN] {
             let e = ProbeSampler::new(
