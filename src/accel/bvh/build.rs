@@ -11,7 +11,7 @@
 //! The binary tree is then collapsed into a 4-wide one (each node adopts
 //! the children of its largest inner children until it has four, as in
 //! Wald et al. 2008, "Getting Rid of Packets"), stored as 128-byte
-//! [`Node4`]s holding their children's boxes in structure-of-arrays form so
+//! [`NodeW`]s holding their children's boxes in structure-of-arrays form so
 //! that traversal tests all four with one pass of vector arithmetic. Halving
 //! the depth halves the cache misses of an incoherent ray, which dominate
 //! its cost on a million-triangle mesh.
@@ -65,24 +65,26 @@ fn leaf_ref(first: u32, count: u32) -> NodeRef {
 /// every ray misses, so traversal needs no child count.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(super) struct Node4 {
-    pub b: [[f32; 4]; 6],
-    pub child: [NodeRef; 4],
+pub(super) struct NodeW {
+    pub b: [[f32; WIDTH]; 6],
+    pub child: [NodeRef; WIDTH],
 }
 
-const _: () = assert!(std::mem::size_of::<Node4>() == 128);
+/// Children per node.
+pub(super) const WIDTH: usize = 4;
+const _: () = assert!(std::mem::size_of::<NodeW>() % 64 == 0);
 
-impl Node4 {
-    const EMPTY: Node4 = Node4 {
+impl NodeW {
+    const EMPTY: NodeW = NodeW {
         b: [
-            [f32::INFINITY; 4],
-            [f32::NEG_INFINITY; 4],
-            [f32::INFINITY; 4],
-            [f32::NEG_INFINITY; 4],
-            [f32::INFINITY; 4],
-            [f32::NEG_INFINITY; 4],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
         ],
-        child: [0; 4],
+        child: [0; WIDTH],
     };
 }
 
@@ -90,7 +92,7 @@ impl Node4 {
 /// is a single leaf; `order` maps leaf positions to primitive ids.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Tree {
-    pub nodes: Vec<Node4>,
+    pub nodes: Vec<NodeW>,
     pub root: NodeRef,
     pub bounds: [[f32; 3]; 2],
     pub order: Vec<u32>,
@@ -107,7 +109,7 @@ impl Tree {
                 return 0;
             }
             let n = &t.nodes[r as usize];
-            (0..4)
+            (0..WIDTH)
                 .filter(|&k| n.b[0][k] <= n.b[1][k])
                 .map(|k| 1 + rec(t, n.child[k]))
                 .max()
@@ -388,7 +390,7 @@ impl BuildNode {
 
 /// Collapses the binary subtree `b` into 4-wide nodes appended to `nodes`
 /// (parents before children) and returns its reference.
-fn collapse(b: &BuildNode, nodes: &mut Vec<Node4>) -> NodeRef {
+fn collapse(b: &BuildNode, nodes: &mut Vec<NodeW>) -> NodeRef {
     let kids = match b {
         BuildNode::Leaf { first, count, .. } => return leaf_ref(*first, *count),
         BuildNode::Inner { kids, .. } => kids,
@@ -396,7 +398,7 @@ fn collapse(b: &BuildNode, nodes: &mut Vec<Node4>) -> NodeRef {
     let mut adopt: Vec<&BuildNode> = vec![&kids[0], &kids[1]];
     // Open the inner child with the largest area until there are four:
     // big boxes are the ones most rays enter.
-    while adopt.len() < 4 {
+    while adopt.len() < WIDTH {
         let open = adopt
             .iter()
             .enumerate()
@@ -415,8 +417,8 @@ fn collapse(b: &BuildNode, nodes: &mut Vec<Node4>) -> NodeRef {
         adopt.push(&kids[1]);
     }
     let at = nodes.len();
-    nodes.push(Node4::EMPTY);
-    let mut node = Node4::EMPTY;
+    nodes.push(NodeW::EMPTY);
+    let mut node = NodeW::EMPTY;
     for (k, kid) in adopt.iter().enumerate() {
         let bb = kid.bounds();
         for a in 0..3 {
@@ -493,7 +495,7 @@ mod tests {
             } else {
                 let n = &tree.nodes[r as usize];
                 let mut used = 0;
-                for k in 0..4 {
+                for k in 0..WIDTH {
                     let lo = Vec3::new(n.b[0][k], n.b[2][k], n.b[4][k]);
                     let hi = Vec3::new(n.b[1][k], n.b[3][k], n.b[5][k]);
                     if lo.x > hi.x {

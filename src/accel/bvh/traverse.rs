@@ -12,7 +12,9 @@
 //! ("Robust BVH Ray Traversal", JCGT 2(2)), so that rounding in the slab
 //! distances never culls a box the triangle test would hit.
 
-use super::build::{is_leaf, leaf_range, Node4, NodeRef, Tree, MAX_DEPTH};
+use super::build::{is_leaf, leaf_range, NodeRef, NodeW, Tree, MAX_DEPTH, WIDTH};
+use std::mem::MaybeUninit;
+
 use crate::geometry::Ray;
 
 /// Relative slack on the box interval: covers the ≤ 3 ulp error of each
@@ -20,15 +22,15 @@ use crate::geometry::Ray;
 /// triangle test's own t, with a wide margin; it costs nothing measurable.
 const SLACK: f32 = 1.0 / (1 << 18) as f32;
 
-/// Each 4-wide level pushes at most three siblings.
-const STACK: usize = 3 * MAX_DEPTH + 1;
+/// Each level pushes at most `WIDTH - 1` siblings.
+const STACK: usize = (WIDTH - 1) * MAX_DEPTH + 1;
 
 /// A ray prepared for box tests.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct RayBox {
     o: [f32; 3],
     inv: [f32; 3],
-    /// Row of [`Node4::b`] holding each axis's near plane (`hi` when the
+    /// Row of [`NodeW::b`] holding each axis's near plane (`hi` when the
     /// direction is negative) and far plane.
     near: [usize; 3],
     far: [usize; 3],
@@ -59,18 +61,17 @@ impl RayBox {
         accept(lo, hi)
     }
 
-    /// Entry distances of the node's four boxes, and which of them the ray
-    /// meets within [tmin, tmax]. Written lane by lane in a shape the
-    /// compiler turns into 4-wide SSE (`maxps`/`minps` have exactly the
-    /// NaN behaviour of the `if` expressions below).
+    /// Entry distances of the node's boxes, and a bit mask of those the
+    /// ray meets within [tmin, tmax].
+    #[cfg(not(target_arch = "x86_64"))]
     #[inline(always)]
-    pub fn hit4(&self, n: &Node4, tmin: f32, tmax: f32) -> ([f32; 4], [bool; 4]) {
-        let mut lo = [tmin; 4];
-        let mut hi = [tmax; 4];
+    pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
+        let mut lo = [tmin; WIDTH];
+        let mut hi = [tmax; WIDTH];
         for a in 0..3 {
             let rn = &n.b[self.near[a]];
             let rf = &n.b[self.far[a]];
-            for k in 0..4 {
+            for k in 0..WIDTH {
                 let tn = (rn[k] - self.o[a]) * self.inv[a];
                 let tf = (rf[k] - self.o[a]) * self.inv[a];
                 // Comparisons are false for NaN, so NaN leaves lo/hi as they are.
@@ -78,11 +79,48 @@ impl RayBox {
                 hi[k] = if tf < hi[k] { tf } else { hi[k] };
             }
         }
-        let mut hit = [false; 4];
-        for k in 0..4 {
-            hit[k] = accept(lo[k], hi[k]);
+        let mut mask = 0;
+        for k in 0..WIDTH {
+            mask |= (accept(lo[k], hi[k]) as u32) << k;
         }
-        (lo, hit)
+        (lo, mask)
+    }
+
+    /// The same with SSE, four boxes at once: the compiler does not
+    /// vectorize the portable version (it keeps the NaN-ordered selects
+    /// scalar). `maxps(a, b)` is `a > b ? a : b` and `minps(a, b)` is
+    /// `a < b ? a : b`, exactly the selects of the portable code, so both
+    /// give bit-identical results.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
+        use std::arch::x86_64::*;
+        const _: () = assert!(WIDTH == 4);
+        let mut out = [0f32; WIDTH];
+        // SAFETY: SSE2 is part of the x86_64 baseline; the loads read
+        // 16-byte-aligned rows of a 64-byte-aligned node, the store writes
+        // a local array of four floats.
+        let mask = unsafe {
+            let mut lo = _mm_set1_ps(tmin);
+            let mut hi = _mm_set1_ps(tmax);
+            for a in 0..3 {
+                let o = _mm_set1_ps(self.o[a]);
+                let inv = _mm_set1_ps(self.inv[a]);
+                let rn = _mm_load_ps(n.b[self.near[a]].as_ptr());
+                let rf = _mm_load_ps(n.b[self.far[a]].as_ptr());
+                let tn = _mm_mul_ps(_mm_sub_ps(rn, o), inv);
+                let tf = _mm_mul_ps(_mm_sub_ps(rf, o), inv);
+                lo = _mm_max_ps(tn, lo);
+                hi = _mm_min_ps(tf, hi);
+            }
+            let abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
+            let slack = _mm_set1_ps(SLACK);
+            let l = _mm_sub_ps(lo, _mm_mul_ps(_mm_and_ps(lo, abs), slack));
+            let h = _mm_add_ps(hi, _mm_mul_ps(_mm_and_ps(hi, abs), slack));
+            _mm_storeu_ps(out.as_mut_ptr(), lo);
+            _mm_movemask_ps(_mm_cmple_ps(l, h)) as u32
+        };
+        (out, mask)
     }
 }
 
@@ -94,29 +132,26 @@ fn accept(lo: f32, hi: f32) -> bool {
     lo - lo.abs() * SLACK <= hi + hi.abs() * SLACK
 }
 
-/// Asks the cache for the line holding `p` (and, with `two`, the next one).
+/// Asks the cache for the lines holding `bytes` bytes from `p` on.
 ///
 /// Incoherent rays spend most of their time waiting for node and triangle
 /// loads; fetching every hit child while the nearest is processed overlaps
 /// those misses.
 #[inline(always)]
-fn prefetch<T>(p: &T, two: bool) {
+fn prefetch<T>(p: &T, bytes: usize) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
         let p = p as *const T as *const i8;
-        // SAFETY: a prefetch is a hint that never faults, whatever the
-        // address; `p` is a valid reference anyway and `p + 64` stays
-        // within (or one line past) the same allocation.
-        unsafe {
-            _mm_prefetch::<_MM_HINT_T0>(p);
-            if two {
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
-            }
+        let lines = ((p as usize & 63) + bytes).div_ceil(64);
+        for k in 0..lines {
+            // SAFETY: a prefetch is a hint that never faults, whatever the
+            // address (`wrapping_add` keeps the pointer arithmetic defined).
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * k)) };
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = (p, two);
+    let _ = (p, bytes);
 }
 
 /// What a leaf visit asks of the traversal.
@@ -142,8 +177,9 @@ pub(super) fn traverse<L>(
     if tree.is_empty() || !ray.hit1(&tree.bounds, tmin, *tmax) {
         return false;
     }
-    let mut stack_ref = [0 as NodeRef; STACK];
-    let mut stack_t = [0f32; STACK];
+    // Left uninitialized: zeroing 2 KiB per traversal (two per query) cost
+    // ~4% of an incoherent ray. Only entries below `sp` are ever read.
+    let mut stack: [MaybeUninit<(NodeRef, f32)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
     let mut sp = 0usize;
     let mut r = tree.root;
     loop {
@@ -157,28 +193,28 @@ pub(super) fn traverse<L>(
                 break;
             }
             let n = &tree.nodes[r as usize];
-            let (t, hit) = ray.hit4(n, tmin, *tmax);
-            // Hit children, sorted nearest first (insertion sort of ≤ 4).
-            let mut kids = [(0 as NodeRef, 0f32); 4];
+            let (t, mut hit) = ray.hit_w(n, tmin, *tmax);
+            // Hit children, sorted nearest first (insertion sort).
+            let mut kids = [(0 as NodeRef, 0f32); WIDTH];
             let mut m = 0;
-            for k in 0..4 {
-                if hit[k] {
-                    let mut j = m;
-                    while j > 0 && kids[j - 1].1 > t[k] {
-                        kids[j] = kids[j - 1];
-                        j -= 1;
+            while hit != 0 {
+                let k = hit.trailing_zeros() as usize;
+                hit &= hit - 1;
+                let mut j = m;
+                while j > 0 && kids[j - 1].1 > t[k] {
+                    kids[j] = kids[j - 1];
+                    j -= 1;
+                }
+                let c = n.child[k];
+                kids[j] = (c, t[k]);
+                m += 1;
+                if is_leaf(c) {
+                    let (first, count) = leaf_range(c);
+                    if let Some(d) = leaf_data.get(first as usize) {
+                        prefetch(d, count as usize * std::mem::size_of::<L>());
                     }
-                    let c = n.child[k];
-                    kids[j] = (c, t[k]);
-                    m += 1;
-                    if is_leaf(c) {
-                        let (first, count) = leaf_range(c);
-                        if let Some(d) = leaf_data.get(first as usize) {
-                            prefetch(d, count > 1);
-                        }
-                    } else {
-                        prefetch(&tree.nodes[c as usize], true);
-                    }
+                } else {
+                    prefetch(&tree.nodes[c as usize], std::mem::size_of::<NodeW>());
                 }
             }
             if m == 0 {
@@ -186,8 +222,7 @@ pub(super) fn traverse<L>(
             }
             // Push the far ones, farthest first, and go on with the nearest.
             for &(c, tc) in kids[1..m].iter().rev() {
-                stack_ref[sp] = c;
-                stack_t[sp] = tc;
+                stack[sp] = MaybeUninit::new((c, tc));
                 sp += 1;
             }
             r = kids[0].0;
@@ -198,8 +233,10 @@ pub(super) fn traverse<L>(
                 return false;
             }
             sp -= 1;
-            if stack_t[sp] - stack_t[sp].abs() * SLACK <= *tmax {
-                r = stack_ref[sp];
+            // SAFETY: every entry below the old `sp` was written by a push.
+            let (c, tc) = unsafe { stack[sp].assume_init() };
+            if tc - tc.abs() * SLACK <= *tmax {
+                r = c;
                 break;
             }
         }
