@@ -8,15 +8,28 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
+use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
 use lucent::film::{self, ToneMap};
+use lucent::integrator::IntegratorKind;
+use lucent::materials::SubsurfaceOverrides;
 use lucent::render::{self, RenderOptions};
 use lucent::scene;
 
 #[derive(Parser)]
-#[command(name = "lucent", version, about = "A path tracer for translucent materials")]
+#[command(
+    name = "lucent",
+    version,
+    about = "A path tracer for translucent materials"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum IntegratorArg {
+    Path,
+    Randomwalk,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -64,9 +77,78 @@ enum Command {
         /// No progress bar and no summary line.
         #[arg(short, long)]
         quiet: bool,
+        /// Estimator at subsurface objects: path (diffusion BSSRDF) |
+        /// randomwalk (volumetric reference).
+        #[arg(long, value_enum, default_value = "path")]
+        integrator: IntegratorArg,
+        #[command(flatten)]
+        subsurface: SubsurfaceArgs,
     },
     /// Print the build's ray-query backends and versions.
     Info,
+}
+
+/// Subsurface sampling choices that override every subsurface material's
+/// own (see docs/scene-format.md for what each means).
+#[derive(clap::Args)]
+struct SubsurfaceArgs {
+    /// Radius sampler: uniform | table[:N] | table-uniform[:N] | analytic | mixture.
+    #[arg(long, value_parser = parse_radius)]
+    radius: Option<RadiusSampler>,
+    /// Probe sphere radius as a quantile of the widest channel's profile, in (0, 1).
+    #[arg(long)]
+    rmax_quantile: Option<f64>,
+    /// Probe axes: normal (the seed) | mis3 (N/T/B with MIS).
+    #[arg(long, value_enum)]
+    axes: Option<AxesArg>,
+    /// Channel choice: single (the seed) | mis (all channels, balance heuristic).
+    #[arg(long, value_enum)]
+    channel: Option<ChannelArg>,
+    /// Divide the profile by CDF(Rmax) so truncation loses no energy.
+    #[arg(long)]
+    renormalize: Option<bool>,
+    /// Normalized Fresnel lobe Sw at the entry point (false: cosine lobe).
+    #[arg(long)]
+    exit_sw: Option<bool>,
+    /// Specular reflection layer on top.
+    #[arg(long)]
+    specular: Option<bool>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum AxesArg {
+    Normal,
+    Mis3,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ChannelArg {
+    Single,
+    Mis,
+}
+
+fn parse_radius(s: &str) -> Result<RadiusSampler, String> {
+    RadiusSampler::parse(s)
+}
+
+impl SubsurfaceArgs {
+    fn overrides(&self) -> SubsurfaceOverrides {
+        SubsurfaceOverrides {
+            radius: self.radius,
+            rmax_quantile: self.rmax_quantile,
+            axes: self.axes.map(|a| match a {
+                AxesArg::Normal => ProbeAxes::Normal,
+                AxesArg::Mis3 => ProbeAxes::Mis3,
+            }),
+            channel: self.channel.map(|c| match c {
+                ChannelArg::Single => ChannelStrategy::Single,
+                ChannelArg::Mis => ChannelStrategy::Mis,
+            }),
+            renormalize: self.renormalize,
+            exit_sw: self.exit_sw,
+            specular: self.specular,
+        }
+    }
 }
 
 enum Failure {
@@ -77,10 +159,43 @@ enum Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render { scene, output, spp, threads, seed, accel, tonemap, exposure, quiet } => {
-            let backend = accel.map(Backend::from).unwrap_or_else(Backend::default_available);
-            let opts = RenderOptions { spp, seed, threads, progress: !quiet };
-            run_render(&scene, &output, backend, &opts, tonemap, exposure, quiet)
+        Command::Render {
+            scene,
+            output,
+            spp,
+            threads,
+            seed,
+            accel,
+            tonemap,
+            exposure,
+            quiet,
+            integrator,
+            subsurface,
+        } => {
+            let backend = accel
+                .map(Backend::from)
+                .unwrap_or_else(Backend::default_available);
+            let integrator = match integrator {
+                IntegratorArg::Path => IntegratorKind::Path,
+                IntegratorArg::Randomwalk => IntegratorKind::RandomWalk,
+            };
+            let opts = RenderOptions {
+                spp,
+                seed,
+                threads,
+                progress: !quiet,
+                integrator,
+            };
+            run_render(
+                &scene,
+                &output,
+                backend,
+                &opts,
+                &subsurface.overrides(),
+                tonemap,
+                exposure,
+                quiet,
+            )
         }
         Command::Info => {
             println!("{}", info());
@@ -100,21 +215,37 @@ fn main() -> ExitCode {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_render(
     scene_path: &Path,
     output: &Path,
     backend: Backend,
     opts: &RenderOptions,
+    overrides: &SubsurfaceOverrides,
     tonemap: ToneMap,
     exposure: f32,
     quiet: bool,
 ) -> Result<(), Failure> {
-    if output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) != Some("exr".into()) {
-        return Err(Failure::Input(format!("output {}: expected a path ending in .exr", output.display())));
+    if output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        != Some("exr".into())
+    {
+        return Err(Failure::Input(format!(
+            "output {}: expected a path ending in .exr",
+            output.display()
+        )));
     }
-    let dir = output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = output
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     if !dir.is_dir() {
-        return Err(Failure::Input(format!("output directory {} does not exist", dir.display())));
+        return Err(Failure::Input(format!(
+            "output directory {} does not exist",
+            dir.display()
+        )));
     }
     if opts.spp == Some(0) {
         return Err(Failure::Input("--spp must be at least 1".into()));
@@ -122,11 +253,15 @@ fn run_render(
     if opts.threads == Some(0) {
         return Err(Failure::Input("--threads must be at least 1".into()));
     }
-    let scene = scene::load(scene_path).map_err(|e| Failure::Input(e.to_string()))?;
+    let mut scene = scene::load(scene_path).map_err(|e| Failure::Input(e.to_string()))?;
+    overrides
+        .apply_all(&mut scene.materials)
+        .map_err(|e| Failure::Input(format!("subsurface option: {e}")))?;
     let accel = accel::build(&scene.meshes, backend).map_err(Failure::Input)?;
     let (film, stats) = render::render(&scene, accel.as_ref(), opts).map_err(Failure::Runtime)?;
     film.write_exr(output).map_err(Failure::Runtime)?;
-    film.write_png(&film::preview_path(output), tonemap, exposure).map_err(Failure::Runtime)?;
+    film.write_png(&film::preview_path(output), tonemap, exposure)
+        .map_err(Failure::Runtime)?;
     if !quiet {
         eprintln!(
             "{}: {}x{} at {} spp, {} triangles: {}",
@@ -150,6 +285,9 @@ fn info() -> String {
         "\nbuilt without Embree: install it with `apt-get install -y --no-install-recommends \
          libembree-dev` and rebuild to enable --accel embree",
     );
-    s.push_str(&format!("\ndefault backend: {}", Backend::default_available().name()));
+    s.push_str(&format!(
+        "\ndefault backend: {}",
+        Backend::default_available().name()
+    ));
     s
 }

@@ -24,7 +24,7 @@ use crate::materials::{dielectric, diffuse, fresnel, Material, Subsurface};
 use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Rng};
 
 /// Bounces after which Russian roulette may end a path.
-const RR_START: u32 = 3;
+pub(crate) const RR_START: u32 = 3;
 
 /// Per-thread buffers the integrator reuses so the hot path never allocates.
 #[derive(Default)]
@@ -35,7 +35,7 @@ pub struct Scratch {
 /// A non-specular lobe at a path vertex, in a local frame whose z axis is
 /// the normal on the side light leaves towards.
 #[derive(Clone, Copy)]
-enum Lobe<'a> {
+pub(crate) enum Lobe<'a> {
     /// Lambertian reflection, ρ/π.
     Diffuse(Vec3),
     /// The entry-point lobe of a subsurface material (Sw or 1/π), outward
@@ -58,7 +58,7 @@ impl Lobe<'_> {
         }
     }
     /// Samples ωi; returns (ωi, f |cos| / pdf, pdf).
-    fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<(Vec3, Vec3, f32)> {
+    pub(crate) fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<(Vec3, Vec3, f32)> {
         match self {
             Lobe::Diffuse(albedo) => diffuse::sample(*albedo, wo, u),
             Lobe::SubsurfaceEntry(ss) => {
@@ -72,16 +72,22 @@ impl Lobe<'_> {
 
 /// A vertex where a non-specular lobe scatters: position, geometric normal
 /// facing the lit side, and the shading frame.
-struct Vertex<'a> {
-    p: Vec3,
-    ng: Vec3,
-    frame: Frame,
-    wo_local: Vec3,
-    lobe: Lobe<'a>,
+pub(crate) struct Vertex<'a> {
+    pub(crate) p: Vec3,
+    pub(crate) ng: Vec3,
+    pub(crate) frame: Frame,
+    pub(crate) wo_local: Vec3,
+    pub(crate) lobe: Lobe<'a>,
 }
 
 /// The radiance arriving along `camera_ray`: one sample of L.
-pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, scratch: &mut Scratch, counters: &mut Counters) -> Vec3 {
+pub fn radiance(
+    ctx: &Context,
+    camera_ray: Ray,
+    rng: &mut Rng,
+    scratch: &mut Scratch,
+    counters: &mut Counters,
+) -> Vec3 {
     let scene = ctx.scene;
     let mut l = Vec3::ZERO;
     // Path throughput: the product of f |cos| / pdf (and BSSRDF weights).
@@ -117,7 +123,13 @@ pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, scratch: &mut Scr
             Material::Diffuse { albedo } => {
                 let frame = si.shading_frame_facing(wo);
                 let ng = if wo.dot(si.ng) >= 0.0 { si.ng } else { -si.ng };
-                Vertex { p: si.p, ng, wo_local: frame.to_local(wo), frame, lobe: Lobe::Diffuse(*albedo) }
+                Vertex {
+                    p: si.p,
+                    ng,
+                    wo_local: frame.to_local(wo),
+                    frame,
+                    lobe: Lobe::Diffuse(*albedo),
+                }
             }
             Material::Dielectric { eta } => {
                 let frame = Frame::from_normal(si.ng);
@@ -140,7 +152,11 @@ pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, scratch: &mut Scr
                     // shading normal keeps highlights smooth on tessellated
                     // meshes; where it would reflect below the surface the
                     // geometric normal is used instead.
-                    let ns_out = if si.ns.dot(n_out) >= 0.0 { si.ns } else { -si.ns };
+                    let ns_out = if si.ns.dot(n_out) >= 0.0 {
+                        si.ns
+                    } else {
+                        -si.ns
+                    };
                     let mut wi = (2.0 * wo.dot(ns_out)) * ns_out - wo;
                     if wi.dot(n_out) <= 0.0 {
                         wi = (2.0 * wo.dot(n_out)) * n_out - wo;
@@ -159,15 +175,27 @@ pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, scratch: &mut Scr
                 let frame_o = si.shading_frame_facing(wo);
                 let u = ProbeRandoms::from_rng(rng);
                 counters.rays += 1;
-                let Some(ps) =
-                    ss.probe.sample(si.p, &frame_o, &u, ctx.accel, hit.geom, mesh, &mut scratch.probe_hits)
-                else {
+                let Some(ps) = ss.probe.sample(
+                    si.p,
+                    &frame_o,
+                    &u,
+                    ctx.accel,
+                    hit.geom,
+                    mesh,
+                    &mut scratch.probe_hits,
+                ) else {
                     break;
                 };
                 beta *= ps.weight;
                 let n_in = if si.front { ps.normal } else { -ps.normal };
                 let frame = Frame::from_normal(n_in);
-                Vertex { p: ps.point, ng: n_in, frame, wo_local: Vec3::Z, lobe: Lobe::SubsurfaceEntry(ss) }
+                Vertex {
+                    p: ps.point,
+                    ng: n_in,
+                    frame,
+                    wo_local: Vec3::Z,
+                    lobe: Lobe::SubsurfaceEntry(ss),
+                }
             }
         };
 
@@ -175,7 +203,8 @@ pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, scratch: &mut Scr
         if ctx.plan.area_lights {
             l += beta * direct_lighting(ctx, &vertex, rng, counters);
         }
-        let Some((wi_local, weight, pdf)) = vertex.lobe.sample(vertex.wo_local, rng.uniform2()) else {
+        let Some((wi_local, weight, pdf)) = vertex.lobe.sample(vertex.wo_local, rng.uniform2())
+        else {
             break;
         };
         let wi = vertex.frame.to_world(wi_local);
@@ -196,7 +225,7 @@ pub fn radiance(ctx: &Context, camera_ray: Ray, rng: &mut Rng, scratch: &mut Scr
 
 /// Russian roulette after `RR_START` bounces: survive with probability
 /// min(1, max β) and reweight; false ends the path.
-fn roulette(depth: u32, beta: &mut Vec3, rng: &mut Rng) -> bool {
+pub(crate) fn roulette(depth: u32, beta: &mut Vec3, rng: &mut Rng) -> bool {
     if depth < RR_START {
         return true;
     }
@@ -209,13 +238,19 @@ fn roulette(depth: u32, beta: &mut Vec3, rng: &mut Rng) -> bool {
 }
 
 /// The MIS weight of emission found by lobe sampling from `prev`.
-fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3, f32)>) -> f32 {
+pub(crate) fn emission_weight(
+    ctx: &Context,
+    si: &Interaction,
+    wo: Vec3,
+    prev: Option<(Vec3, f32)>,
+) -> f32 {
     match prev {
         None => 1.0,
         Some((p0, pdf_lobe)) => {
             let cos_l = wo.dot(si.ng);
-            let pdf_light =
-                ctx.lights.pdf_area(&ctx.scene.meshes, si.geom, si.prim) * (si.p - p0).length_squared() / cos_l;
+            let pdf_light = ctx.lights.pdf_area(&ctx.scene.meshes, si.geom, si.prim)
+                * (si.p - p0).length_squared()
+                / cos_l;
             power(pdf_lobe, pdf_light)
         }
     }
@@ -223,7 +258,12 @@ fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3
 
 /// Next-event estimation at a vertex: one light sample, weighted by the
 /// power heuristic against lobe sampling of the same direction.
-fn direct_lighting(ctx: &Context, v: &Vertex, rng: &mut Rng, counters: &mut Counters) -> Vec3 {
+pub(crate) fn direct_lighting(
+    ctx: &Context,
+    v: &Vertex,
+    rng: &mut Rng,
+    counters: &mut Counters,
+) -> Vec3 {
     let u_pick = rng.uniform();
     let u = rng.uniform2();
     let Some(ls) = ctx.lights.sample(ctx.scene, u_pick, u) else {
@@ -249,7 +289,10 @@ fn direct_lighting(ctx: &Context, v: &Vertex, rng: &mut Rng, counters: &mut Coun
     let origin = offset_origin(v.p, v.ng, wi, ctx.ray_epsilon);
     // t is in units of |d| = the distance to the light point; stop just short
     // of it so the light's own triangle does not shadow itself.
-    if ctx.accel.occluded(&Ray::new(origin, ls.point - origin), 0.0, 1.0 - 1e-4) {
+    if ctx
+        .accel
+        .occluded(&Ray::new(origin, ls.point - origin), 0.0, 1.0 - 1e-4)
+    {
         return Vec3::ZERO;
     }
     let w = power(pdf_light, v.lobe.pdf(v.wo_local, wi_local));

@@ -9,7 +9,7 @@ pub mod subsurface;
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
-pub use subsurface::Subsurface;
+pub use subsurface::{Subsurface, SubsurfaceOverrides};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {

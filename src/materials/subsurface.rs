@@ -39,9 +39,20 @@ impl PartialEq for Subsurface {
 }
 
 impl Subsurface {
-    pub fn new(params: SubsurfaceParams, opts: &ProbeOptions, exit_sw: bool, specular: bool) -> Result<Self, String> {
+    pub fn new(
+        params: SubsurfaceParams,
+        opts: &ProbeOptions,
+        exit_sw: bool,
+        specular: bool,
+    ) -> Result<Self, String> {
         let probe = ProbeSampler::new(&params, opts)?;
-        Ok(Subsurface { sw_c: sw_normalization(params.eta), params, probe, exit_sw, specular })
+        Ok(Subsurface {
+            sw_c: sw_normalization(params.eta),
+            params,
+            probe,
+            exit_sw,
+            specular,
+        })
     }
 
     pub fn eta(&self) -> f32 {
@@ -65,5 +76,86 @@ impl Subsurface {
     pub fn albedo(&self) -> Vec3 {
         let a = self.params.albedo;
         Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
+    }
+}
+
+/// Sampling choices that replace a material's own (from the command line
+/// or a study configuration); `None` keeps the material's setting.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SubsurfaceOverrides {
+    pub radius: Option<crate::bssrdf::RadiusSampler>,
+    pub rmax_quantile: Option<f64>,
+    pub axes: Option<crate::bssrdf::ProbeAxes>,
+    pub channel: Option<crate::bssrdf::ChannelStrategy>,
+    pub renormalize: Option<bool>,
+    pub exit_sw: Option<bool>,
+    pub specular: Option<bool>,
+}
+
+impl SubsurfaceOverrides {
+    pub fn is_empty(&self) -> bool {
+        *self == SubsurfaceOverrides::default()
+    }
+
+    /// The material with these choices applied (its parameters unchanged).
+    pub fn apply(&self, ss: &Subsurface) -> Result<Subsurface, String> {
+        let mut opts = *ss.probe.options();
+        opts.radius = self.radius.unwrap_or(opts.radius);
+        opts.rmax_quantile = self.rmax_quantile.unwrap_or(opts.rmax_quantile);
+        opts.axes = self.axes.unwrap_or(opts.axes);
+        opts.channel = self.channel.unwrap_or(opts.channel);
+        opts.renormalize = self.renormalize.unwrap_or(opts.renormalize);
+        Subsurface::new(
+            ss.params,
+            &opts,
+            self.exit_sw.unwrap_or(ss.exit_sw),
+            self.specular.unwrap_or(ss.specular),
+        )
+    }
+
+    /// Applies the overrides to every subsurface material of `materials`.
+    pub fn apply_all(&self, materials: &mut [super::Material]) -> Result<(), String> {
+        for m in materials.iter_mut() {
+            if let super::Material::Subsurface(ss) = m {
+                *ss = std::sync::Arc::new(self.apply(ss)?);
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bssrdf::{Fit, ProbeAxes, RadiusSampler};
+
+    #[test]
+    fn overrides_replace_only_what_they_name() {
+        let p = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
+        let ss = Subsurface::new(p, &ProbeOptions::default(), true, true).unwrap();
+        let ov = SubsurfaceOverrides {
+            axes: Some(ProbeAxes::Normal),
+            specular: Some(false),
+            ..Default::default()
+        };
+        let out = ov.apply(&ss).unwrap();
+        assert_eq!(out.probe.options().axes, ProbeAxes::Normal);
+        assert_eq!(out.probe.options().radius, RadiusSampler::Analytic);
+        assert!(out.exit_sw && !out.specular);
+        assert_eq!(out.params, ss.params);
+        let bad = SubsurfaceOverrides {
+            rmax_quantile: Some(1.5),
+            ..Default::default()
+        };
+        assert!(bad.apply(&ss).is_err());
+        // lobe: Sw integrates to 1 against cos; the plain lobe is 1/π
+        assert_eq!(out.lobe(-0.1), 0.0);
+        let plain = SubsurfaceOverrides {
+            exit_sw: Some(false),
+            ..Default::default()
+        }
+        .apply(&ss)
+        .unwrap();
+        assert_eq!(plain.lobe(0.3), std::f32::consts::FRAC_1_PI);
     }
 }

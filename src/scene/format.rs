@@ -126,13 +126,19 @@ impl MaterialDef {
         add("albedo", self.albedo.as_ref().map(|x| x.span()));
         add("eta", self.eta.as_ref().map(|x| x.span()));
         add("preset", self.preset.as_ref().map(|x| x.span()));
-        add("sigma_s_prime", self.sigma_s_prime.as_ref().map(|x| x.span()));
+        add(
+            "sigma_s_prime",
+            self.sigma_s_prime.as_ref().map(|x| x.span()),
+        );
         add("sigma_a", self.sigma_a.as_ref().map(|x| x.span()));
         add("g", self.g.as_ref().map(|x| x.span()));
         add("dmfp", self.dmfp.as_ref().map(|x| x.span()));
         add("fit", self.fit.as_ref().map(|x| x.span()));
         add("radius", self.radius.as_ref().map(|x| x.span()));
-        add("rmax_quantile", self.rmax_quantile.as_ref().map(|x| x.span()));
+        add(
+            "rmax_quantile",
+            self.rmax_quantile.as_ref().map(|x| x.span()),
+        );
         add("axes", self.axes.as_ref().map(|x| x.span()));
         add("channel", self.channel.as_ref().map(|x| x.span()));
         add("renormalize", self.renormalize.as_ref().map(|x| x.span()));

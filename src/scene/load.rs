@@ -389,30 +389,57 @@ fn text(v: &Option<Spanned<String>>) -> Option<(&str, std::ops::Range<usize>)> {
 /// A `type = "subsurface"` material: one of three parameter forms (preset;
 /// measured σs', σa, A; artist A, dmfp), then the sampling options.
 fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32) -> Res<Material> {
-    use crate::bssrdf::{ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler, SubsurfaceParams};
+    use crate::bssrdf::{
+        ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler, SubsurfaceParams,
+    };
     let d = m.get_ref();
     let f = |k: &str| format!("{field}.{k}");
     let units = units_per_mm as f64;
     // Errors from the bssrdf module start with the offending key.
     let param_err = |msg: String| {
-        let key = msg.split([':', '.']).next().unwrap_or("").trim().to_string();
-        let span = d.present_keys().into_iter().find(|(k, _)| *k == key).map(|(_, s)| s).unwrap_or(m.span());
+        let key = msg
+            .split([':', '.'])
+            .next()
+            .unwrap_or("")
+            .trim()
+            .to_string();
+        let span = d
+            .present_keys()
+            .into_iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, s)| s)
+            .unwrap_or(m.span());
         cx.err(span, &f(&key), msg)
     };
     let fit = match text(&d.fit) {
         Some((s, span)) => Fit::parse(s).map_err(|e| cx.err(span, &f("fit"), e))?,
         None => Fit::Searchlight,
     };
-    let eta = d.eta.as_ref().map(|e| cx.positive(e, &f("eta"))).transpose()?;
+    let eta = d
+        .eta
+        .as_ref()
+        .map(|e| cx.positive(e, &f("eta")))
+        .transpose()?;
     let triple = |v: &Option<Spanned<[f64; 3]>>, k: &str| -> Res<Option<[f64; 3]>> {
-        v.as_ref().map(|t| cx.vec3(t, &f(k)).map(|v| [v.x as f64, v.y as f64, v.z as f64])).transpose()
+        v.as_ref()
+            .map(|t| {
+                cx.vec3(t, &f(k))
+                    .map(|v| [v.x as f64, v.y as f64, v.z as f64])
+            })
+            .transpose()
     };
     let albedo = triple(&d.albedo, "albedo")?;
-    let (sigma_s, sigma_a, dmfp) = (triple(&d.sigma_s_prime, "sigma_s_prime")?, triple(&d.sigma_a, "sigma_a")?, triple(&d.dmfp, "dmfp")?);
-    let forms = "give exactly one of: `preset`; `sigma_s_prime` + `sigma_a` + `albedo`; `albedo` + `dmfp`";
+    let (sigma_s, sigma_a, dmfp) = (
+        triple(&d.sigma_s_prime, "sigma_s_prime")?,
+        triple(&d.sigma_a, "sigma_a")?,
+        triple(&d.dmfp, "dmfp")?,
+    );
+    let forms =
+        "give exactly one of: `preset`; `sigma_s_prime` + `sigma_a` + `albedo`; `albedo` + `dmfp`";
     let params = match (text(&d.preset), sigma_s.or(sigma_a), dmfp) {
         (Some((name, span)), None, None) if albedo.is_none() && d.g.is_none() => {
-            let mut p = SubsurfaceParams::from_preset(name, units, fit).map_err(|e| cx.err(span, &f("preset"), e))?;
+            let mut p = SubsurfaceParams::from_preset(name, units, fit)
+                .map_err(|e| cx.err(span, &f("preset"), e))?;
             if let Some(eta) = eta {
                 p.eta = eta;
             }
@@ -420,22 +447,45 @@ fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32)
         }
         (None, Some(_), None) => {
             let (Some(ss), Some(sa)) = (sigma_s, sigma_a) else {
-                return Err(cx.err(m.span(), &f("sigma_a"), format!("`sigma_s_prime` and `sigma_a` go together; {forms}")));
+                return Err(cx.err(
+                    m.span(),
+                    &f("sigma_a"),
+                    format!("`sigma_s_prime` and `sigma_a` go together; {forms}"),
+                ));
             };
             let Some(albedo) = albedo else {
-                return Err(cx.err(m.span(), &f("albedo"), format!("missing field `albedo` for measured parameters; {forms}")));
+                return Err(cx.err(
+                    m.span(),
+                    &f("albedo"),
+                    format!("missing field `albedo` for measured parameters; {forms}"),
+                ));
             };
-            let g = d.g.as_ref().map(|g| cx.scalar(g, &f("g"))).transpose()?.unwrap_or(0.0) as f64;
+            let g =
+                d.g.as_ref()
+                    .map(|g| cx.scalar(g, &f("g")))
+                    .transpose()?
+                    .unwrap_or(0.0) as f64;
             // σs' is given: σs = σs' / (1 − g) so that the loader's σs(1 − g) is σs' again.
             let sigma_s = ss.map(|x| x / (1.0 - g));
-            let measured = Measured { sigma_s, sigma_a: sa, g, albedo, eta: eta.unwrap_or(1.3) };
+            let measured = Measured {
+                sigma_s,
+                sigma_a: sa,
+                g,
+                albedo,
+                eta: eta.unwrap_or(1.3),
+            };
             SubsurfaceParams::from_measured(&measured, units, fit).map_err(param_err)?
         }
         (None, None, Some(mfp)) if d.g.is_none() => {
             let Some(albedo) = albedo else {
-                return Err(cx.err(m.span(), &f("albedo"), format!("missing field `albedo` for the artist form; {forms}")));
+                return Err(cx.err(
+                    m.span(),
+                    &f("albedo"),
+                    format!("missing field `albedo` for the artist form; {forms}"),
+                ));
             };
-            SubsurfaceParams::from_artist(albedo, mfp.map(|x| x * units), eta.unwrap_or(1.3), fit).map_err(param_err)?
+            SubsurfaceParams::from_artist(albedo, mfp.map(|x| x * units), eta.unwrap_or(1.3), fit)
+                .map_err(param_err)?
         }
         _ => return Err(cx.err(m.span(), field, format!("subsurface parameters: {forms}"))),
     };
@@ -447,7 +497,11 @@ fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32)
     if let Some(q) = &d.rmax_quantile {
         let v = cx.scalar(q, &f("rmax_quantile"))? as f64;
         if !(v > 0.0 && v < 1.0) {
-            return Err(cx.err(q.span(), &f("rmax_quantile"), format!("expected a number in (0, 1), found {v}")));
+            return Err(cx.err(
+                q.span(),
+                &f("rmax_quantile"),
+                format!("expected a number in (0, 1), found {v}"),
+            ));
         }
         opts.rmax_quantile = *q.get_ref();
     }
@@ -455,21 +509,34 @@ fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32)
         opts.axes = match s.to_ascii_lowercase().as_str() {
             "normal" => ProbeAxes::Normal,
             "mis3" => ProbeAxes::Mis3,
-            _ => return Err(cx.err(span, &f("axes"), format!("expected \"normal\" or \"mis3\", found \"{s}\""))),
+            _ => {
+                return Err(cx.err(
+                    span,
+                    &f("axes"),
+                    format!("expected \"normal\" or \"mis3\", found \"{s}\""),
+                ))
+            }
         };
     }
     if let Some((s, span)) = text(&d.channel) {
         opts.channel = match s.to_ascii_lowercase().as_str() {
             "single" => ChannelStrategy::Single,
             "mis" => ChannelStrategy::Mis,
-            _ => return Err(cx.err(span, &f("channel"), format!("expected \"single\" or \"mis\", found \"{s}\""))),
+            _ => {
+                return Err(cx.err(
+                    span,
+                    &f("channel"),
+                    format!("expected \"single\" or \"mis\", found \"{s}\""),
+                ))
+            }
         };
     }
     if let Some(b) = &d.renormalize {
         opts.renormalize = *b.get_ref();
     }
     let flag = |b: &Option<Spanned<bool>>| b.as_ref().map(|b| *b.get_ref()).unwrap_or(true);
-    let ss = Subsurface::new(params, &opts, flag(&d.exit_sw), flag(&d.specular)).map_err(|e| cx.err(m.span(), field, e))?;
+    let ss = Subsurface::new(params, &opts, flag(&d.exit_sw), flag(&d.specular))
+        .map_err(|e| cx.err(m.span(), field, e))?;
     Ok(Material::Subsurface(Arc::new(ss)))
 }
 
