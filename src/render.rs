@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use crate::accel::Accel;
 use crate::film::Film;
 use crate::geometry::Vec3;
-use crate::integrator::{path, Context, Counters};
+use crate::integrator::{Context, Counters, IntegratorKind};
 use crate::integrator::path::Scratch;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -30,11 +30,14 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
     /// Draw a progress bar on stderr.
     pub progress: bool,
+    /// The estimator: the diffusion BSSRDF (default) or the random-walk
+    /// reference at subsurface objects.
+    pub integrator: IntegratorKind,
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { spp: None, seed: None, threads: None, progress: false }
+        RenderOptions { spp: None, seed: None, threads: None, progress: false, integrator: IntegratorKind::Path }
     }
 }
 
@@ -49,7 +52,7 @@ pub struct RenderStats {
 impl RenderStats {
     pub fn summary(&self, backend: &str) -> String {
         format!(
-            "{:.2} s wall, {:.3} Msamples/s, {:.2} Mrays/s ({} rays, {} threads, {backend}){}",
+            "{:.2} s wall, {:.3} Msamples/s, {:.2} Mrays/s ({} rays, {} threads, {backend}){}{}",
             self.seconds,
             self.samples as f64 / self.seconds / 1e6,
             self.counters.rays as f64 / self.seconds / 1e6,
@@ -59,6 +62,10 @@ impl RenderStats {
                 format!(", {} non-finite samples discarded", self.counters.nonfinite)
             } else {
                 String::new()
+            },
+            match (self.counters.walks_capped, self.counters.walks_escaped) {
+                (0, 0) => String::new(),
+                (c, e) => format!(", random walks: {c} capped, {e} escaped through holes"),
             }
         )
     }
@@ -106,7 +113,7 @@ pub fn render(scene: &Scene, accel: &dyn Accel, opts: &RenderOptions) -> Result<
         tiles
             .par_iter()
             .map(|&(x0, y0)| {
-                let r = render_tile(&ctx, x0, y0);
+                let r = render_tile(&ctx, opts.integrator, x0, y0);
                 bar.inc(1);
                 r
             })
@@ -129,7 +136,7 @@ pub fn render(scene: &Scene, accel: &dyn Accel, opts: &RenderOptions) -> Result<
     Ok((film, stats))
 }
 
-fn render_tile(ctx: &Context, x0: u32, y0: u32) -> (Vec<Vec3>, Counters) {
+fn render_tile(ctx: &Context, integrator: IntegratorKind, x0: u32, y0: u32) -> (Vec<Vec3>, Counters) {
     let scene = ctx.scene;
     let (w, h) = (scene.camera.width, scene.camera.height);
     let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
@@ -145,7 +152,7 @@ fn render_tile(ctx: &Context, x0: u32, y0: u32) -> (Vec<Vec3>, Counters) {
                 let mut rng = Rng::new(scene.settings.seed, pixel, s as u64);
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                let l = path::radiance(ctx, ray, &mut rng, &mut scratch, &mut counters);
+                let l = integrator.radiance(ctx, ray, &mut rng, &mut scratch, &mut counters);
                 if l.is_finite() {
                     sum[0] += l.x as f64;
                     sum[1] += l.y as f64;

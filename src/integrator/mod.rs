@@ -4,10 +4,13 @@
 //! and multiple importance sampling. [`plan`] decides once per scene which
 //! effects exist, so a scene pays only for what it uses. [`interaction`]
 //! turns an accel hit into the local surface geometry shading needs.
+//! [`randomwalk`] is the brute-force volumetric reference for subsurface
+//! materials, selected with [`IntegratorKind`].
 
 pub mod interaction;
 pub mod path;
 pub mod plan;
+pub mod randomwalk;
 
 use crate::accel::Accel;
 use crate::lights::LightSet;
@@ -53,6 +56,34 @@ fn scene_bounds(scene: &Scene) -> (glam::Vec3, glam::Vec3) {
     (lo, hi)
 }
 
+/// Which estimator renders the image. Both treat surfaces, lights and the
+/// environment alike; they differ at subsurface objects.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum IntegratorKind {
+    /// [`path::radiance`]: the diffusion BSSRDF sampled with probe rays.
+    #[default]
+    Path,
+    /// [`randomwalk::radiance`]: a volumetric random walk in the medium.
+    RandomWalk,
+}
+
+impl IntegratorKind {
+    /// One sample of the radiance along `ray` with this estimator.
+    pub fn radiance(
+        self,
+        ctx: &Context,
+        ray: crate::geometry::Ray,
+        rng: &mut crate::sampling::Rng,
+        scratch: &mut path::Scratch,
+        counters: &mut Counters,
+    ) -> crate::geometry::Vec3 {
+        match self {
+            IntegratorKind::Path => path::radiance(ctx, ray, rng, scratch, counters),
+            IntegratorKind::RandomWalk => randomwalk::radiance(ctx, ray, rng, scratch, counters),
+        }
+    }
+}
+
 /// Per-thread tallies, summed after rendering (no shared atomics in the
 /// hot loop).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -61,11 +92,17 @@ pub struct Counters {
     pub rays: u64,
     /// Samples whose radiance was not finite and was discarded.
     pub nonfinite: u64,
+    /// Random walks stopped at the cap on events inside a medium.
+    pub walks_capped: u64,
+    /// Random walks that left an open mesh through a hole (no boundary hit).
+    pub walks_escaped: u64,
 }
 
 impl std::ops::AddAssign for Counters {
     fn add_assign(&mut self, o: Self) {
         self.rays += o.rays;
         self.nonfinite += o.nonfinite;
+        self.walks_capped += o.walks_capped;
+        self.walks_escaped += o.walks_escaped;
     }
 }
