@@ -2,7 +2,8 @@
 //!
 //! Lookup order: `EMBREE_DIR` (a prefix with `include/embree3/rtcore.h` and
 //! `lib/libembree3.so`), then `pkg-config embree3`, then the standard Debian
-//! locations. Without Embree lucent still builds, with only its own BVH.
+//! locations. Without Embree (or with `LUCENT_NO_EMBREE=1`) lucent still
+//! builds, with only its own BVH.
 
 use std::env;
 use std::path::{Path, PathBuf};
@@ -111,6 +112,7 @@ fn from_standard_paths() -> Option<Embree> {
 fn main() {
     println!("cargo::rustc-check-cfg=cfg(lucent_embree)");
     println!("cargo::rerun-if-env-changed=EMBREE_DIR");
+    println!("cargo::rerun-if-env-changed=LUCENT_NO_EMBREE");
     println!("cargo::rerun-if-env-changed=PKG_CONFIG_PATH");
     println!("cargo::rerun-if-changed=build.rs");
     // Cargo only reruns this script for the paths named here, so installing
@@ -119,6 +121,13 @@ fn main() {
     // missing path would make Cargo rerun the script on every build).
     if Path::new("/var/lib/dpkg/status").is_file() {
         println!("cargo::rerun-if-changed=/var/lib/dpkg/status");
+    }
+
+    // Forces a BVH-only build even where Embree is installed, so CI can
+    // check that configuration compiles and passes too.
+    if env::var_os("LUCENT_NO_EMBREE").is_some_and(|v| !v.is_empty() && v != "0") {
+        println!("cargo::warning=LUCENT_NO_EMBREE is set: lucent is built with its own BVH only.");
+        return;
     }
 
     match from_embree_dir()
