@@ -112,7 +112,7 @@ impl Bvh {
         }
     }
 
-    /// 4-wide node count and depth of each mesh's tree, for logs and
+    /// Wide-node count and depth of each mesh's tree, for logs and
     /// tuning.
     pub fn stats(&self) -> Vec<(usize, usize)> {
         self.meshes

@@ -1,4 +1,4 @@
-//! Stack-based, front-to-back traversal of a 4-wide [`Tree`](super::build::Tree)
+//! Stack-based, front-to-back traversal of a wide [`Tree`](super::build::Tree)
 //! with a robust ray/box slab test, four boxes at a time.
 //!
 //! The slab test (Kay & Kajiya 1986) picks each axis's near and far plane by
@@ -86,7 +86,7 @@ impl RayBox {
         (lo, mask)
     }
 
-    /// The same with SSE, four boxes at once: the compiler does not
+    /// The same with SSE, four boxes at a time: the compiler does not
     /// vectorize the portable version (it keeps the NaN-ordered selects
     /// scalar). `maxps(a, b)` is `a > b ? a : b` and `minps(a, b)` is
     /// `a < b ? a : b`, exactly the selects of the portable code, so both
@@ -95,31 +95,35 @@ impl RayBox {
     #[inline(always)]
     pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
         use std::arch::x86_64::*;
-        const _: () = assert!(WIDTH == 4);
+        const _: () = assert!(WIDTH % 4 == 0);
         let mut out = [0f32; WIDTH];
-        // SAFETY: SSE2 is part of the x86_64 baseline; the loads read
-        // 16-byte-aligned rows of a 64-byte-aligned node, the store writes
-        // a local array of four floats.
-        let mask = unsafe {
-            let mut lo = _mm_set1_ps(tmin);
-            let mut hi = _mm_set1_ps(tmax);
-            for a in 0..3 {
-                let o = _mm_set1_ps(self.o[a]);
-                let inv = _mm_set1_ps(self.inv[a]);
-                let rn = _mm_load_ps(n.b[self.near[a]].as_ptr());
-                let rf = _mm_load_ps(n.b[self.far[a]].as_ptr());
-                let tn = _mm_mul_ps(_mm_sub_ps(rn, o), inv);
-                let tf = _mm_mul_ps(_mm_sub_ps(rf, o), inv);
-                lo = _mm_max_ps(tn, lo);
-                hi = _mm_min_ps(tf, hi);
-            }
-            let abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
-            let slack = _mm_set1_ps(SLACK);
-            let l = _mm_sub_ps(lo, _mm_mul_ps(_mm_and_ps(lo, abs), slack));
-            let h = _mm_add_ps(hi, _mm_mul_ps(_mm_and_ps(hi, abs), slack));
-            _mm_storeu_ps(out.as_mut_ptr(), lo);
-            _mm_movemask_ps(_mm_cmple_ps(l, h)) as u32
-        };
+        let mut mask = 0u32;
+        for g in (0..WIDTH).step_by(4) {
+            // SAFETY: SSE2 is part of the x86_64 baseline; the loads read
+            // 16-byte-aligned quarters of rows of a 64-byte-aligned node,
+            // the store writes four floats of a local array.
+            let m = unsafe {
+                let mut lo = _mm_set1_ps(tmin);
+                let mut hi = _mm_set1_ps(tmax);
+                for a in 0..3 {
+                    let o = _mm_set1_ps(self.o[a]);
+                    let inv = _mm_set1_ps(self.inv[a]);
+                    let rn = _mm_load_ps(n.b[self.near[a]][g..].as_ptr());
+                    let rf = _mm_load_ps(n.b[self.far[a]][g..].as_ptr());
+                    let tn = _mm_mul_ps(_mm_sub_ps(rn, o), inv);
+                    let tf = _mm_mul_ps(_mm_sub_ps(rf, o), inv);
+                    lo = _mm_max_ps(tn, lo);
+                    hi = _mm_min_ps(tf, hi);
+                }
+                let abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
+                let slack = _mm_set1_ps(SLACK);
+                let l = _mm_sub_ps(lo, _mm_mul_ps(_mm_and_ps(lo, abs), slack));
+                let h = _mm_add_ps(hi, _mm_mul_ps(_mm_and_ps(hi, abs), slack));
+                _mm_storeu_ps(out[g..].as_mut_ptr(), lo);
+                _mm_movemask_ps(_mm_cmple_ps(l, h)) as u32
+            };
+            mask |= m << g;
+        }
         (out, mask)
     }
 }
