@@ -38,8 +38,9 @@
 //! roulette on the walk's throughput ends absorbed walks early; walks longer
 //! than [`MAX_WALK_EVENTS`] are stopped (counted in
 //! [`Counters::walks_capped`]). On an open mesh a walk may leave through a
-//! hole without meeting the boundary; there is no defined "outside" there,
-//! so it ends with zero radiance (counted in [`Counters::walks_escaped`]).
+//! hole: a flight whose ray meets no boundary at all has no bounded medium
+//! around it, so the walk ends there with zero radiance (counted in
+//! [`Counters::walks_escaped`]) instead of scattering through infinite space.
 
 use super::interaction::offset_origin;
 use super::path::{direct_lighting, emission_weight, roulette, Lobe, Scratch, Vertex};
@@ -188,8 +189,15 @@ pub fn walk(
     let mut beta = [1.0f64; 3];
     for event in 0..MAX_WALK_EVENTS {
         counters.rays += 1;
-        let hit = ctx.accel.intersect(&ray, 0.0, f32::INFINITY);
-        let t_max = hit.map_or(f64::INFINITY, |h| h.t as f64);
+        // Inside a closed mesh every direction meets the boundary. No hit
+        // means the walk is in the open (through a hole of an open mesh, or
+        // on the wrong side of a single sheet): there is no bounded medium,
+        // and scattering on in an unbounded one would never end.
+        let Some(hit) = ctx.accel.intersect(&ray, 0.0, f32::INFINITY) else {
+            counters.walks_escaped += 1;
+            return None;
+        };
+        let t_max = hit.t as f64;
 
         // Hero channel by throughput; q sums to 1 over live channels.
         let total: f64 = beta.iter().sum();
@@ -228,11 +236,6 @@ pub fn walk(
             continue;
         }
 
-        let Some(hit) = hit else {
-            // Through a hole in an open mesh: no boundary, no defined outside.
-            counters.walks_escaped += 1;
-            return None;
-        };
         // The flight reached the boundary: probability e^{−σt t} per channel.
         let tr: [f64; 3] = std::array::from_fn(|k| (-sigma_t[k] * t_max).exp());
         let pdf: f64 = (0..3).map(|k| q[k] * tr[k]).sum();
@@ -242,12 +245,12 @@ pub fn walk(
         for k in 0..3 {
             beta[k] *= tr[k] / pdf;
         }
-        let (exit, ray_next) = cross_boundary(ctx, eta, &ray, &hit, rng);
+        let (exit, next, weight) = cross_boundary(ctx, eta, &ray, &hit, rng);
         if exit {
             let w = Vec3::new(beta[0] as f32, beta[1] as f32, beta[2] as f32);
-            return Some((ray_next.0, w * ray_next.1));
+            return Some((next, w * weight));
         }
-        ray = ray_next.0;
+        ray = next;
     }
     counters.walks_capped += 1;
     None
@@ -262,7 +265,7 @@ fn cross_boundary(
     ray: &Ray,
     hit: &Hit,
     rng: &mut Rng,
-) -> (bool, (Ray, f32)) {
+) -> (bool, Ray, f32) {
     let mesh = &ctx.scene.meshes[hit.geom as usize];
     let si = Interaction::new(mesh, ray, hit);
     // Outside is where the ray is heading.
@@ -275,7 +278,7 @@ fn cross_boundary(
     let s = dielectric::sample(eta, frame.to_local(-ray.d), rng.uniform());
     let wi = frame.to_world(s.wi).normalize();
     // spawn offsets to the side wi goes: outside on exit, inside on reflection.
-    (s.transmitted, (si.spawn(wi, ctx.ray_epsilon), s.weight))
+    (s.transmitted, si.spawn(wi, ctx.ray_epsilon), s.weight)
 }
 
 /// The channel whose cumulative probability interval holds `u`.

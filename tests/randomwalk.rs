@@ -1,0 +1,489 @@
+//! The random-walk reference integrator (`lucent::integrator::randomwalk`):
+//! energy conservation on its own closed-form answers, agreement with the
+//! diffusion BSSRDF on the flat-slab ground truth, determinism across thread
+//! counts, and clean termination on open meshes.
+
+use std::sync::Arc;
+
+use lucent::accel::{self, Backend};
+use lucent::bssrdf::params::{dipole_reflectance, invert_dipole_reflectance, Medium};
+use lucent::bssrdf::{Fit, Measured, ProbeOptions, SubsurfaceParams, PRESETS};
+use lucent::film::Film;
+use lucent::geometry::{Mesh, Vec3};
+use lucent::integrator::{Counters, IntegratorKind};
+use lucent::materials::{Material, Subsurface};
+use lucent::render::{render, RenderOptions};
+use lucent::scene::{shapes, Camera, Object, RenderSettings, Scene};
+
+fn placed(mut m: Mesh, scale: Vec3, translate: Vec3) -> Mesh {
+    m.transform(|p| p * scale + translate, |n| n / scale);
+    m
+}
+
+fn subsurface(params: SubsurfaceParams) -> Material {
+    let opts = ProbeOptions {
+        renormalize: true,
+        ..ProbeOptions::default()
+    };
+    // Plain cosine lobe and no coat: with η = 1 the diffusion model then
+    // reflects exactly A (docs/bssrdf.md §7, ground truth 1).
+    Material::Subsurface(Arc::new(
+        Subsurface::new(params, &opts, false, false).unwrap(),
+    ))
+}
+
+/// A medium given directly in mm⁻¹ (units_per_mm = 1).
+fn medium(sigma_s: [f64; 3], sigma_a: [f64; 3], g: f64, eta: f32) -> SubsurfaceParams {
+    let m = Measured {
+        sigma_s,
+        sigma_a,
+        g,
+        albedo: [1.0; 3],
+        eta,
+    };
+    SubsurfaceParams::from_measured(&m, 1.0, Fit::Searchlight).unwrap()
+}
+
+struct Part {
+    mesh: Mesh,
+    material: Material,
+    emission: Option<Vec3>,
+}
+
+fn scene(parts: Vec<Part>, env: Option<Vec3>, camera: Camera, spp: u32, max_depth: u32) -> Scene {
+    let meshes = parts.iter().map(|p| p.mesh.clone()).collect();
+    let objects = parts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| Object {
+            name: format!("o{i}"),
+            material: i,
+            emission: p.emission,
+        })
+        .collect();
+    let materials = parts.into_iter().map(|p| p.material).collect();
+    Scene {
+        camera,
+        settings: RenderSettings {
+            spp,
+            max_depth,
+            seed: 11,
+        },
+        meshes: Arc::new(meshes),
+        objects,
+        materials,
+        environment: env,
+        units_per_mm: 1.0,
+        source: None,
+    }
+}
+
+fn run(scene: &Scene, integrator: IntegratorKind, threads: Option<usize>) -> (Film, Counters, f64) {
+    let a = accel::build(&scene.meshes, Backend::default_available()).unwrap();
+    let opts = RenderOptions {
+        integrator,
+        threads,
+        ..Default::default()
+    };
+    let (film, stats) = render(scene, a.as_ref(), &opts).unwrap();
+    (film, stats.counters, stats.seconds)
+}
+
+/// Mean over the image and its standard error (pixels are independent).
+fn mean_and_error(film: &Film) -> (Vec3, Vec3) {
+    let n = film.pixels.len() as f32;
+    let mean = film.pixels.iter().copied().sum::<Vec3>() / n;
+    let var = film
+        .pixels
+        .iter()
+        .map(|p| (*p - mean) * (*p - mean))
+        .sum::<Vec3>()
+        / (n - 1.0);
+    (mean, (var / n).map(f32::sqrt))
+}
+
+/// A slab 200 × `thickness` × 200 with its top face at y = 0.
+fn slab(thickness: f32, material: Material) -> Part {
+    let mesh = placed(
+        shapes::cuboid(),
+        Vec3::new(100.0, thickness / 2.0, 100.0),
+        Vec3::new(0.0, -thickness / 2.0, 0.0),
+    );
+    Part {
+        mesh,
+        material,
+        emission: None,
+    }
+}
+
+fn camera_above(res: u32) -> Camera {
+    Camera::new(
+        Vec3::new(0.0, 10.0, 0.0),
+        Vec3::ZERO,
+        Vec3::new(0.0, 0.0, -1.0),
+        10.0,
+        res,
+        res,
+    )
+}
+
+/// With σa = 0 and η = 1 nothing is absorbed and nothing reflects at the
+/// boundary, so every walk leaves the slab (top, bottom or side) into a
+/// uniform environment of radiance 1: each sample's expectation is exactly
+/// 1. The chromatic σs exercises the spectral MIS weights (one channel's
+/// distance, all channels' throughputs). Then the same slab with a
+/// black floor (reflectance R) and with an emitting floor under a black sky
+/// (transmittance T): R + T = 1, and forward scattering transmits more.
+#[test]
+fn albedo_one_slab_conserves_energy_and_r_plus_t_is_one() {
+    let sigma_s = [1.0, 2.0, 4.0];
+    let mut transmitted = Vec::new();
+    for g in [0.0, 0.8] {
+        let mat = || subsurface(medium(sigma_s, [0.0; 3], g, 1.0));
+        let cam = camera_above(8);
+        let s = scene(vec![slab(1.0, mat())], Some(Vec3::ONE), cam.clone(), 64, 8);
+        let (film, c, _) = run(&s, IntegratorKind::RandomWalk, None);
+        let (m, e) = mean_and_error(&film);
+        println!("g = {g}: furnace mean {m}, standard error {e}");
+        assert_eq!((c.walks_capped, c.walks_escaped, c.nonfinite), (0, 0, 0));
+        for k in 0..3 {
+            assert!(
+                (m[k] - 1.0).abs() < 4.0 * e[k] + 1e-5,
+                "g = {g}, channel {k}: {} ± {}",
+                m[k],
+                e[k]
+            );
+        }
+
+        // A large floor 1 unit below the slab catches what leaves downwards.
+        let floor = || placed(shapes::quad(), Vec3::splat(2000.0), Vec3::ZERO);
+        let floor = || {
+            let mut f = floor();
+            // quad faces +z; turn it to face +y and move it under the slab
+            f.transform(
+                |p| Vec3::new(p.x, -2.0, -p.y),
+                |n| Vec3::new(n.x, n.z, -n.y),
+            );
+            f
+        };
+        let black = Material::Diffuse { albedo: Vec3::ZERO };
+        let r_scene = scene(
+            vec![
+                slab(1.0, mat()),
+                Part {
+                    mesh: floor(),
+                    material: black.clone(),
+                    emission: None,
+                },
+            ],
+            Some(Vec3::ONE),
+            cam.clone(),
+            64,
+            8,
+        );
+        let t_scene = scene(
+            vec![
+                slab(1.0, mat()),
+                Part {
+                    mesh: floor(),
+                    material: black,
+                    emission: Some(Vec3::ONE),
+                },
+            ],
+            None,
+            cam,
+            64,
+            8,
+        );
+        let (r, er) = mean_and_error(&run(&r_scene, IntegratorKind::RandomWalk, None).0);
+        let (t, et) = mean_and_error(&run(&t_scene, IntegratorKind::RandomWalk, None).0);
+        println!("g = {g}: R = {r} ± {er}, T = {t} ± {et}, R + T = {}", r + t);
+        for k in 0..3 {
+            let err = (er[k] * er[k] + et[k] * et[k]).sqrt();
+            assert!(
+                (r[k] + t[k] - 1.0).abs() < 4.0 * err + 1e-4,
+                "g = {g}, channel {k}: R {} T {}",
+                r[k],
+                t[k]
+            );
+            assert!(
+                r[k] > 0.02 && t[k] > 0.05,
+                "g = {g}, channel {k}: R {} T {}",
+                r[k],
+                t[k]
+            );
+        }
+        // optically thicker channels reflect more
+        assert!(r.x < r.y && r.y < r.z, "R {r}");
+        transmitted.push(t);
+    }
+    assert!(
+        transmitted[1].min_element() > transmitted[0].max_element() * 0.9,
+        "{transmitted:?}"
+    );
+    for k in 0..3 {
+        assert!(
+            transmitted[1][k] > transmitted[0][k],
+            "forward scattering transmits more: {transmitted:?}"
+        );
+    }
+}
+
+/// The dipole relations behind the artist-form medium: the Jensen table's
+/// Rd column follows the dipole at its η (docs/bssrdf.md §3: within 0.01
+/// except Chicken1 blue), and the numeric inversion round-trips.
+#[test]
+fn dipole_inversion_round_trips_and_matches_the_table() {
+    for pr in PRESETS.iter().filter(|p| p.name != "Spectralon") {
+        for c in 0..3 {
+            let a = pr.sigma_s_reduced[c] / (pr.sigma_s_reduced[c] + pr.sigma_a[c]);
+            let rd = dipole_reflectance(a, pr.eta as f64);
+            let tol = if pr.name == "Chicken1" && c == 2 {
+                0.03
+            } else {
+                0.012
+            };
+            assert!(
+                (rd - pr.albedo[c]).abs() < tol,
+                "{} {c}: dipole {rd} table {}",
+                pr.name,
+                pr.albedo[c]
+            );
+        }
+    }
+    for eta in [1.0, 1.3, 1.5] {
+        for a in [0.0, 0.01, 0.2, 0.5, 0.8, 0.95, 0.99] {
+            let alpha = invert_dipole_reflectance(a, eta);
+            assert!(
+                (dipole_reflectance(alpha, eta) - a).abs() < 1e-9,
+                "eta {eta} A {a}"
+            );
+        }
+    }
+    // Artist form: σtr = 1/ℓd per channel; ℓ = 0 is a dense absorber.
+    let p = SubsurfaceParams::from_artist([0.2, 0.5, 0.8], [0.2, 0.0, 0.4], 1.0, Fit::Searchlight)
+        .unwrap();
+    let m: Medium = p.medium.unwrap();
+    for c in [0, 2] {
+        let st = m.sigma_t()[c];
+        let str_ = (3.0 * m.sigma_a[c] * st).sqrt();
+        assert!((str_ * [0.2, 0.0, 0.4][c] - 1.0).abs() < 1e-9, "{m:?}");
+    }
+    assert!(m.sigma_s[1] == 0.0 && m.sigma_a[1] >= 1e6 / 0.2, "{m:?}");
+}
+
+/// Ground truth 1 against ground truth 3: a thick flat slab under uniform
+/// white light, η = 1, rendered with the diffusion BSSRDF (which returns A
+/// exactly, renormalized) and with the random walk in the medium the
+/// parameters came from. Measured (seed 11, 8×8 px, 256 spp; standard
+/// errors ≈ 0.5–1 %), (diffusion − walk) / walk per channel:
+///
+/// - marble σ's with A = the dipole's Rd at η = 1: +0.14 %, −0.07 %, −0.20 %
+///   (walk R = 0.914, 0.891, 0.868): for this high-albedo medium the
+///   diffusion total reflectance is exact within noise; bound 2 %;
+/// - marble with the table's A (measured at η = 1.5) but rendered at η = 1:
+///   −9.1 %, −11.5 %, −13.8 %: the table's A belongs to another boundary,
+///   not a diffusion error; asserted to stay in [−17 %, −6 %];
+/// - the artist material of `scenes/slab-uniform.toml` (A = 0.2, 0.5, 0.8,
+///   medium from the dipole inversion): −15.0 %, −4.6 %, +0.03 %: diffusion
+///   underestimates low-albedo media (few scattering events); bounds 22 %,
+///   10 %, 5 %, and red must stay below −8 %.
+#[test]
+fn diffusion_agrees_with_random_walk_on_the_flat_slab() {
+    let marble = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
+    let table = &PRESETS.iter().find(|p| p.name == "Marble").unwrap();
+    // The table's A was measured at η = 1.5; the dipole's total reflectance
+    // of the same medium at η = 1 is the consistent A for this slab.
+    let a_eta1: [f64; 3] = std::array::from_fn(|c| {
+        let (s, a) = (table.sigma_s_reduced[c], table.sigma_a[c]);
+        dipole_reflectance(s / (s + a), 1.0)
+    });
+    let cases: Vec<(&str, SubsurfaceParams, f32)> = vec![
+        (
+            "marble, table A (η = 1.5 data)",
+            SubsurfaceParams { eta: 1.0, ..marble },
+            100.0,
+        ),
+        (
+            "marble, A = dipole Rd at η = 1",
+            SubsurfaceParams {
+                eta: 1.0,
+                albedo: a_eta1,
+                ..marble
+            },
+            100.0,
+        ),
+        (
+            "artist (0.2, 0.5, 0.8), dmfp 0.2",
+            SubsurfaceParams::from_artist([0.2, 0.5, 0.8], [0.2; 3], 1.0, Fit::Searchlight)
+                .unwrap(),
+            10.0,
+        ),
+    ];
+    for (name, params, thickness) in cases {
+        let mut part = slab(thickness, subsurface(params));
+        part.mesh = placed(part.mesh, Vec3::new(5.0, 1.0, 5.0), Vec3::ZERO);
+        let s = scene(vec![part], Some(Vec3::ONE), camera_above(8), 256, 8);
+        let (fd, _, td) = run(&s, IntegratorKind::Path, None);
+        let (fw, cw, tw) = run(&s, IntegratorKind::RandomWalk, None);
+        let (d, ed) = mean_and_error(&fd);
+        let (w, ew) = mean_and_error(&fw);
+        let rel = (d - w) / w;
+        println!(
+            "{name}: diffusion {d} ± {ed} ({td:.2} s), random walk {w} ± {ew} ({tw:.2} s), \
+             (diffusion − walk)/walk = {rel}, walks capped {} escaped {}",
+            cw.walks_capped, cw.walks_escaped
+        );
+        assert_eq!(cw.nonfinite, 0);
+        assert_eq!((cw.walks_capped, cw.walks_escaped), (0, 0));
+        let (lo, hi): ([f32; 3], [f32; 3]) = match name {
+            n if n.contains("dipole") => ([-0.02; 3], [0.02; 3]),
+            n if n.contains("table") => ([-0.17; 3], [-0.06; 3]),
+            _ => ([-0.22, -0.10, -0.05], [-0.08, 0.10, 0.05]),
+        };
+        for k in 0..3 {
+            assert!(
+                lo[k] <= rel[k] && rel[k] <= hi[k],
+                "{name}, channel {k}: {rel}"
+            );
+        }
+    }
+}
+
+/// Same seed → the same image, bit for bit, on 1 and 2 threads (each sample
+/// draws from its own counter-based stream, and the walk uses only it).
+#[test]
+fn random_walk_is_deterministic_across_thread_counts() {
+    let ball = placed(shapes::sphere(2), Vec3::splat(1.0), Vec3::ZERO);
+    let params =
+        SubsurfaceParams::from_artist([0.8, 0.5, 0.3], [0.5, 0.3, 0.1], 1.3, Fit::Searchlight)
+            .unwrap();
+    let mut lamp = placed(shapes::quad(), Vec3::splat(0.5), Vec3::new(0.0, 0.0, 3.0));
+    lamp.flip_winding(); // face −z, towards the ball
+    let s = scene(
+        vec![
+            Part {
+                mesh: ball,
+                material: subsurface(params),
+                emission: None,
+            },
+            Part {
+                mesh: lamp,
+                material: Material::Diffuse { albedo: Vec3::ZERO },
+                emission: Some(Vec3::splat(4.0)),
+            },
+        ],
+        Some(Vec3::splat(0.2)),
+        Camera::new(Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO, Vec3::Y, 40.0, 20, 12),
+        4,
+        6,
+    );
+    let (one, c1, _) = run(&s, IntegratorKind::RandomWalk, Some(1));
+    let (two, c2, _) = run(&s, IntegratorKind::RandomWalk, Some(2));
+    assert_eq!(one.pixels, two.pixels);
+    assert_eq!(c1, c2);
+    let (path, _, _) = run(&s, IntegratorKind::Path, Some(2));
+    assert_ne!(
+        one.pixels, path.pixels,
+        "the option must select a different estimator"
+    );
+    assert!(one
+        .pixels
+        .iter()
+        .all(|p| p.is_finite() && p.min_element() >= 0.0));
+}
+
+/// Open meshes (the Stanford dragon has holes): a bowl (an open hemisphere,
+/// seen from its open side, so the medium behind the single sheet is
+/// unbounded) and a sphere with a cap cut off, of a medium with σa = 0 and
+/// η = 1.3 (total internal reflection keeps walks inside for long). Walks
+/// that leave through the hole must end cleanly: no hang, no NaN, counted.
+#[test]
+fn open_mesh_walks_end_cleanly() {
+    let s3 = shapes::sphere(3);
+    let pos = s3.positions().to_vec();
+    let keep = |f: &dyn Fn(f32) -> bool| -> Mesh {
+        let tris = s3
+            .indices
+            .iter()
+            .copied()
+            .filter(|t| t.iter().all(|&i| f(pos[i as usize].y)))
+            .collect();
+        Mesh::new(pos.clone(), tris, None)
+    };
+    let bowl = keep(&|y| y >= -1e-4);
+    let holed = keep(&|y| y <= 0.7);
+    let cases = [
+        ("bowl", bowl, Vec3::new(0.0, -3.0, 2.0), 1.3, 0.0),
+        (
+            "bowl",
+            keep(&|y| y >= -1e-4),
+            Vec3::new(0.0, -3.0, 2.0),
+            1.0,
+            0.01,
+        ),
+        ("cut sphere", holed, Vec3::new(0.0, 0.3, 3.0), 1.3, 0.0),
+    ];
+    for (name, mesh, eye, eta, sigma_a) in cases {
+        let params = medium([2.0, 3.0, 4.0], [sigma_a; 3], 0.5, eta);
+        let s = scene(
+            vec![Part {
+                mesh,
+                material: subsurface(params),
+                emission: None,
+            }],
+            Some(Vec3::ONE),
+            Camera::new(eye, Vec3::ZERO, Vec3::Y, 50.0, 16, 16),
+            16,
+            8,
+        );
+        let (film, c, secs) = run(&s, IntegratorKind::RandomWalk, None);
+        println!("{name} η {eta} σa {sigma_a}: {c:?} in {secs:.2} s");
+        assert!(film
+            .pixels
+            .iter()
+            .all(|p| p.is_finite() && p.min_element() >= 0.0));
+        assert_eq!(c.nonfinite, 0);
+        assert!(
+            c.walks_escaped > 0,
+            "{name}: some walks must leave through the opening"
+        );
+        let (m, _) = mean_and_error(&film);
+        // energy is lost through the opening, never created
+        assert!(
+            m.min_element() > 0.1 && m.max_element() <= 1.05,
+            "{name}: {m}"
+        );
+    }
+}
+
+/// A closed sphere of a σa = 0 medium behind a Fresnel boundary (η = 1.3,
+/// g = 0.5) in a uniform environment: Fresnel reflection, refraction (with
+/// its 1/η² radiance scaling in and η² out) and total internal reflection
+/// lose nothing, so every pixel is 1 in expectation, and no walk escapes.
+#[test]
+fn closed_sphere_with_fresnel_boundary_is_invisible_in_a_furnace() {
+    let params = medium([2.0, 3.0, 4.0], [0.0; 3], 0.5, 1.3);
+    let ball = Part {
+        mesh: shapes::sphere(3),
+        material: subsurface(params),
+        emission: None,
+    };
+    let cam = Camera::new(Vec3::new(0.0, 0.0, 2.2), Vec3::ZERO, Vec3::Y, 40.0, 12, 12);
+    let (film, c, _) = run(
+        &scene(vec![ball], Some(Vec3::ONE), cam, 32, 16),
+        IntegratorKind::RandomWalk,
+        None,
+    );
+    let (m, e) = mean_and_error(&film);
+    println!("furnace sphere: {m} ± {e}, {c:?}");
+    assert_eq!((c.walks_capped, c.walks_escaped, c.nonfinite), (0, 0, 0));
+    for k in 0..3 {
+        assert!(
+            (m[k] - 1.0).abs() < 4.0 * e[k] + 1e-5,
+            "channel {k}: {} ± {}",
+            m[k],
+            e[k]
+        );
+    }
+}
