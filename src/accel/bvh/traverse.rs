@@ -181,6 +181,11 @@ pub(super) fn traverse<L>(
     if tree.is_empty() || !ray.hit1(&tree.bounds, tmin, *tmax) {
         return false;
     }
+    if is_leaf(tree.root) {
+        // A tree of one leaf: the top level of a one-mesh scene.
+        let (first, count) = leaf_range(tree.root);
+        return matches!(leaf(first, count, tmax), Visit::Stop);
+    }
     // Left uninitialized: zeroing 2 KiB per traversal (two per query) cost
     // ~4% of an incoherent ray. Only entries below `sp` are ever read.
     let mut stack: [MaybeUninit<(NodeRef, f32)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
