@@ -130,7 +130,7 @@ fn camera_above(res: u32) -> Camera {
 /// With σa = 0 and η = 1 nothing is absorbed and nothing reflects at the
 /// boundary, so every walk leaves the slab (top, bottom or side) into a
 /// uniform environment of radiance 1: each sample's expectation is exactly
-/// 1. The chromatic σs exercises the spectral MIS weights (one channel's
+/// one. The chromatic σs exercises the spectral MIS weights (one channel's
 /// distance, all channels' throughputs). Then the same slab with a
 /// black floor (reflectance R) and with an emitting floor under a black sky
 /// (transmittance T): R + T = 1, and forward scattering transmits more.

@@ -216,7 +216,7 @@ pub fn walk(
             // A real scattering event at distance t.
             let tr: [f64; 3] = std::array::from_fn(|k| (-sigma_t[k] * t).exp());
             let pdf: f64 = (0..3).map(|k| q[k] * sigma_t[k] * tr[k]).sum();
-            if !(pdf > 0.0) {
+            if pdf.is_nan() || pdf <= 0.0 {
                 return None;
             }
             for k in 0..3 {
@@ -228,7 +228,7 @@ pub fn walk(
             ray = Ray::new(p, d);
             if event >= WALK_RR_START {
                 let survive = beta.iter().copied().fold(0.0, f64::max).min(1.0);
-                if !(survive > 0.0) || rng.uniform_f64() >= survive {
+                if survive.is_nan() || survive <= 0.0 || rng.uniform_f64() >= survive {
                     return None;
                 }
                 beta = beta.map(|b| b / survive);
@@ -239,7 +239,7 @@ pub fn walk(
         // The flight reached the boundary: probability e^{−σt t} per channel.
         let tr: [f64; 3] = std::array::from_fn(|k| (-sigma_t[k] * t_max).exp());
         let pdf: f64 = (0..3).map(|k| q[k] * tr[k]).sum();
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         for k in 0..3 {
