@@ -445,8 +445,11 @@ pub(super) fn build(mut prims: Vec<PrimRef>, max_leaf: usize) -> Tree {
         return Tree::default();
     }
     let root = build_rec(&mut prims, 0, 0, max_leaf);
-    let mut nodes = Vec::with_capacity(prims.len() / 4 + 1);
-    let root_ref = collapse(&root, &mut nodes);
+    let mut tmp = Vec::with_capacity(prims.len() / 4 + 1);
+    let root_ref = collapse(&root, &mut tmp);
+    // Copied once more into an exactly sized, huge-page-backed array.
+    let mut nodes = super::mem::with_huge_pages(tmp.len());
+    nodes.extend_from_slice(&tmp);
     let bb = root.bounds();
     Tree {
         nodes,

@@ -14,6 +14,7 @@
 //! arithmetic.
 
 mod build;
+mod mem;
 mod traverse;
 pub mod triangle;
 
@@ -70,13 +71,10 @@ impl MeshBvh {
             })
             .collect();
         let tree = build::build(prims, MAX_LEAF);
-        let tris = tree
-            .order
-            .par_iter()
-            .map(|&id| Tri {
-                p: mesh.triangle(id),
-            })
-            .collect();
+        let mut tris = mem::with_huge_pages(tree.order.len());
+        tris.par_extend(tree.order.par_iter().map(|&id| Tri {
+            p: mesh.triangle(id),
+        }));
         MeshBvh { tree, tris }
     }
 }
