@@ -32,6 +32,10 @@
 //! does). Choosing by throughput never spends samples on a channel that can
 //! no longer contribute, and keeps every weight bounded by 1/q_c.
 //!
+//! The material's diffusion-only options (probe sampling, the exit lobe
+//! `exit_sw`, the `specular` coat) do not apply here: the boundary is always
+//! the full Fresnel interface, which is what those options approximate.
+//!
 //! Next-event estimation through the boundary is not attempted: light
 //! reaches the medium only by the walk leaving it and the path finding the
 //! light, which is exact but noisy for small lights. Inside, Russian
