@@ -10,6 +10,8 @@ use lucent::scene::{load, SceneError};
 
 const CAM: &str = "[camera]\nlook_from = [0, 1, 5]\nlook_at = [0, 1, 0]\nresolution = [32, 32]\n";
 const MAT: &str = "[materials.white]\ntype = \"diffuse\"\nalbedo = [0.8, 0.8, 0.8]\n";
+/// The header of a subsurface material; each case adds its keys.
+const SSS: &str = "[materials.skin]\ntype = \"subsurface\"\n";
 
 /// Which file the error must name.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -171,7 +173,7 @@ fn cases() -> Vec<Case> {
         case(
             "unknown material type",
             format!("{CAM}[materials.chrome]\ntype = \"metal\"\n"),
-            "unknown variant `metal`, expected `diffuse` or `dielectric`",
+            "unknown variant `metal`, expected one of `diffuse`, `dielectric`, `subsurface`",
             Some("metal"),
             Some("materials.chrome.type"),
         ),
@@ -216,6 +218,154 @@ fn cases() -> Vec<Case> {
             "does not apply to type \"diffuse\"",
             Some("eta"),
             Some("materials.red.eta"),
+        ),
+        // --- subsurface materials
+        case(
+            "subsurface unknown preset",
+            format!("{CAM}{SSS}preset = \"jade\"\n"),
+            "unknown material \"jade\" (known: Apple,",
+            Some("jade"),
+            Some("materials.skin.preset"),
+        ),
+        case(
+            "subsurface preset mixed with artist form",
+            format!("{CAM}{SSS}preset = \"marble\"\ndmfp = [1, 1, 1]\n"),
+            "`preset` cannot be combined with `dmfp`",
+            Some("dmfp"),
+            Some("materials.skin.dmfp"),
+        ),
+        case(
+            "subsurface measured mixed with artist form",
+            format!("{CAM}{SSS}sigma_s_prime = [1, 1, 1]\nsigma_a = [0.1, 0.1, 0.1]\nalbedo = [0.5, 0.5, 0.5]\ndmfp = [1, 1, 1]\n"),
+            "`sigma_s_prime` cannot be combined with `dmfp`",
+            Some("dmfp"),
+            Some("materials.skin.dmfp"),
+        ),
+        case(
+            "subsurface sigma_a without sigma_s_prime",
+            format!("{CAM}{SSS}sigma_a = [0.1, 0.1, 0.1]\nalbedo = [0.5, 0.5, 0.5]\n"),
+            "missing field `sigma_s_prime`",
+            Some("[materials.skin]"),
+            Some("materials.skin.sigma_s_prime"),
+        ),
+        case(
+            "subsurface measured without albedo",
+            format!("{CAM}{SSS}sigma_s_prime = [1, 1, 1]\nsigma_a = [0.1, 0.1, 0.1]\n"),
+            "missing field `albedo`",
+            Some("[materials.skin]"),
+            Some("materials.skin.albedo"),
+        ),
+        case(
+            "subsurface no parameters",
+            format!("{CAM}{SSS}eta = 1.4\n"),
+            "give exactly one of",
+            Some("[materials.skin]"),
+            Some("materials.skin"),
+        ),
+        case(
+            "subsurface albedo above 1",
+            format!("{CAM}{SSS}albedo = [1.2, 0.5, 0.5]\ndmfp = [1, 1, 1]\n"),
+            "albedo.r: 1.2 must be in [0, 1]",
+            Some("albedo"),
+            Some("materials.skin.albedo"),
+        ),
+        case(
+            "subsurface negative dmfp",
+            format!("{CAM}{SSS}albedo = [0.5, 0.5, 0.5]\ndmfp = [1, -1, 1]\n"),
+            "dmfp.g: -1 must be finite and non-negative",
+            Some("dmfp"),
+            Some("materials.skin.dmfp"),
+        ),
+        case(
+            "subsurface negative sigma_s_prime",
+            format!("{CAM}{SSS}sigma_s_prime = [1, 1, -2]\nsigma_a = [0.1, 0.1, 0.1]\nalbedo = [0.5, 0.5, 0.5]\n"),
+            "sigma_s_prime.b: -2 must be finite and non-negative",
+            Some("sigma_s_prime"),
+            Some("materials.skin.sigma_s_prime"),
+        ),
+        case(
+            "subsurface no medium",
+            format!("{CAM}{SSS}sigma_s_prime = [1, 0, 1]\nsigma_a = [0.1, 0, 0.1]\nalbedo = [0.5, 0.5, 0.5]\n"),
+            "both zero, there is no medium",
+            Some("sigma_s_prime"),
+            Some("materials.skin.sigma_s_prime"),
+        ),
+        case(
+            "subsurface g = 1",
+            format!("{CAM}{SSS}sigma_s_prime = [1, 1, 1]\nsigma_a = [0.1, 0.1, 0.1]\nalbedo = [0.5, 0.5, 0.5]\ng = 1.0\n"),
+            "g: 1 must be in (-1, 1)",
+            Some("g = "),
+            Some("materials.skin.g"),
+        ),
+        case(
+            "subsurface g on a preset",
+            format!("{CAM}{SSS}preset = \"skin1\"\ng = 0.8\n"),
+            "`preset` cannot be combined with `g`",
+            Some("g = "),
+            Some("materials.skin.g"),
+        ),
+        case(
+            "subsurface rmax_quantile 1",
+            format!("{CAM}{SSS}preset = \"skin1\"\nrmax_quantile = 1.0\n"),
+            "expected a number in (0, 1), found 1",
+            Some("rmax_quantile"),
+            Some("materials.skin.rmax_quantile"),
+        ),
+        case(
+            "subsurface rmax_quantile 0",
+            format!("{CAM}{SSS}preset = \"skin1\"\nrmax_quantile = 0\n"),
+            "expected a number in (0, 1), found 0",
+            Some("rmax_quantile"),
+            Some("materials.skin.rmax_quantile"),
+        ),
+        case(
+            "subsurface unknown radius sampler",
+            format!("{CAM}{SSS}preset = \"skin1\"\nradius = \"gauss\"\n"),
+            "unknown sampler \"gauss\" (expected uniform, table[:N], table-uniform[:N], analytic or mixture)",
+            Some("gauss"),
+            Some("materials.skin.radius"),
+        ),
+        case(
+            "subsurface table size 0",
+            format!("{CAM}{SSS}preset = \"skin1\"\nradius = \"table:0\"\n"),
+            "table size 0 must be in [2, 16777216]",
+            Some("table:0"),
+            Some("materials.skin.radius"),
+        ),
+        case(
+            "subsurface table size not a number",
+            format!("{CAM}{SSS}preset = \"skin1\"\nradius = \"table:many\"\n"),
+            "bad table size \"many\"",
+            Some("table:many"),
+            Some("materials.skin.radius"),
+        ),
+        case(
+            "subsurface bad axes",
+            format!("{CAM}{SSS}preset = \"skin1\"\naxes = \"tangent\"\n"),
+            "expected \"normal\" or \"mis3\", found \"tangent\"",
+            Some("tangent"),
+            Some("materials.skin.axes"),
+        ),
+        case(
+            "subsurface bad channel",
+            format!("{CAM}{SSS}preset = \"skin1\"\nchannel = \"all\"\n"),
+            "expected \"single\" or \"mis\", found \"all\"",
+            Some("all"),
+            Some("materials.skin.channel"),
+        ),
+        case(
+            "subsurface unknown fit",
+            format!("{CAM}{SSS}preset = \"skin1\"\nfit = \"dipole\"\n"),
+            "unknown fit \"dipole\"",
+            Some("dipole"),
+            Some("materials.skin.fit"),
+        ),
+        case(
+            "subsurface renormalize not a boolean",
+            format!("{CAM}{SSS}preset = \"skin1\"\nrenormalize = \"yes\"\n"),
+            "expected a boolean",
+            Some("renormalize"),
+            Some("materials.skin.renormalize"),
         ),
         // --- shapes
         case(

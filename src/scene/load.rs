@@ -395,8 +395,14 @@ fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32)
     let d = m.get_ref();
     let f = |k: &str| format!("{field}.{k}");
     let units = units_per_mm as f64;
-    // Errors from the bssrdf module start with the offending key.
-    let param_err = |msg: String| {
+    // Errors from the bssrdf module start with the offending key, named as
+    // there: `sigma_s` for the σs' given here, `mfp` for `dmfp`.
+    let param_err = |mut msg: String| {
+        for (from, to) in [("sigma_s.", "sigma_s_prime."), ("mfp.", "dmfp.")] {
+            if let Some(rest) = msg.strip_prefix(from) {
+                msg = format!("{to}{rest}");
+            }
+        }
         let key = msg
             .split([':', '.'])
             .next()
@@ -423,8 +429,8 @@ fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32)
     let triple = |v: &Option<Spanned<[f64; 3]>>, k: &str| -> Res<Option<[f64; 3]>> {
         v.as_ref()
             .map(|t| {
-                cx.vec3(t, &f(k))
-                    .map(|v| [v.x as f64, v.y as f64, v.z as f64])
+                // checked as f32, kept as written (no 1.2000000476837158)
+                cx.vec3(t, &f(k)).map(|_| *t.get_ref())
             })
             .transpose()
     };
@@ -436,6 +442,30 @@ fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32)
     );
     let forms =
         "give exactly one of: `preset`; `sigma_s_prime` + `sigma_a` + `albedo`; `albedo` + `dmfp`";
+    // Keys of two forms: name the first key of each, at the later one's line
+    // (`albedo` belongs to the measured and the artist form).
+    let present = d.present_keys();
+    let span_of = |k: &str| {
+        present
+            .iter()
+            .find(|(p, _)| *p == k)
+            .map(|(_, s)| s.clone())
+    };
+    let groups: [&[&str]; 3] = [
+        &["preset"],
+        &["sigma_s_prime", "sigma_a", "g"],
+        &["dmfp", "albedo"],
+    ];
+    let firsts: Vec<&str> = groups
+        .iter()
+        .filter_map(|g| g.iter().copied().find(|k| span_of(k).is_some()))
+        .collect();
+    if let [a, b, ..] = firsts[..] {
+        if a == "preset" || b == "dmfp" {
+            let msg = format!("`{a}` cannot be combined with `{b}`; {forms}");
+            return Err(cx.err(span_of(b).unwrap_or(m.span()), &f(b), msg));
+        }
+    }
     let params = match (text(&d.preset), sigma_s.or(sigma_a), dmfp) {
         (Some((name, span)), None, None) if albedo.is_none() && d.g.is_none() => {
             let mut p = SubsurfaceParams::from_preset(name, units, fit)
@@ -447,10 +477,15 @@ fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32)
         }
         (None, Some(_), None) => {
             let (Some(ss), Some(sa)) = (sigma_s, sigma_a) else {
+                let missing = if sigma_s.is_none() {
+                    "sigma_s_prime"
+                } else {
+                    "sigma_a"
+                };
                 return Err(cx.err(
                     m.span(),
-                    &f("sigma_a"),
-                    format!("`sigma_s_prime` and `sigma_a` go together; {forms}"),
+                    &f(missing),
+                    format!("missing field `{missing}`: measured parameters need `sigma_s_prime`, `sigma_a` and `albedo`"),
                 ));
             };
             let Some(albedo) = albedo else {
@@ -460,11 +495,32 @@ fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32)
                     format!("missing field `albedo` for measured parameters; {forms}"),
                 ));
             };
-            let g =
-                d.g.as_ref()
-                    .map(|g| cx.scalar(g, &f("g")))
-                    .transpose()?
-                    .unwrap_or(0.0) as f64;
+            // g is checked here, before σs = σs'/(1 − g) below (g = 1 would
+            // make that infinite), and so is σs' as written.
+            let g = match &d.g {
+                Some(gs) => {
+                    let g = *gs.get_ref();
+                    if !(g > -1.0 && g < 1.0) {
+                        return Err(cx.err(
+                            gs.span(),
+                            &f("g"),
+                            format!("g: {g} must be in (-1, 1)"),
+                        ));
+                    }
+                    g
+                }
+                None => 0.0,
+            };
+            if let Some((c, x)) = ss
+                .iter()
+                .enumerate()
+                .find(|(_, x)| !x.is_finite() || **x < 0.0)
+            {
+                let ch = ["r", "g", "b"][c];
+                return Err(param_err(format!(
+                    "sigma_s.{ch}: {x} must be finite and non-negative"
+                )));
+            }
             // σs' is given: σs = σs' / (1 − g) so that the loader's σs(1 − g) is σs' again.
             let sigma_s = ss.map(|x| x / (1.0 - g));
             let measured = Measured {
@@ -492,7 +548,13 @@ fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32)
 
     let mut opts = ProbeOptions::default();
     if let Some((s, span)) = text(&d.radius) {
-        opts.radius = RadiusSampler::parse(s).map_err(|e| cx.err(span, &f("radius"), e))?;
+        opts.radius = RadiusSampler::parse(s).map_err(|e| {
+            // the bssrdf module's name for this key is `radius_sampler`
+            let e = e
+                .replacen("radius_sampler.table_size: ", "table size ", 1)
+                .replacen("radius_sampler: ", "", 1);
+            cx.err(span, &f("radius"), e)
+        })?;
     }
     if let Some(q) = &d.rmax_quantile {
         let v = cx.scalar(q, &f("rmax_quantile"))? as f64;
