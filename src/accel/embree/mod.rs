@@ -39,7 +39,7 @@ pub fn live_objects() -> (usize, usize) {
 pub fn version() -> String {
     static VERSION: OnceLock<String> = OnceLock::new();
     VERSION
-        .get_or_init(|| match Device::new(1) {
+        .get_or_init(|| match Device::new(Some(1)) {
             Ok(d) => {
                 let p = |prop| d.property(prop);
                 format!(
@@ -113,9 +113,14 @@ struct Device {
 
 impl Device {
     /// A device whose builds use at most `threads` threads (Embree's own
-    /// TBB pool, which does not know about rayon).
-    fn new(threads: usize) -> Result<Device, String> {
-        let config = CString::new(format!("threads={}", threads.max(1))).expect("no NUL");
+    /// TBB pool, which does not know about rayon); `None`: Embree's
+    /// default, all hardware threads.
+    fn new(threads: Option<usize>) -> Result<Device, String> {
+        let config = match threads {
+            Some(n) => format!("threads={}", n.max(1)),
+            None => String::new(),
+        };
+        let config = CString::new(config).expect("no NUL");
         // SAFETY: `config` is a NUL-terminated string alive for the call.
         let raw = unsafe { ffi::rtcNewDevice(config.as_ptr()) };
         if raw.is_null() {
@@ -221,7 +226,7 @@ unsafe impl Sync for EmbreeAccel {}
 
 impl EmbreeAccel {
     /// Builds and commits an Embree scene over `meshes`, sharing their
-    /// buffers, with `rayon::current_num_threads()` build threads. Fails (without leaking) if Embree reports any error or if a
+    /// buffers; called inside a rayon pool, the build uses that many threads. Fails (without leaking) if Embree reports any error or if a
     /// mesh cannot be shared safely (index out of range, too many elements).
     pub fn build(meshes: &Arc<Vec<Mesh>>) -> Result<EmbreeAccel, String> {
         if meshes.len() >= ffi::RTC_INVALID_GEOMETRY_ID as usize {
@@ -247,10 +252,12 @@ impl EmbreeAccel {
             }
         }
 
-        // Build with as many threads as the rayon pool we are called from
-        // (all cores by default; one inside a one-thread pool), so
-        // `--threads` and the benchmarks' pools bound Embree's build too.
-        let device = Device::new(rayon::current_num_threads())?;
+        // Inside a rayon pool, build with as many threads as it has (so a
+        // one-thread pool means a one-thread build, as for our BVH). Outside
+        // any pool, Embree's default (all cores): asking rayon there would
+        // start its global pool as a side effect.
+        let threads = rayon::current_thread_index().map(|_| rayon::current_num_threads());
+        let device = Device::new(threads)?;
         if device.property(ffi::RTC_DEVICE_PROPERTY_TRIANGLE_GEOMETRY_SUPPORTED) == 0
             || device.property(ffi::RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0
         {
