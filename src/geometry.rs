@@ -117,6 +117,24 @@ impl Mesh {
             t.swap(1, 2);
         }
     }
+    /// Sets per-vertex normals to the area-weighted average of the normals
+    /// of the triangles around each vertex (the cross product's length is
+    /// twice the area, so summing unnormalized cross products weights by
+    /// area). Vertices of only degenerate triangles get +z.
+    pub fn compute_smooth_normals(&mut self) {
+        let mut n = vec![Vec3::ZERO; self.vertex_count()];
+        for &[a, b, c] in &self.indices {
+            let p = &self.positions;
+            let face = (p[b as usize] - p[a as usize]).cross(p[c as usize] - p[a as usize]);
+            if face.is_finite() {
+                for i in [a, b, c] {
+                    n[i as usize] += face;
+                }
+            }
+        }
+        self.normals = Some(n.into_iter().map(|v| v.try_normalize().unwrap_or(Vec3::Z)).collect());
+    }
+
     pub fn area(&self, prim: u32) -> f32 {
         let [a, b, c] = self.triangle(prim);
         0.5 * (b - a).cross(c - a).length()
@@ -154,5 +172,21 @@ mod tests {
         assert_eq!(m.vertex_count(), 3);
         assert_eq!(m.padded_positions().len(), 4);
         assert!((m.area(0) - 0.5).abs() < 1e-7);
+    }
+
+    #[test]
+    fn smooth_normals_average_adjacent_faces_by_area() {
+        // two triangles folded along the x axis: one in the xy plane (area
+        // 1/2, normal +z), one in the xz plane (area 1, normal +y)
+        let mut m = Mesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(0.0, 0.0, 2.0)],
+            vec![[0, 1, 2], [0, 3, 1]],
+            None,
+        );
+        m.compute_smooth_normals();
+        let n = m.normals.unwrap();
+        assert!(n[2].abs_diff_eq(Vec3::Z, 1e-6));
+        assert!(n[3].abs_diff_eq(Vec3::Y, 1e-6));
+        assert!(n[0].abs_diff_eq(Vec3::new(0.0, 2.0, 1.0).normalize(), 1e-6));
     }
 }

@@ -180,6 +180,9 @@ pub struct ShapeDef {
     pub name: Option<String>,
     /// `obj`: path of the OBJ file, relative to the scene file's directory.
     pub file: Option<Spanned<String>>,
+    /// `obj`: compute smooth (area-weighted) vertex normals when the file
+    /// has none.
+    pub smooth: Option<Spanned<bool>>,
     /// `sphere`: icosphere subdivision level.
     pub subdivisions: Option<Spanned<u32>>,
     pub material: Spanned<String>,
@@ -195,6 +198,9 @@ impl ShapeDef {
         let mut v = Vec::new();
         if let Some(x) = &self.file {
             v.push(("file", x.span()));
+        }
+        if let Some(x) = &self.smooth {
+            v.push(("smooth", x.span()));
         }
         if let Some(x) = &self.subdivisions {
             v.push(("subdivisions", x.span()));

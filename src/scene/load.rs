@@ -606,7 +606,7 @@ fn shape_mesh(cx: &Cx, dir: &Path, field: &str, s: &Spanned<ShapeDef>) -> Res<Me
     let d = s.get_ref();
     let kind = *d.kind.get_ref();
     let allowed: &[&str] = match kind {
-        ShapeKind::Obj => &["file"],
+        ShapeKind::Obj => &["file", "smooth"],
         ShapeKind::Sphere => &["subdivisions"],
         ShapeKind::Quad | ShapeKind::Box => &[],
     };
@@ -628,7 +628,11 @@ fn shape_mesh(cx: &Cx, dir: &Path, field: &str, s: &Spanned<ShapeDef>) -> Res<Me
                     format!("cannot read OBJ file {}: {e}", path.display()),
                 )
             })?;
-            load_obj(&text, &path)
+            let mut mesh = load_obj(&text, &path)?;
+            if d.smooth.as_ref().is_some_and(|b| *b.get_ref()) && mesh.normals.is_none() {
+                mesh.compute_smooth_normals();
+            }
+            Ok(mesh)
         }
         ShapeKind::Sphere => {
             let level = match &d.subdivisions {
