@@ -9,7 +9,9 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::{
+    criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
+};
 use lucent::accel::{self, Accel, Backend};
 use lucent::geometry::{Mesh, Ray, Vec3};
 use lucent::scene::shapes;
@@ -84,19 +86,29 @@ mod helpers {
         g.finish();
     }
 
-    /// Build time of `backend` over `meshes` with 1 and 2 threads.
+    /// Build time of `backend` over `meshes`: with 1 and 2 rayon threads
+    /// for our BVH; once for Embree, which builds on its own TBB threads
+    /// whatever the rayon pool. Flat sampling runs each build exactly once
+    /// per sample, which keeps the 1.3M-triangle builds to about ten each.
     pub fn build_time(c: &mut Criterion, meshes: &Arc<Vec<Mesh>>, backend: Backend) {
         let mut g = c.benchmark_group("build_1.3M");
         g.sample_size(10)
-            .warm_up_time(Duration::from_millis(500))
-            .measurement_time(Duration::from_secs(8));
-        for threads in [1, 2] {
-            let p = pool(threads);
-            g.bench_with_input(
-                BenchmarkId::new(backend.name(), format!("{threads}t")),
-                &threads,
-                |b, _| b.iter(|| p.install(|| accel::build(meshes, backend).unwrap())),
-            );
+            .sampling_mode(SamplingMode::Flat)
+            .warm_up_time(Duration::from_millis(100))
+            .measurement_time(Duration::from_secs(5));
+        let threads: &[usize] = match backend {
+            Backend::Bvh => &[1, 2],
+            Backend::Embree => &[2],
+        };
+        for &t in threads {
+            let p = pool(t);
+            let id = match backend {
+                Backend::Bvh => format!("{t}t"),
+                Backend::Embree => "own-threads".to_string(),
+            };
+            g.bench_with_input(BenchmarkId::new(backend.name(), id), &t, |b, _| {
+                b.iter(|| p.install(|| accel::build(meshes, backend).unwrap()))
+            });
         }
         g.finish();
     }
