@@ -1,7 +1,8 @@
 //! Our own BVH: the reference [`Accel`] backend.
 //!
-//! Two levels: one binned-SAH hierarchy per mesh ([`build`]) and a small
-//! top-level hierarchy over the meshes' bounds. Nearest-hit and occlusion
+//! Two levels: one binned-SAH hierarchy per mesh, collapsed to 8-wide
+//! nodes ([`build`]), and a small top-level hierarchy over the meshes'
+//! bounds. Nearest-hit and occlusion
 //! queries walk the top level and descend into the meshes whose boxes the
 //! ray meets; [`Accel::hits_on_segment`] asks about one mesh and so walks
 //! only that mesh's tree. Triangles are tested with the watertight test of
@@ -45,9 +46,10 @@ struct MeshBvh {
 }
 
 /// Whether a triangle can ever be hit by [`RayTri::intersect`]: finite
-/// coordinates and non-zero area. The area test is done in f64, where the
-/// cross product of f32 edge vectors is exact for all but extreme exponent
-/// ranges, so exactly collinear vertices are caught.
+/// coordinates and non-zero area. The area test is done in f64, where
+/// exactly collinear (or repeated) vertices of similar magnitude give an
+/// exactly zero cross product; `RayTri` alone would let rounding noise
+/// through for some collinear triangles.
 pub fn can_hit(p: [Vec3; 3]) -> bool {
     if !p.iter().all(|v| v.is_finite()) {
         return false;
