@@ -132,7 +132,11 @@ impl Mesh {
                 }
             }
         }
-        self.normals = Some(n.into_iter().map(|v| v.try_normalize().unwrap_or(Vec3::Z)).collect());
+        self.normals = Some(
+            n.into_iter()
+                .map(|v| v.try_normalize().unwrap_or(Vec3::Z))
+                .collect(),
+        );
     }
 
     pub fn area(&self, prim: u32) -> f32 {

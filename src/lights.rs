@@ -48,7 +48,11 @@ impl LightSet {
                 weights.push(mesh.area(p) as f64 * power);
             }
         }
-        LightSet { tris, dist: Distribution1D::new(&weights), first }
+        LightSet {
+            tris,
+            dist: Distribution1D::new(&weights),
+            first,
+        }
     }
 
     pub fn is_empty(&self) -> bool {

@@ -13,8 +13,8 @@ use rayon::prelude::*;
 use crate::accel::Accel;
 use crate::film::Film;
 use crate::geometry::Vec3;
-use crate::integrator::{Context, Counters, IntegratorKind};
 use crate::integrator::path::Scratch;
+use crate::integrator::{Context, Counters, IntegratorKind};
 use crate::sampling::Rng;
 use crate::scene::Scene;
 
@@ -37,7 +37,13 @@ pub struct RenderOptions {
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { spp: None, seed: None, threads: None, progress: false, integrator: IntegratorKind::Path }
+        RenderOptions {
+            spp: None,
+            seed: None,
+            threads: None,
+            progress: false,
+            integrator: IntegratorKind::Path,
+        }
     }
 }
 
@@ -71,7 +77,11 @@ impl RenderStats {
     }
 }
 
-pub fn render(scene: &Scene, accel: &dyn Accel, opts: &RenderOptions) -> Result<(Film, RenderStats), String> {
+pub fn render(
+    scene: &Scene,
+    accel: &dyn Accel,
+    opts: &RenderOptions,
+) -> Result<(Film, RenderStats), String> {
     let mut scene_settings = scene.settings;
     if let Some(s) = opts.spp {
         scene_settings.spp = s;
@@ -81,7 +91,10 @@ pub fn render(scene: &Scene, accel: &dyn Accel, opts: &RenderOptions) -> Result<
     }
     let scene_local;
     let scene = if scene_settings != scene.settings {
-        scene_local = Scene { settings: scene_settings, ..scene.clone() };
+        scene_local = Scene {
+            settings: scene_settings,
+            ..scene.clone()
+        };
         &scene_local
     } else {
         scene
@@ -93,15 +106,19 @@ pub fn render(scene: &Scene, accel: &dyn Accel, opts: &RenderOptions) -> Result<
     let threads = pool.current_num_threads();
     let ctx = Context::new(scene, accel);
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let tiles: Vec<(u32, u32)> =
-        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+        .collect();
 
     let bar = if opts.progress {
-        let b = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::stderr());
+        let b =
+            ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::stderr());
         b.set_style(
-            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} tiles, eta {eta}")
-                .unwrap()
-                .progress_chars("=> "),
+            ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {pos}/{len} tiles, eta {eta}",
+            )
+            .unwrap()
+            .progress_chars("=> "),
         );
         b
     } else {
@@ -131,12 +148,21 @@ pub fn render(scene: &Scene, accel: &dyn Accel, opts: &RenderOptions) -> Result<
             film.set(x0 + i as u32 % tw, y0 + i as u32 / tw, p);
         }
     }
-    let stats =
-        RenderStats { seconds, samples: w as u64 * h as u64 * scene.settings.spp as u64, threads, counters };
+    let stats = RenderStats {
+        seconds,
+        samples: w as u64 * h as u64 * scene.settings.spp as u64,
+        threads,
+        counters,
+    };
     Ok((film, stats))
 }
 
-fn render_tile(ctx: &Context, integrator: IntegratorKind, x0: u32, y0: u32) -> (Vec<Vec3>, Counters) {
+fn render_tile(
+    ctx: &Context,
+    integrator: IntegratorKind,
+    x0: u32,
+    y0: u32,
+) -> (Vec<Vec3>, Counters) {
     let scene = ctx.scene;
     let (w, h) = (scene.camera.width, scene.camera.height);
     let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
@@ -162,7 +188,11 @@ fn render_tile(ctx: &Context, integrator: IntegratorKind, x0: u32, y0: u32) -> (
                 }
             }
             let n = spp.max(1) as f64;
-            out.push(Vec3::new((sum[0] / n) as f32, (sum[1] / n) as f32, (sum[2] / n) as f32));
+            out.push(Vec3::new(
+                (sum[0] / n) as f32,
+                (sum[1] / n) as f32,
+                (sum[2] / n) as f32,
+            ));
         }
     }
     (out, counters)

@@ -18,12 +18,28 @@ fn backends() -> Vec<Backend> {
     b
 }
 
-fn scene_with(mesh: lucent::geometry::Mesh, material: Material, emission: Option<Vec3>, env: Option<Vec3>, camera: Camera, spp: u32, max_depth: u32) -> Scene {
+fn scene_with(
+    mesh: lucent::geometry::Mesh,
+    material: Material,
+    emission: Option<Vec3>,
+    env: Option<Vec3>,
+    camera: Camera,
+    spp: u32,
+    max_depth: u32,
+) -> Scene {
     Scene {
         camera,
-        settings: RenderSettings { spp, max_depth, seed: 7 },
+        settings: RenderSettings {
+            spp,
+            max_depth,
+            seed: 7,
+        },
         meshes: Arc::new(vec![mesh]),
-        objects: vec![Object { name: "s".into(), material: 0, emission }],
+        objects: vec![Object {
+            name: "s".into(),
+            material: 0,
+            emission,
+        }],
         materials: vec![material],
         environment: env,
         units_per_mm: 1.0,
@@ -38,7 +54,9 @@ fn faceted_sphere(level: u32) -> lucent::geometry::Mesh {
 
 fn render_with(scene: &Scene, backend: Backend) -> Film {
     let a = accel::build(&scene.meshes, backend).unwrap();
-    render(scene, a.as_ref(), &RenderOptions::default()).unwrap().0
+    render(scene, a.as_ref(), &RenderOptions::default())
+        .unwrap()
+        .0
 }
 
 /// A convex diffuse object under a constant environment L: a path bounces
@@ -51,7 +69,15 @@ fn convex_diffuse_sphere_in_constant_environment() {
     let cam = Camera::new(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 40.0, 48, 32);
     for backend in backends() {
         for rho in [Vec3::ONE, Vec3::new(0.2, 0.5, 0.9)] {
-            let scene = scene_with(faceted_sphere(3), Material::Diffuse { albedo: rho }, None, Some(env), cam.clone(), 4, 8);
+            let scene = scene_with(
+                faceted_sphere(3),
+                Material::Diffuse { albedo: rho },
+                None,
+                Some(env),
+                cam.clone(),
+                4,
+                8,
+            );
             let film = render_with(&scene, backend);
             let (mut on, mut off) = (0, 0);
             for p in &film.pixels {
@@ -62,11 +88,18 @@ fn convex_diffuse_sphere_in_constant_environment() {
                     on += 1;
                 } else {
                     let t = (p.x - env.x) / (rho.x * env.x - env.x + 1e-30);
-                    assert!(rho == Vec3::ONE || (0.0..=1.0).contains(&t), "{backend:?}: pixel {p} is no mix of L and ρL");
+                    assert!(
+                        rho == Vec3::ONE || (0.0..=1.0).contains(&t),
+                        "{backend:?}: pixel {p} is no mix of L and ρL"
+                    );
                 }
             }
             if rho == Vec3::ONE {
-                assert_eq!(off, film.pixels.len(), "{backend:?}: ρ = 1 must give exactly L everywhere");
+                assert_eq!(
+                    off,
+                    film.pixels.len(),
+                    "{backend:?}: ρ = 1 must give exactly L everywhere"
+                );
             } else {
                 assert!(on > 150 && off > 300, "{backend:?}: on {on} off {off}");
             }
@@ -86,7 +119,17 @@ fn closed_emissive_sphere_sums_the_neumann_series() {
         let mut mesh = faceted_sphere(2);
         mesh.flip_winding(); // front faces inward
         let cam = Camera::new(Vec3::ZERO, Vec3::new(0.3, 0.2, -1.0), Vec3::Y, 90.0, 32, 32);
-        let scene = scene_with(mesh, Material::Diffuse { albedo: Vec3::splat(rho) }, Some(le), None, cam, 16, 200);
+        let scene = scene_with(
+            mesh,
+            Material::Diffuse {
+                albedo: Vec3::splat(rho),
+            },
+            Some(le),
+            None,
+            cam,
+            16,
+            200,
+        );
         let film = render_with(&scene, backend);
         let n = film.pixels.len() as f64;
         for c in 0..3 {
@@ -95,8 +138,14 @@ fn closed_emissive_sphere_sums_the_neumann_series() {
             let var = vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
             let se = (var / n).sqrt();
             let expect = le[c] as f64 / (1.0 - rho as f64);
-            assert!((mean - expect).abs() < 4.0 * se + 1e-4 * expect, "{backend:?} ρ={rho} ch{c}: mean {mean} expected {expect} (se {se})");
-            assert!(se < 0.02 * expect, "test too noisy to mean anything: se {se}");
+            assert!(
+                (mean - expect).abs() < 4.0 * se + 1e-4 * expect,
+                "{backend:?} ρ={rho} ch{c}: mean {mean} expected {expect} (se {se})"
+            );
+            assert!(
+                se < 0.02 * expect,
+                "test too noisy to mean anything: se {se}"
+            );
         }
     }
 }
@@ -107,12 +156,55 @@ fn image_is_identical_for_any_thread_count() {
     let mut mesh = faceted_sphere(2);
     mesh.flip_winding();
     let cam = Camera::new(Vec3::ZERO, Vec3::new(0.3, 0.2, -1.0), Vec3::Y, 90.0, 37, 21);
-    let scene = scene_with(mesh, Material::Diffuse { albedo: Vec3::splat(0.7) }, Some(Vec3::ONE), None, cam, 3, 20);
+    let scene = scene_with(
+        mesh,
+        Material::Diffuse {
+            albedo: Vec3::splat(0.7),
+        },
+        Some(Vec3::ONE),
+        None,
+        cam,
+        3,
+        20,
+    );
     let a = accel::build(&scene.meshes, Backend::Bvh).unwrap();
-    let one = render(&scene, a.as_ref(), &RenderOptions { threads: Some(1), ..Default::default() }).unwrap().0;
-    let two = render(&scene, a.as_ref(), &RenderOptions { threads: Some(2), ..Default::default() }).unwrap().0;
-    let bits = |f: &Film| f.pixels.iter().flat_map(|p| p.to_array()).map(f32::to_bits).collect::<Vec<_>>();
+    let one = render(
+        &scene,
+        a.as_ref(),
+        &RenderOptions {
+            threads: Some(1),
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .0;
+    let two = render(
+        &scene,
+        a.as_ref(),
+        &RenderOptions {
+            threads: Some(2),
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .0;
+    let bits = |f: &Film| {
+        f.pixels
+            .iter()
+            .flat_map(|p| p.to_array())
+            .map(f32::to_bits)
+            .collect::<Vec<_>>()
+    };
     assert_eq!(bits(&one), bits(&two));
-    let other_seed = render(&scene, a.as_ref(), &RenderOptions { seed: Some(8), ..Default::default() }).unwrap().0;
+    let other_seed = render(
+        &scene,
+        a.as_ref(),
+        &RenderOptions {
+            seed: Some(8),
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .0;
     assert_ne!(bits(&one), bits(&other_seed));
 }

@@ -208,9 +208,21 @@ impl Medium {
     /// diffuse mean free path (or, with `volume_mfp`, volume mean free path
     /// 1/σt') is `mfp` (scene units), g = 0. See the module docs.
     pub fn from_reflectance(albedo: [f64; 3], mfp: [f64; 3], eta: f32, volume_mfp: bool) -> Medium {
-        let shortest = mfp.iter().copied().filter(|&l| l > 0.0).fold(f64::INFINITY, f64::min);
-        let dense = if shortest.is_finite() { ZERO_LENGTH_DENSITY / shortest } else { 1e9 };
-        let mut m = Medium { sigma_s: [0.0; 3], sigma_a: [0.0; 3], g: 0.0 };
+        let shortest = mfp
+            .iter()
+            .copied()
+            .filter(|&l| l > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        let dense = if shortest.is_finite() {
+            ZERO_LENGTH_DENSITY / shortest
+        } else {
+            1e9
+        };
+        let mut m = Medium {
+            sigma_s: [0.0; 3],
+            sigma_a: [0.0; 3],
+            g: 0.0,
+        };
         for c in 0..3 {
             if mfp[c] <= 0.0 {
                 m.sigma_a[c] = dense;
@@ -392,7 +404,12 @@ impl SubsurfaceParams {
     }
 
     fn checked(albedo: [f64; 3], d: [f64; 3], eta: f32, medium: Medium) -> Result<Self, String> {
-        let p = SubsurfaceParams { albedo, d, eta, medium: Some(medium) };
+        let p = SubsurfaceParams {
+            albedo,
+            d,
+            eta,
+            medium: Some(medium),
+        };
         p.validate()?;
         Ok(p)
     }

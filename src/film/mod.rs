@@ -21,7 +21,11 @@ pub struct Film {
 
 impl Film {
     pub fn new(width: u32, height: u32) -> Self {
-        Film { width, height, pixels: vec![Vec3::ZERO; width as usize * height as usize] }
+        Film {
+            width,
+            height,
+            pixels: vec![Vec3::ZERO; width as usize * height as usize],
+        }
     }
     pub fn get(&self, x: u32, y: u32) -> Vec3 {
         self.pixels[(y * self.width + x) as usize]
@@ -70,7 +74,8 @@ impl Film {
         }
         let img = image::RgbImage::from_raw(self.width, self.height, buf).ok_or("bad film size")?;
         atomic_write(path, |tmp| {
-            img.save_with_format(tmp, image::ImageFormat::Png).map_err(|e| e.to_string())
+            img.save_with_format(tmp, image::ImageFormat::Png)
+                .map_err(|e| e.to_string())
         })
     }
 }
@@ -78,7 +83,10 @@ impl Film {
 /// Runs `write` on a temporary path next to `path`, then renames it into
 /// place; on any failure the temporary file is removed and nothing appears
 /// under `path`.
-pub fn atomic_write(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
+pub fn atomic_write(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), String> {
     let tmp = temp_path(path);
     let result = write(&tmp).and_then(|()| fs::rename(&tmp, path).map_err(|e| e.to_string()));
     if result.is_err() {
@@ -88,7 +96,10 @@ pub fn atomic_write(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>
 }
 
 fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
@@ -115,8 +126,11 @@ mod tests {
         let img = image::open(&png).unwrap().to_rgb8();
         assert_eq!(img.dimensions(), (3, 2));
         assert_eq!(img.get_pixel(2, 1).0, [255, 188, 0]); // sRGB(0.5) = 0.7354
-        // no temporary files left behind
-        let names: Vec<_> = fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+                                                          // no temporary files left behind
+        let names: Vec<_> = fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
         assert_eq!(names.len(), 2, "{names:?}");
     }
 

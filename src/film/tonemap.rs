@@ -54,6 +54,9 @@ mod tests {
             assert!((0.0..=1.0).contains(&y) && y >= prev);
             prev = y;
         }
-        assert_eq!(ToneMap::Clamp.apply(Vec3::new(2.0, -1.0, 0.5)), Vec3::new(1.0, 0.0, 0.5));
+        assert_eq!(
+            ToneMap::Clamp.apply(Vec3::new(2.0, -1.0, 0.5)),
+            Vec3::new(1.0, 0.0, 0.5)
+        );
     }
 }

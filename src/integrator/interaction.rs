@@ -26,7 +26,11 @@ impl Interaction {
         let ng = (b - a).cross(c - a).normalize_or_zero();
         // Degenerate triangles never hit in either backend, but keep a valid
         // normal if one does.
-        let ng = if ng == Vec3::ZERO { -ray.d.normalize_or_zero() } else { ng };
+        let ng = if ng == Vec3::ZERO {
+            -ray.d.normalize_or_zero()
+        } else {
+            ng
+        };
         let ns = match &mesh.normals {
             Some(ns) => {
                 let [i0, i1, i2] = mesh.indices[hit.prim as usize];
@@ -42,12 +46,23 @@ impl Interaction {
             }
             None => ng,
         };
-        Interaction { p, ng, ns, front: ray.d.dot(ng) < 0.0, geom: hit.geom, prim: hit.prim }
+        Interaction {
+            p,
+            ng,
+            ns,
+            front: ray.d.dot(ng) < 0.0,
+            geom: hit.geom,
+            prim: hit.prim,
+        }
     }
 
     /// The shading frame oriented towards the side the ray came from.
     pub fn shading_frame_facing(&self, wo: Vec3) -> Frame {
-        let n = if wo.dot(self.ng) >= 0.0 { self.ns } else { -self.ns };
+        let n = if wo.dot(self.ng) >= 0.0 {
+            self.ns
+        } else {
+            -self.ns
+        };
         Frame::from_normal(n)
     }
 

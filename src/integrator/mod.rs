@@ -33,7 +33,11 @@ impl<'a> Context<'a> {
     pub fn new(scene: &'a Scene, accel: &'a dyn Accel) -> Self {
         let (lo, hi) = scene_bounds(scene);
         let extent = (hi - lo).max_element();
-        let extent = if extent.is_finite() && extent > 0.0 { extent } else { 1.0 };
+        let extent = if extent.is_finite() && extent > 0.0 {
+            extent
+        } else {
+            1.0
+        };
         Context {
             scene,
             accel,

@@ -17,9 +17,15 @@ pub struct Plan {
 impl Plan {
     pub fn new(scene: &Scene) -> Self {
         Plan {
-            area_lights: scene.objects.iter().any(|o| o.emission.is_some_and(|e| e.max_element() > 0.0)),
+            area_lights: scene
+                .objects
+                .iter()
+                .any(|o| o.emission.is_some_and(|e| e.max_element() > 0.0)),
             environment: scene.environment.is_some_and(|e| e.max_element() > 0.0),
-            subsurface: scene.objects.iter().any(|o| matches!(scene.materials[o.material], Material::Subsurface(_))),
+            subsurface: scene
+                .objects
+                .iter()
+                .any(|o| matches!(scene.materials[o.material], Material::Subsurface(_))),
         }
     }
 }
