@@ -616,6 +616,10 @@ fn probes_that_find_nothing_on_geometry_thinner_than_d() {
 /// the top sheet escapes to the environment, so the mean is at most A
 /// (+ 5 s.e.), and every pixel is under the Mis3 bound × the most distinct
 /// hits a segment of length 2·Rmax can have (2 triangles per sheet crossed).
+/// It is also more than A/2 (it converges to about A, the top sheet's
+/// share of the profile; s.e. ≈ 0.1 A): an estimator that did not multiply
+/// the picked hit by the segment's hit count (~100 sheets) would give about
+/// A/100.
 #[test]
 fn more_probe_hits_than_the_buffer_holds() {
     let (n_sheets, delta) = (2000usize, 0.01f32);
@@ -670,7 +674,7 @@ fn more_probe_hits_than_the_buffer_holds() {
         println!("stack of {n_sheets}, {backend:?}: mean {mean:.3?} ± {se:.3?}");
         for c in 0..3 {
             assert!(
-                mean[c] > 0.0 && mean[c] <= albedo[c] + 5.0 * se[c],
+                mean[c] > 0.5 * albedo[c] && mean[c] <= albedo[c] + 5.0 * se[c],
                 "{backend:?}: {mean:?} ± {se:?}"
             );
         }
