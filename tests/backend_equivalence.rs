@@ -668,21 +668,12 @@ mod embree_vs_bvh {
     #[test]
     fn stanford_bunny() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/meshes/bunny.obj");
-        let (name, mesh) = if path.is_file() {
-            ("bunny", load_obj(&path))
-        } else {
-            // Until scenes/meshes/bunny.obj is committed: a closed,
-            // non-convex stand-in of similar size.
-            println!("scenes/meshes/bunny.obj is missing; testing a displaced sphere instead");
-            (
-                "displaced_sphere(5)",
-                scaled(
-                    shapes::displaced_sphere(5, 0.15),
-                    4.0,
-                    Vec3::new(0.0, 4.8, 0.0),
-                ),
-            )
-        };
+        assert!(
+            path.is_file(),
+            "{} is missing: it is part of the repository",
+            path.display()
+        );
+        let (name, mesh) = ("bunny", load_obj(&path));
         assert!(mesh.triangle_count() > 3000);
         let lo = mesh
             .positions()
