@@ -13,3 +13,4 @@ pub mod materials;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod study;

@@ -86,6 +86,10 @@ enum Command {
     },
     /// Print the build's ray-query backends and versions.
     Info,
+    /// Measure error against time for every sampling choice of the
+    /// subsurface estimator: results.csv, plots and report.md in the output
+    /// directory (resumes from results.csv; see src/study/mod.rs).
+    Study(StudyArgs),
 }
 
 /// Subsurface sampling choices that override every subsurface material's
@@ -197,6 +201,7 @@ fn main() -> ExitCode {
                 quiet,
             )
         }
+        Command::Study(args) => run_study(args),
         Command::Info => {
             println!("{}", info());
             Ok(())
@@ -271,6 +276,88 @@ fn run_render(
             opts.spp.unwrap_or(scene.settings.spp),
             scene.triangle_count(),
             stats.summary(accel.name())
+        );
+    }
+    Ok(())
+}
+
+#[derive(clap::Args)]
+struct StudyArgs {
+    /// The scene description (TOML; needs a subsurface material).
+    scene: PathBuf,
+    /// Output directory (created; default: study-<scene name>).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Small images, few configurations, short ladders: under two minutes.
+    #[arg(long)]
+    quick: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Integrator of the reference render: diffusion | randomwalk.
+    #[arg(long, default_value = "diffusion", value_parser = parse_study_integrator)]
+    reference: lucent::integrator::IntegratorKind,
+    /// Samples per pixel of the reference (default 4096, quick 512).
+    #[arg(long)]
+    reference_spp: Option<u32>,
+    /// Largest sample count of the ladder 1, 2, 4, … (default 128, quick 16).
+    #[arg(long)]
+    max_spp: Option<u32>,
+    /// Image width in pixels, aspect kept (default 128, quick 48).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Base seed (default: the scene's).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Firefly threshold: pixels above K times the reference.
+    #[arg(long, default_value_t = 10.0)]
+    firefly_k: f64,
+    /// Only these axes (comma separated: radius, rmax, axes, channel,
+    /// renormalize, exit_sw, specular, backend, integrator); the baseline always runs.
+    #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
+    only: Vec<lucent::study::Axis>,
+    /// No progress bars.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, String> {
+    lucent::study::config::parse_integrator(s).ok_or_else(|| format!("expected diffusion or randomwalk, found \"{s}\""))
+}
+
+fn parse_study_axis(s: &str) -> Result<lucent::study::Axis, String> {
+    lucent::study::Axis::parse(s).ok_or_else(|| format!("unknown axis \"{s}\""))
+}
+
+fn run_study(a: StudyArgs) -> Result<(), Failure> {
+    use lucent::study::{self, StudyError};
+    let out = a.output.clone().unwrap_or_else(|| {
+        let stem = a.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        PathBuf::from(format!("study-{stem}"))
+    });
+    let mut s = study::Settings::new(&a.scene, out, a.quick);
+    s.threads = a.threads;
+    s.reference = a.reference;
+    s.reference_spp = a.reference_spp.unwrap_or(s.reference_spp);
+    s.max_spp = a.max_spp.unwrap_or(s.max_spp);
+    s.width = a.width.unwrap_or(s.width);
+    s.seed = a.seed;
+    s.firefly_k = a.firefly_k;
+    s.only = a.only;
+    s.progress = !a.quiet;
+    let o = study::run(&s).map_err(|e| match e {
+        StudyError::Input(m) => Failure::Input(m),
+        StudyError::Runtime(m) => Failure::Runtime(m),
+    })?;
+    if !a.quiet {
+        eprintln!(
+            "{}: {} configurations, {} rows ({} rendered now), reference {} at {} spp",
+            o.report.display(),
+            o.configs.len(),
+            o.rows.len(),
+            o.rendered_rows,
+            study::config::integrator_name(o.reference.integrator),
+            o.reference.spp
         );
     }
     Ok(())

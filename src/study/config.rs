@@ -1,0 +1,403 @@
+//! The configuration matrix of a study: a baseline and, for every sampling
+//! choice of the subsurface estimator, variations that change that one
+//! choice and nothing else (one axis at a time, not the cross product: the
+//! cross product of the axes below is thousands of renders, and the axes
+//! interact little enough that one-at-a-time answers "what does this choice
+//! cost and buy").
+//!
+//! A configuration is applied by rebuilding every subsurface material of
+//! the scene with the new options ([`apply`]); the ray-query backend and the
+//! integrator are chosen at render time.
+
+use std::sync::Arc;
+
+use crate::accel::Backend;
+use crate::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, RadiusSampler, TableSpacing};
+use crate::integrator::IntegratorKind;
+use crate::materials::{Material, Subsurface};
+use crate::scene::Scene;
+
+/// Which choice a configuration varies from the baseline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Axis {
+    Baseline,
+    Radius,
+    RmaxQuantile,
+    Axes,
+    Channel,
+    Renormalize,
+    ExitSw,
+    Specular,
+    Backend,
+    Integrator,
+}
+
+impl Axis {
+    pub const ALL: [Axis; 10] = [
+        Axis::Baseline,
+        Axis::Radius,
+        Axis::RmaxQuantile,
+        Axis::Axes,
+        Axis::Channel,
+        Axis::Renormalize,
+        Axis::ExitSw,
+        Axis::Specular,
+        Axis::Backend,
+        Axis::Integrator,
+    ];
+
+    /// The name used in configuration names and the CSV.
+    pub fn name(self) -> &'static str {
+        match self {
+            Axis::Baseline => "baseline",
+            Axis::Radius => "radius",
+            Axis::RmaxQuantile => "rmax",
+            Axis::Axes => "axes",
+            Axis::Channel => "channel",
+            Axis::Renormalize => "renormalize",
+            Axis::ExitSw => "exit_sw",
+            Axis::Specular => "specular",
+            Axis::Backend => "backend",
+            Axis::Integrator => "integrator",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Axis> {
+        Axis::ALL.into_iter().find(|a| a.name() == s)
+    }
+}
+
+/// Sampling choices for every subsurface material; `None` keeps the
+/// material's own setting.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Overrides {
+    pub radius: Option<RadiusSampler>,
+    pub rmax_quantile: Option<f64>,
+    pub axes: Option<ProbeAxes>,
+    pub channel: Option<ChannelStrategy>,
+    pub renormalize: Option<bool>,
+    pub exit_sw: Option<bool>,
+    pub specular: Option<bool>,
+}
+
+/// One row group of the study: what is rendered and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    /// Unique, stable name: "baseline" or "axis=value"; the CSV key.
+    pub name: String,
+    pub axis: Axis,
+    /// The varied value as text (the baseline's own value on the baseline).
+    pub value: String,
+    pub overrides: Overrides,
+    pub backend: Backend,
+    pub integrator: IntegratorKind,
+}
+
+/// "uniform", "table:N" (tail-spaced), "table-uniform:N", "analytic",
+/// "mixture": the names [`RadiusSampler::parse`] reads.
+pub fn radius_name(r: RadiusSampler) -> String {
+    match r {
+        RadiusSampler::Uniform => "uniform".into(),
+        RadiusSampler::Table {
+            size,
+            spacing: TableSpacing::Tail,
+        } => format!("table:{size}"),
+        RadiusSampler::Table {
+            size,
+            spacing: TableSpacing::Uniform,
+        } => format!("table-uniform:{size}"),
+        RadiusSampler::Analytic => "analytic".into(),
+        RadiusSampler::Mixture => "mixture".into(),
+    }
+}
+
+pub fn integrator_name(i: IntegratorKind) -> &'static str {
+    match i {
+        IntegratorKind::Path => "diffusion",
+        IntegratorKind::RandomWalk => "randomwalk",
+    }
+}
+
+pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
+    match s {
+        "diffusion" | "path" => Some(IntegratorKind::Path),
+        "randomwalk" | "random-walk" => Some(IntegratorKind::RandomWalk),
+        _ => None,
+    }
+}
+
+fn axes_name(a: ProbeAxes) -> &'static str {
+    match a {
+        ProbeAxes::Normal => "normal",
+        ProbeAxes::Mis3 => "mis3",
+    }
+}
+
+fn channel_name(c: ChannelStrategy) -> &'static str {
+    match c {
+        ChannelStrategy::Single => "single",
+        ChannelStrategy::Mis => "mis",
+    }
+}
+
+/// The baseline's probe options: the recommended defaults (exact analytic
+/// radius sampling, N/T/B probes with MIS, all channels per sample, Rmax at
+/// the 0.999 quantile, no renormalization).
+pub fn baseline_probe() -> ProbeOptions {
+    ProbeOptions::default()
+}
+
+/// The Rmax quantile of the diffusion reference: far enough out that the
+/// truncation of the configurations (0.999 by default) shows as bias.
+pub const REFERENCE_RMAX_QUANTILE: f64 = 0.99999;
+
+fn full_probe(o: ProbeOptions) -> Overrides {
+    Overrides {
+        radius: Some(o.radius),
+        rmax_quantile: Some(o.rmax_quantile),
+        axes: Some(o.axes),
+        channel: Some(o.channel),
+        renormalize: Some(o.renormalize),
+        exit_sw: None,
+        specular: None,
+    }
+}
+
+/// The overrides of the diffusion reference: the exact sampler, MIS axes
+/// and channels, Rmax at [`REFERENCE_RMAX_QUANTILE`]; Fresnel choices are
+/// the scene's (they change the model, not the estimator).
+pub fn reference_overrides() -> Overrides {
+    full_probe(ProbeOptions {
+        rmax_quantile: REFERENCE_RMAX_QUANTILE,
+        ..baseline_probe()
+    })
+}
+
+/// The first subsurface material's (exit_sw, specular): the scene's model
+/// choices, which the baseline keeps and the Fresnel axes flip.
+fn scene_fresnel(scene: &Scene) -> Option<(bool, bool)> {
+    scene.materials.iter().find_map(|m| match m {
+        Material::Subsurface(ss) => Some((ss.exit_sw, ss.specular)),
+        _ => None,
+    })
+}
+
+/// The configurations of a study of `scene`. `quick` keeps a few values per
+/// axis (enough for the ordering facts the tests check). `backends[0]` is
+/// the baseline's backend; each further one gets a backend row.
+pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Config>, String> {
+    let (exit_sw, specular) =
+        scene_fresnel(scene).ok_or("the scene has no subsurface material: nothing to study")?;
+    let base_probe = baseline_probe();
+    let base_backend = backends[0];
+    let mut base_ov = full_probe(base_probe);
+    base_ov.exit_sw = Some(exit_sw);
+    base_ov.specular = Some(specular);
+    let mut out = vec![Config {
+        name: "baseline".into(),
+        axis: Axis::Baseline,
+        value: String::new(),
+        overrides: base_ov,
+        backend: base_backend,
+        integrator: IntegratorKind::Path,
+    }];
+    let mut add =
+        |axis: Axis, value: String, ov: Overrides, backend: Backend, integrator: IntegratorKind| {
+            out.push(Config {
+                name: format!("{}={value}", axis.name()),
+                axis,
+                value,
+                overrides: ov,
+                backend,
+                integrator,
+            });
+        };
+    let tu = |size| RadiusSampler::Table {
+        size,
+        spacing: TableSpacing::Uniform,
+    };
+    let tt = |size| RadiusSampler::Table {
+        size,
+        spacing: TableSpacing::Tail,
+    };
+    let radii: Vec<RadiusSampler> = if quick {
+        vec![
+            RadiusSampler::Uniform,
+            tu(16),
+            tu(1024),
+            RadiusSampler::Mixture,
+        ]
+    } else {
+        vec![
+            RadiusSampler::Uniform,
+            tu(16),
+            tu(64),
+            tu(256),
+            tu(1024),
+            tt(16),
+            tt(256),
+            tt(1024),
+            RadiusSampler::Mixture,
+        ]
+    };
+    for r in radii {
+        add(
+            Axis::Radius,
+            radius_name(r),
+            Overrides {
+                radius: Some(r),
+                ..base_ov
+            },
+            base_backend,
+            IntegratorKind::Path,
+        );
+    }
+    let quantiles: &[f64] = if quick {
+        &[0.99]
+    } else {
+        &[0.9, 0.99, 0.997, 0.9999]
+    };
+    for &q in quantiles {
+        add(
+            Axis::RmaxQuantile,
+            format!("{q}"),
+            Overrides {
+                rmax_quantile: Some(q),
+                ..base_ov
+            },
+            base_backend,
+            IntegratorKind::Path,
+        );
+    }
+    let other_axes = match base_probe.axes {
+        ProbeAxes::Normal => ProbeAxes::Mis3,
+        ProbeAxes::Mis3 => ProbeAxes::Normal,
+    };
+    add(
+        Axis::Axes,
+        axes_name(other_axes).into(),
+        Overrides {
+            axes: Some(other_axes),
+            ..base_ov
+        },
+        base_backend,
+        IntegratorKind::Path,
+    );
+    let other_channel = match base_probe.channel {
+        ChannelStrategy::Single => ChannelStrategy::Mis,
+        ChannelStrategy::Mis => ChannelStrategy::Single,
+    };
+    add(
+        Axis::Channel,
+        channel_name(other_channel).into(),
+        Overrides {
+            channel: Some(other_channel),
+            ..base_ov
+        },
+        base_backend,
+        IntegratorKind::Path,
+    );
+    if !quick {
+        let r = !base_probe.renormalize;
+        add(
+            Axis::Renormalize,
+            r.to_string(),
+            Overrides {
+                renormalize: Some(r),
+                ..base_ov
+            },
+            base_backend,
+            IntegratorKind::Path,
+        );
+    }
+    add(
+        Axis::ExitSw,
+        (!exit_sw).to_string(),
+        Overrides {
+            exit_sw: Some(!exit_sw),
+            ..base_ov
+        },
+        base_backend,
+        IntegratorKind::Path,
+    );
+    if !quick {
+        add(
+            Axis::Specular,
+            (!specular).to_string(),
+            Overrides {
+                specular: Some(!specular),
+                ..base_ov
+            },
+            base_backend,
+            IntegratorKind::Path,
+        );
+    }
+    for &b in &backends[1..] {
+        add(
+            Axis::Backend,
+            b.name().into(),
+            base_ov,
+            b,
+            IntegratorKind::Path,
+        );
+    }
+    add(
+        Axis::Integrator,
+        integrator_name(IntegratorKind::RandomWalk).into(),
+        base_ov,
+        base_backend,
+        IntegratorKind::RandomWalk,
+    );
+    Ok(out)
+}
+
+/// `scene` with every subsurface material rebuilt with `ov` applied to its
+/// own options (its medium parameters unchanged).
+pub fn apply(scene: &Scene, ov: &Overrides) -> Result<Scene, String> {
+    let mut out = scene.clone();
+    for m in out.materials.iter_mut() {
+        if let Material::Subsurface(ss) = m {
+            let mut opts = *ss.probe.options();
+            opts.radius = ov.radius.unwrap_or(opts.radius);
+            opts.rmax_quantile = ov.rmax_quantile.unwrap_or(opts.rmax_quantile);
+            opts.axes = ov.axes.unwrap_or(opts.axes);
+            opts.channel = ov.channel.unwrap_or(opts.channel);
+            opts.renormalize = ov.renormalize.unwrap_or(opts.renormalize);
+            let new = Subsurface::new(
+                ss.params,
+                &opts,
+                ov.exit_sw.unwrap_or(ss.exit_sw),
+                ov.specular.unwrap_or(ss.specular),
+            )?;
+            *m = Material::Subsurface(Arc::new(new));
+        }
+    }
+    Ok(out)
+}
+
+/// A one-line description of overrides for the report.
+pub fn describe(ov: &Overrides) -> String {
+    let mut parts = Vec::new();
+    if let Some(r) = ov.radius {
+        parts.push(format!("radius {}", radius_name(r)));
+    }
+    if let Some(q) = ov.rmax_quantile {
+        parts.push(format!("Rmax quantile {q}"));
+    }
+    if let Some(a) = ov.axes {
+        parts.push(format!("axes {}", axes_name(a)));
+    }
+    if let Some(c) = ov.channel {
+        parts.push(format!("channel {}", channel_name(c)));
+    }
+    if let Some(r) = ov.renormalize {
+        parts.push(format!("renormalize {r}"));
+    }
+    if let Some(e) = ov.exit_sw {
+        parts.push(format!("exit_sw {e}"));
+    }
+    if let Some(s) = ov.specular {
+        parts.push(format!("specular {s}"));
+    }
+    parts.join(", ")
+}
