@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what lucent needs on Debian 12 and skips what is already there:
 # Embree 3 (Debian's libembree-dev, the production ray-query backend),
-# pkg-config (to find it) and a C compiler (for the FFI layout test).
+# pkg-config (to find it), a C compiler (for the FFI layout test) and the
+# DejaVu Sans font (text in `lucent study` plots, read by path).
 # Safe to run any number of times.
 set -euo pipefail
 
@@ -9,6 +10,7 @@ need=()
 dpkg -s libembree-dev >/dev/null 2>&1 || need+=(libembree-dev)
 command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
 command -v cc >/dev/null 2>&1 || need+=(gcc libc6-dev)
+[ -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || need+=(fonts-dejavu-core)
 
 if ((${#need[@]})); then
   sudo=""
