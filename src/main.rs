@@ -322,7 +322,8 @@ struct StudyArgs {
 }
 
 fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, String> {
-    lucent::study::config::parse_integrator(s).ok_or_else(|| format!("expected diffusion or randomwalk, found \"{s}\""))
+    lucent::study::config::parse_integrator(s)
+        .ok_or_else(|| format!("expected diffusion or randomwalk, found \"{s}\""))
 }
 
 fn parse_study_axis(s: &str) -> Result<lucent::study::Axis, String> {
@@ -332,7 +333,11 @@ fn parse_study_axis(s: &str) -> Result<lucent::study::Axis, String> {
 fn run_study(a: StudyArgs) -> Result<(), Failure> {
     use lucent::study::{self, StudyError};
     let out = a.output.clone().unwrap_or_else(|| {
-        let stem = a.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let stem = a
+            .scene
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         PathBuf::from(format!("study-{stem}"))
     });
     let mut s = study::Settings::new(&a.scene, out, a.quick);
