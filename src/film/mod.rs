@@ -34,15 +34,30 @@ impl Film {
         self.pixels[(y * self.width + x) as usize] = v;
     }
 
-    /// Writes a float (f32) RGBA OpenEXR, alpha = 1.
+    /// Writes a float (f32) RGBA OpenEXR, alpha = 1, ZIP-compressed scan
+    /// lines. Blocks are compressed and written sequentially in increasing
+    /// line order: the exr crate's parallel writer emits blocks in the order
+    /// they finish, which would make the file's bytes (not its pixels)
+    /// differ from run to run.
     pub fn write_exr(&self, path: &Path) -> Result<(), String> {
+        use exr::prelude::*;
         let w = self.width as usize;
+        let channels = SpecificChannels::rgba(|pos: Vec2<usize>| {
+            let p = self.pixels[pos.y() * w + pos.x()];
+            (p.x, p.y, p.z, 1.0f32)
+        });
+        let encoding = Encoding {
+            compression: Compression::ZIP16,
+            blocks: Blocks::ScanLines,
+            line_order: LineOrder::Increasing,
+        };
+        let image = Image::from_encoded_channels((w, self.height as usize), encoding, channels);
         atomic_write(path, |tmp| {
-            exr::prelude::write_rgba_file(tmp, w, self.height as usize, |x, y| {
-                let p = self.pixels[y * w + x];
-                (p.x, p.y, p.z, 1.0f32)
-            })
-            .map_err(|e| e.to_string())
+            image
+                .write()
+                .non_parallel()
+                .to_file(tmp)
+                .map_err(|e| e.to_string())
         })
     }
 

@@ -1,0 +1,167 @@
+//! The `lucent` command line end to end: render the Cornell box, check the
+//! outputs, determinism across thread counts at the file level, and `info`.
+
+use std::path::Path;
+use std::process::Command;
+
+fn lucent() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lucent"))
+}
+
+fn scene(name: &str) -> String {
+    format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn render(args: &[&str]) -> std::process::Output {
+    let out = lucent().arg("render").args(args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "lucent render {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+#[test]
+fn renders_the_cornell_box_end_to_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("cornell.exr");
+    let out = render(&[
+        &scene("cornell.toml"),
+        "-o",
+        exr.to_str().unwrap(),
+        "--spp",
+        "2",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // the closing summary: time, samples/s and rays/s
+    assert!(
+        stderr.contains(" s wall") && stderr.contains("Msamples/s") && stderr.contains("Mrays/s"),
+        "{stderr}"
+    );
+    let film = lucent::film::Film::read_exr(&exr).unwrap();
+    assert_eq!((film.width, film.height), (512, 512));
+    // lit, finite, and the light itself is the brightest thing in view
+    let mean: f32 = film
+        .pixels
+        .iter()
+        .map(|p| p.element_sum() / 3.0)
+        .sum::<f32>()
+        / film.pixels.len() as f32;
+    assert!(
+        mean > 0.05
+            && film
+                .pixels
+                .iter()
+                .all(|p| p.is_finite() && p.min_element() >= 0.0),
+        "mean {mean}"
+    );
+    let png = image::open(dir.path().join("cornell.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (512, 512));
+    // exactly the two outputs: no temporary files left behind
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["cornell.exr", "cornell.png"]);
+}
+
+#[test]
+fn exr_is_bitwise_identical_for_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("t1.exr");
+    let b = dir.path().join("t2.exr");
+    for (path, threads) in [(&a, "1"), (&b, "2")] {
+        render(&[
+            &scene("marble-bunny.toml"),
+            "-o",
+            path.to_str().unwrap(),
+            "--spp",
+            "1",
+            "--threads",
+            threads,
+            "--quiet",
+        ]);
+    }
+    let (fa, fb) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert!(fa.len() > 1000);
+    assert!(fa == fb, "EXRs differ between --threads 1 and --threads 2");
+    // and a different seed really changes the image
+    let c = dir.path().join("seed.exr");
+    render(&[
+        &scene("marble-bunny.toml"),
+        "-o",
+        c.to_str().unwrap(),
+        "--spp",
+        "1",
+        "--seed",
+        "9",
+        "--quiet",
+    ]);
+    assert!(std::fs::read(&c).unwrap() != fa);
+}
+
+#[test]
+fn bad_arguments_exit_2_without_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("x.exr");
+    for args in [
+        vec![
+            scene("cornell.toml"),
+            "-o".into(),
+            exr.to_str().unwrap().into(),
+            "--spp".into(),
+            "0".into(),
+        ],
+        vec![
+            scene("cornell.toml"),
+            "-o".into(),
+            dir.path().join("x.png").to_str().unwrap().into(),
+        ],
+        vec![
+            scene("cornell.toml"),
+            "-o".into(),
+            "/nonexistent-dir/x.exr".into(),
+        ],
+        vec![
+            scene("marble-bunny.toml"),
+            "-o".into(),
+            exr.to_str().unwrap().into(),
+            "--radius".into(),
+            "table:1".into(),
+        ],
+        vec![
+            scene("marble-bunny.toml"),
+            "-o".into(),
+            exr.to_str().unwrap().into(),
+            "--rmax-quantile".into(),
+            "1".into(),
+        ],
+    ] {
+        let out = lucent().arg("render").args(&args).output().unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn info_lists_the_backends() {
+    let out = lucent().arg("info").output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("backends: bvh"), "{text}");
+    if cfg!(lucent_embree) {
+        assert!(text.contains("embree (Embree 3."), "{text}");
+        assert!(text.contains("default backend: embree"), "{text}");
+    } else {
+        assert!(text.contains("built without Embree"), "{text}");
+    }
+    assert!(Path::new(env!("CARGO_BIN_EXE_lucent")).exists());
+}
