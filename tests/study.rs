@@ -265,6 +265,13 @@ fn resume_renders_only_missing_rows_and_extends_the_ladder() {
         assert!(r32.seconds > r16.seconds, "{c}");
         assert!(r32.rmse < r16.rmse, "{c}: {} vs {}", r32.rmse, r16.rmse);
     }
+    // Rows made under other settings are not mixed in.
+    let mut other = s.clone();
+    other.seed = Some(12345);
+    match study::run(&other) {
+        Err(study::StudyError::Input(m)) => assert!(m.contains("other settings"), "{m}"),
+        r => panic!("expected a settings mismatch, got {r:?}"),
+    }
     // The same 32-spp images from scratch: identical errors.
     let fresh = tempfile::tempdir().unwrap();
     let mut s2 = s.clone();

@@ -356,6 +356,51 @@ fn reference(
     Ok((film, info))
 }
 
+/// Rows in `results.csv` are only comparable (and only resumable) under the
+/// settings that made them: the same reference (which covers the scene,
+/// resolution and reference settings), base seed and firefly factor. They
+/// are recorded in `DIR/results.key` next to the CSV; a directory holding
+/// rows made under other settings is refused rather than mixed. Thread
+/// count, ladder length and the axis filter may change between runs.
+fn check_results_key(
+    s: &Settings,
+    r: &ReferenceInfo,
+    seed: u64,
+    scene: &Scene,
+) -> Result<(), StudyError> {
+    let key = format!(
+        "reference={:016x} seed={seed} firefly_k={} resolution={}x{}\n",
+        r.hash, s.firefly_k, scene.camera.width, scene.camera.height
+    );
+    let key_path = s.out_dir.join("results.key");
+    let csv = s.out_dir.join("results.csv");
+    let has_rows = fs::read_to_string(&csv)
+        .map(|t| t.lines().count() > 1)
+        .unwrap_or(false);
+    match fs::read_to_string(&key_path) {
+        Ok(old) if old == key => return Ok(()),
+        Ok(old) if has_rows => {
+            return Err(StudyError::Input(format!(
+                "{} holds results made with other settings ({}), not ({}); choose another output directory",
+                csv.display(),
+                old.trim(),
+                key.trim()
+            )))
+        }
+        Err(_) if has_rows => {
+            return Err(StudyError::Input(format!(
+                "{} has rows but no results.key: cannot tell which settings made them; choose another output directory",
+                csv.display()
+            )))
+        }
+        _ => {}
+    }
+    film::atomic_write(&key_path, |tmp| {
+        fs::write(tmp, &key).map_err(|e| e.to_string())
+    })
+    .map_err(runtime)
+}
+
 /// Runs (or resumes) a study; see the module docs.
 pub fn run(s: &Settings) -> Result<Outcome, StudyError> {
     validate(s)?;
@@ -396,6 +441,7 @@ pub fn run(s: &Settings) -> Result<Outcome, StudyError> {
         seed,
     )?;
 
+    check_results_key(s, &ref_info, seed, &scene)?;
     let mut results = Results::open(&s.out_dir.join("results.csv")).map_err(runtime)?;
     let spps = ladder(s.max_spp);
     let pending = configs
