@@ -4,6 +4,7 @@
 //! [`integrator`] (rendered in tiles by [`render`]) → [`film`] output.
 
 pub mod accel;
+pub mod bench;
 pub mod bssrdf;
 pub mod film;
 pub mod geometry;

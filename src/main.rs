@@ -84,6 +84,10 @@ enum Command {
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
     },
+    /// Benchmark the ray-query backends on the same meshes and rays: build
+    /// time and memory, Mrays/s of camera, incoherent, shadow and probe
+    /// rays; bench.csv, report.txt and plots in the output directory.
+    Bench(BenchArgs),
     /// Print the build's ray-query backends and versions.
     Info,
     /// Measure error against time for every sampling choice of the
@@ -202,6 +206,7 @@ fn main() -> ExitCode {
             )
         }
         Command::Study(args) => run_study(args),
+        Command::Bench(args) => run_bench(args),
         Command::Info => {
             println!("{}", info());
             Ok(())
@@ -363,6 +368,60 @@ fn run_study(a: StudyArgs) -> Result<(), Failure> {
             o.rendered_rows,
             study::config::integrator_name(o.reference.integrator),
             o.reference.spp
+        );
+    }
+    Ok(())
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Output directory for bench.csv, report.txt and the plots.
+    #[arg(short, long, default_value = "bench")]
+    output: PathBuf,
+    /// Sizes up to 80k triangles, 16k rays, short timing: under a minute.
+    #[arg(long)]
+    quick: bool,
+    /// Triangle counts, comma separated (1k, 16k, 1.3M; each becomes the
+    /// displaced sphere of 20·4^level triangles nearest to it).
+    #[arg(long, value_delimiter = ',', value_parser = lucent::bench::parse_size)]
+    sizes: Vec<usize>,
+    /// Thread counts, comma separated (default: 1 and all cores).
+    #[arg(long, value_delimiter = ',', value_parser = lucent::bench::parse_threads)]
+    threads: Vec<usize>,
+    /// Rays per query set (default 500000, quick 16384).
+    #[arg(long, value_parser = lucent::bench::parse_rays)]
+    rays: Option<usize>,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn run_bench(a: BenchArgs) -> Result<(), Failure> {
+    use lucent::bench::{self, BenchError};
+    let mut s = bench::Settings::new(&a.output, a.quick);
+    if !a.sizes.is_empty() {
+        s.sizes = a.sizes;
+    }
+    if !a.threads.is_empty() {
+        s.threads = a.threads;
+    }
+    s.rays = a.rays.unwrap_or(s.rays);
+    s.progress = !a.quiet;
+    let o = bench::run(&s).map_err(|e| match e {
+        BenchError::Input(m) => Failure::Input(m),
+        BenchError::Runtime(m) => Failure::Runtime(m),
+    })?;
+    print!("{}", o.report);
+    if !a.quiet {
+        eprintln!(
+            "{} rows in {}; plots: {}",
+            o.rows.len(),
+            o.csv.display(),
+            o.plots
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     Ok(())
