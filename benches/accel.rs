@@ -18,7 +18,6 @@ use lucent::scene::shapes;
 
 mod helpers {
     use super::*;
-    use lucent::sampling::{uniform_sphere, Rng};
     use rayon::prelude::*;
 
     /// Rays per criterion iteration.
@@ -26,22 +25,10 @@ mod helpers {
 
     /// Incoherent rays: origins uniform on the sphere of radius 3, each
     /// aimed at a uniform random point of the unit ball (so nearly all of
-    /// them hit the displaced unit sphere, at random places).
+    /// them hit the displaced unit sphere, at random places). The generator
+    /// is shared with `lucent bench` (`lucent::bench::rays`).
     pub fn incoherent_rays(n: usize, seed: u64) -> Vec<Ray> {
-        let mut rng = Rng::from_key(seed);
-        (0..n)
-            .map(|_| {
-                let o = uniform_sphere(rng.uniform2()) * 3.0;
-                let target = loop {
-                    let p =
-                        Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE;
-                    if p.length_squared() <= 1.0 {
-                        break p;
-                    }
-                };
-                Ray::new(o, (target - o).normalize())
-            })
-            .collect()
+        lucent::bench::rays::incoherent_rays(n, seed, Vec3::ZERO, 1.0)
     }
 
     pub fn pool(threads: usize) -> rayon::ThreadPool {

@@ -222,6 +222,26 @@ mod tests {
     }
 
     #[test]
+    fn unit_ball_rays_are_the_criterion_bench_sequence() {
+        // The generator benches/accel.rs used before it called this one.
+        let mut rng = Rng::from_key(1);
+        let old: Vec<Ray> = (0..200)
+            .map(|_| {
+                let o = uniform_sphere(rng.uniform2()) * 3.0;
+                let target = loop {
+                    let p =
+                        Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE;
+                    if p.length_squared() <= 1.0 {
+                        break p;
+                    }
+                };
+                Ray::new(o, (target - o).normalize())
+            })
+            .collect();
+        assert_eq!(incoherent_rays(200, 1, Vec3::ZERO, 1.0), old);
+    }
+
+    #[test]
     fn camera_rays_are_tiled_and_frame_the_sphere() {
         let m = shapes::sphere(3);
         let q = camera_rays(&m, 4096);
