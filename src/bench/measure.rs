@@ -221,11 +221,15 @@ mod tests {
 
     #[test]
     fn rss_grows_when_memory_is_touched() {
-        let before = rss_bytes().unwrap();
-        let v = vec![1u8; 64 << 20];
-        let v: Vec<u8> = v.iter().map(|x| x.wrapping_add(1)).collect();
-        let after = rss_bytes().unwrap();
-        assert!(after >= before + (32 << 20), "{before} -> {after}");
-        assert_eq!(v[12345], 2);
+        // Other tests of the process may free memory meanwhile: a few tries.
+        let grew = (0..3).any(|_| {
+            let before = rss_bytes().unwrap();
+            let v = vec![1u8; 64 << 20];
+            let w: Vec<u8> = v.iter().map(|x| x.wrapping_add(1)).collect();
+            let after = rss_bytes().unwrap();
+            assert_eq!(w[12345], 2);
+            after >= before + (32 << 20)
+        });
+        assert!(grew);
     }
 }
