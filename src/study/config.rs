@@ -9,12 +9,10 @@
 //! the scene with the new options ([`apply`]); the ray-query backend and the
 //! integrator are chosen at render time.
 
-use std::sync::Arc;
-
 use crate::accel::Backend;
 use crate::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, RadiusSampler, TableSpacing};
 use crate::integrator::IntegratorKind;
-use crate::materials::{Material, Subsurface};
+use crate::materials::Material;
 use crate::scene::Scene;
 
 /// Which choice a configuration varies from the baseline.
@@ -68,17 +66,8 @@ impl Axis {
 }
 
 /// Sampling choices for every subsurface material; `None` keeps the
-/// material's own setting.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Overrides {
-    pub radius: Option<RadiusSampler>,
-    pub rmax_quantile: Option<f64>,
-    pub axes: Option<ProbeAxes>,
-    pub channel: Option<ChannelStrategy>,
-    pub renormalize: Option<bool>,
-    pub exit_sw: Option<bool>,
-    pub specular: Option<bool>,
-}
+/// material's own setting (the same overrides `lucent render` takes).
+pub use crate::materials::SubsurfaceOverrides as Overrides;
 
 /// One row group of the study: what is rendered and how.
 #[derive(Clone, Debug, PartialEq)]
@@ -355,23 +344,7 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
 /// own options (its medium parameters unchanged).
 pub fn apply(scene: &Scene, ov: &Overrides) -> Result<Scene, String> {
     let mut out = scene.clone();
-    for m in out.materials.iter_mut() {
-        if let Material::Subsurface(ss) = m {
-            let mut opts = *ss.probe.options();
-            opts.radius = ov.radius.unwrap_or(opts.radius);
-            opts.rmax_quantile = ov.rmax_quantile.unwrap_or(opts.rmax_quantile);
-            opts.axes = ov.axes.unwrap_or(opts.axes);
-            opts.channel = ov.channel.unwrap_or(opts.channel);
-            opts.renormalize = ov.renormalize.unwrap_or(opts.renormalize);
-            let new = Subsurface::new(
-                ss.params,
-                &opts,
-                ov.exit_sw.unwrap_or(ss.exit_sw),
-                ov.specular.unwrap_or(ss.specular),
-            )?;
-            *m = Material::Subsurface(Arc::new(new));
-        }
-    }
+    ov.apply_all(&mut out.materials)?;
     Ok(out)
 }
 
