@@ -24,7 +24,7 @@ use crate::materials::{dielectric, diffuse, fresnel, Material, Subsurface};
 use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Rng};
 
 /// Bounces after which Russian roulette may end a path.
-pub(crate) const RR_START: u32 = 3;
+const RR_START: u32 = 3;
 
 /// Per-thread buffers the integrator reuses so the hot path never allocates.
 #[derive(Default)]
@@ -80,13 +80,52 @@ pub(crate) struct Vertex<'a> {
     pub(crate) lobe: Lobe<'a>,
 }
 
-/// The radiance arriving along `camera_ray`: one sample of L.
+/// What a subsurface hit turns into: a vertex that scatters light with a
+/// lobe (next-event estimation, then lobe sampling), a ray that continues
+/// without one (a specular bounce, or leaving a medium), or the end of the
+/// path. Both integrators share one bounce loop, [`trace`], and differ only
+/// in how they produce this.
+pub(crate) enum Scatter<'a> {
+    Vertex(Vertex<'a>),
+    Continue(Ray),
+    Absorbed,
+}
+
+/// The radiance arriving along `camera_ray`: one sample of L, with the
+/// BSSRDF estimated by one probe ray per subsurface hit.
 pub fn radiance(
     ctx: &Context,
     camera_ray: Ray,
     rng: &mut Rng,
     scratch: &mut Scratch,
     counters: &mut Counters,
+) -> Vec3 {
+    trace(
+        ctx,
+        camera_ray,
+        rng,
+        counters,
+        |ss, si, wo, beta, rng, counters| {
+            subsurface_probe(ctx, ss, si, wo, beta, rng, scratch, counters)
+        },
+    )
+}
+
+/// The bounce loop both integrators share; `subsurface` handles hits on
+/// subsurface objects (and may scale the throughput `beta`).
+pub(crate) fn trace<'s>(
+    ctx: &'s Context,
+    camera_ray: Ray,
+    rng: &mut Rng,
+    counters: &mut Counters,
+    mut subsurface: impl FnMut(
+        &'s Subsurface,
+        &Interaction,
+        Vec3,
+        &mut Vec3,
+        &mut Rng,
+        &mut Counters,
+    ) -> Scatter<'s>,
 ) -> Vec3 {
     let scene = ctx.scene;
     let mut l = Vec3::ZERO;
@@ -119,84 +158,37 @@ pub fn radiance(
             break;
         }
 
-        let vertex = match &scene.materials[object.material] {
+        let scatter = match &scene.materials[object.material] {
             Material::Diffuse { albedo } => {
                 let frame = si.shading_frame_facing(wo);
                 let ng = if wo.dot(si.ng) >= 0.0 { si.ng } else { -si.ng };
-                Vertex {
+                Scatter::Vertex(Vertex {
                     p: si.p,
                     ng,
                     wo_local: frame.to_local(wo),
                     frame,
                     lobe: Lobe::Diffuse(*albedo),
-                }
+                })
             }
             Material::Dielectric { eta } => {
                 let frame = Frame::from_normal(si.ng);
                 let s = dielectric::sample(*eta, frame.to_local(wo), rng.uniform());
                 beta *= s.weight;
+                Scatter::Continue(si.spawn(frame.to_world(s.wi), ctx.ray_epsilon))
+            }
+            Material::Subsurface(ss) => subsurface(ss, &si, wo, &mut beta, rng, counters),
+        };
+        let vertex = match scatter {
+            Scatter::Vertex(v) => v,
+            Scatter::Continue(next) => {
                 prev = None;
-                ray = si.spawn(frame.to_world(s.wi), ctx.ray_epsilon);
+                ray = next;
                 if !roulette(depth, &mut beta, rng) {
                     break;
                 }
                 continue;
             }
-            Material::Subsurface(ss) => {
-                // Boundary at xo: the normal facing the camera is "outside"
-                // (a mesh wound inside-out is read consistently the other way).
-                let n_out = if si.front { si.ng } else { -si.ng };
-                let fr = fresnel::dielectric(wo.dot(n_out).max(0.0), ss.eta());
-                if ss.specular && rng.uniform() < fr {
-                    // Specular reflection with probability Fr: weight 1. The
-                    // shading normal keeps highlights smooth on tessellated
-                    // meshes; where it would reflect below the surface the
-                    // geometric normal is used instead.
-                    let ns_out = if si.ns.dot(n_out) >= 0.0 {
-                        si.ns
-                    } else {
-                        -si.ns
-                    };
-                    let mut wi = (2.0 * wo.dot(ns_out)) * ns_out - wo;
-                    if wi.dot(n_out) <= 0.0 {
-                        wi = (2.0 * wo.dot(n_out)) * n_out - wo;
-                    }
-                    prev = None;
-                    ray = si.spawn(wi, ctx.ray_epsilon);
-                    if !roulette(depth, &mut beta, rng) {
-                        break;
-                    }
-                    continue;
-                }
-                if !ss.specular {
-                    beta *= 1.0 - fr;
-                }
-                // The area integral: one entry point xi from a probe ray.
-                let frame_o = si.shading_frame_facing(wo);
-                let u = ProbeRandoms::from_rng(rng);
-                counters.rays += 1;
-                let Some(ps) = ss.probe.sample(
-                    si.p,
-                    &frame_o,
-                    &u,
-                    ctx.accel,
-                    hit.geom,
-                    mesh,
-                    &mut scratch.probe_hits,
-                ) else {
-                    break;
-                };
-                beta *= ps.weight;
-                let n_in = if si.front { ps.normal } else { -ps.normal };
-                let frame = Frame::from_normal(n_in);
-                Vertex {
-                    p: ps.point,
-                    ng: n_in,
-                    frame,
-                    wo_local: Vec3::Z,
-                    lobe: Lobe::SubsurfaceEntry(ss),
-                }
-            }
+            Scatter::Absorbed => break,
         };
 
         // Next-event estimation, then continue by sampling the lobe.
@@ -223,9 +215,73 @@ pub fn radiance(
     l
 }
 
+/// A subsurface hit at xo under the diffusion model: the Fresnel split at
+/// xo, then one probe ray for the entry point xi, where the path continues
+/// with the entry lobe.
+#[allow(clippy::too_many_arguments)]
+fn subsurface_probe<'s>(
+    ctx: &Context,
+    ss: &'s Subsurface,
+    si: &Interaction,
+    wo: Vec3,
+    beta: &mut Vec3,
+    rng: &mut Rng,
+    scratch: &mut Scratch,
+    counters: &mut Counters,
+) -> Scatter<'s> {
+    // Boundary at xo: the normal facing the camera is "outside"
+    // (a mesh wound inside-out is read consistently the other way).
+    let n_out = if si.front { si.ng } else { -si.ng };
+    let fr = fresnel::dielectric(wo.dot(n_out).max(0.0), ss.eta());
+    if ss.specular && rng.uniform() < fr {
+        // Specular reflection with probability Fr: weight 1. The
+        // shading normal keeps highlights smooth on tessellated
+        // meshes; where it would reflect below the surface the
+        // geometric normal is used instead.
+        let ns_out = if si.ns.dot(n_out) >= 0.0 {
+            si.ns
+        } else {
+            -si.ns
+        };
+        let mut wi = (2.0 * wo.dot(ns_out)) * ns_out - wo;
+        if wi.dot(n_out) <= 0.0 {
+            wi = (2.0 * wo.dot(n_out)) * n_out - wo;
+        }
+        return Scatter::Continue(si.spawn(wi, ctx.ray_epsilon));
+    }
+    if !ss.specular {
+        *beta *= 1.0 - fr;
+    }
+    // The area integral: one entry point xi from a probe ray.
+    let frame_o = si.shading_frame_facing(wo);
+    let u = ProbeRandoms::from_rng(rng);
+    counters.rays += 1;
+    let mesh = &ctx.scene.meshes[si.geom as usize];
+    let Some(ps) = ss.probe.sample(
+        si.p,
+        &frame_o,
+        &u,
+        ctx.accel,
+        si.geom,
+        mesh,
+        &mut scratch.probe_hits,
+    ) else {
+        return Scatter::Absorbed;
+    };
+    *beta *= ps.weight;
+    let n_in = if si.front { ps.normal } else { -ps.normal };
+    Scatter::Vertex(Vertex {
+        p: ps.point,
+        ng: n_in,
+        frame: Frame::from_normal(n_in),
+        wo_local: Vec3::Z,
+        lobe: Lobe::SubsurfaceEntry(ss),
+    })
+}
+
 /// Russian roulette after `RR_START` bounces: survive with probability
 /// min(1, max β) and reweight; false ends the path.
-pub(crate) fn roulette(depth: u32, beta: &mut Vec3, rng: &mut Rng) -> bool {
+fn roulette(depth: u32, beta: &mut Vec3, rng: &mut Rng) -> bool {
     if depth < RR_START {
         return true;
     }
@@ -238,12 +294,7 @@ pub(crate) fn roulette(depth: u32, beta: &mut Vec3, rng: &mut Rng) -> bool {
 }
 
 /// The MIS weight of emission found by lobe sampling from `prev`.
-pub(crate) fn emission_weight(
-    ctx: &Context,
-    si: &Interaction,
-    wo: Vec3,
-    prev: Option<(Vec3, f32)>,
-) -> f32 {
+fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3, f32)>) -> f32 {
     match prev {
         None => 1.0,
         Some((p0, pdf_lobe)) => {
@@ -258,12 +309,7 @@ pub(crate) fn emission_weight(
 
 /// Next-event estimation at a vertex: one light sample, weighted by the
 /// power heuristic against lobe sampling of the same direction.
-pub(crate) fn direct_lighting(
-    ctx: &Context,
-    v: &Vertex,
-    rng: &mut Rng,
-    counters: &mut Counters,
-) -> Vec3 {
+fn direct_lighting(ctx: &Context, v: &Vertex, rng: &mut Rng, counters: &mut Counters) -> Vec3 {
     let u_pick = rng.uniform();
     let u = rng.uniform2();
     let Some(ls) = ctx.lights.sample(ctx.scene, u_pick, u) else {

@@ -3,9 +3,9 @@
 //! (`docs/bssrdf.md` §7, ground truth 3).
 //!
 //! Surfaces, lights and the environment are handled exactly as in
-//! [`super::path`] (the same lobes, next-event estimation with MIS and
-//! Russian roulette, shared from there). At a subsurface object the BSSRDF
-//! is replaced by the physics it approximates:
+//! [`super::path`]: the same bounce loop (`path::trace`), lobes, next-event
+//! estimation with MIS and Russian roulette. At a subsurface object the
+//! BSSRDF is replaced by the physics it approximates:
 //!
 //! - the boundary is a smooth dielectric of index η: Fresnel reflection or
 //!   refraction, sampled like [`crate::materials::dielectric`];
@@ -46,13 +46,12 @@
 //! around it, so the walk ends there with zero radiance (counted in
 //! [`Counters::walks_escaped`]) instead of scattering through infinite space.
 
-use super::interaction::offset_origin;
-use super::path::{direct_lighting, emission_weight, roulette, Lobe, Scratch, Vertex};
+use super::path::{trace, Scatter, Scratch};
 use super::{Context, Counters, Interaction};
 use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
 use crate::geometry::{Frame, Ray, Vec3};
-use crate::materials::{dielectric, Material};
+use crate::materials::dielectric;
 use crate::sampling::Rng;
 
 /// Events (scatterings and internal reflections) after which a walk is
@@ -66,7 +65,8 @@ const WALK_RR_START: u32 = 16;
 
 /// The radiance arriving along `camera_ray`: one sample of L, with
 /// subsurface objects simulated as media. Same contract as
-/// [`super::path::radiance`].
+/// [`super::path::radiance`], and the same bounce loop ([`trace`]); only
+/// subsurface hits differ.
 pub fn radiance(
     ctx: &Context,
     camera_ray: Ray,
@@ -74,107 +74,37 @@ pub fn radiance(
     _scratch: &mut Scratch,
     counters: &mut Counters,
 ) -> Vec3 {
-    let scene = ctx.scene;
-    let mut l = Vec3::ZERO;
-    let mut beta = Vec3::ONE;
-    let mut ray = camera_ray;
-    let mut prev: Option<(Vec3, f32)> = None;
-
-    for depth in 0..=scene.settings.max_depth {
-        counters.rays += 1;
-        let Some(hit) = ctx.accel.intersect(&ray, 0.0, f32::INFINITY) else {
-            if ctx.plan.environment {
-                l += beta * scene.environment.unwrap_or(Vec3::ZERO);
+    trace(
+        ctx,
+        camera_ray,
+        rng,
+        counters,
+        |ss, si, wo, beta, rng, counters| {
+            // Parameters built by hand without a medium leave nothing to
+            // simulate; the path ends as at a black surface.
+            let Some(medium) = ss.params.medium else {
+                return Scatter::Absorbed;
+            };
+            // As in the path tracer, the side the ray arrives from is
+            // "outside", so a mesh wound inside-out still works.
+            let n_out = if si.front { si.ng } else { -si.ng };
+            let frame = Frame::from_normal(n_out);
+            let s = dielectric::sample(ss.eta(), frame.to_local(wo), rng.uniform());
+            *beta *= s.weight;
+            let wi = frame.to_world(s.wi).normalize();
+            if !s.transmitted {
+                return Scatter::Continue(si.spawn(wi, ctx.ray_epsilon));
             }
-            break;
-        };
-        let mesh = &scene.meshes[hit.geom as usize];
-        let object = &scene.objects[hit.geom as usize];
-        let si = Interaction::new(mesh, &ray, &hit);
-        let wo = -ray.d;
-
-        if let (Some(le), true) = (object.emission, si.front) {
-            l += beta * le * emission_weight(ctx, &si, wo, prev);
-        }
-        if depth == scene.settings.max_depth {
-            break;
-        }
-
-        let vertex = match &scene.materials[object.material] {
-            Material::Diffuse { albedo } => {
-                let frame = si.shading_frame_facing(wo);
-                let ng = if wo.dot(si.ng) >= 0.0 { si.ng } else { -si.ng };
-                Vertex {
-                    p: si.p,
-                    ng,
-                    wo_local: frame.to_local(wo),
-                    frame,
-                    lobe: Lobe::Diffuse(*albedo),
+            let inside = si.spawn(wi, ctx.ray_epsilon);
+            match walk(ctx, &medium, ss.eta(), inside, rng, counters) {
+                Some((exit, w)) => {
+                    *beta *= w;
+                    Scatter::Continue(exit)
                 }
+                None => Scatter::Absorbed,
             }
-            Material::Dielectric { eta } => {
-                let frame = Frame::from_normal(si.ng);
-                let s = dielectric::sample(*eta, frame.to_local(wo), rng.uniform());
-                beta *= s.weight;
-                prev = None;
-                ray = si.spawn(frame.to_world(s.wi), ctx.ray_epsilon);
-                if !roulette(depth, &mut beta, rng) {
-                    break;
-                }
-                continue;
-            }
-            Material::Subsurface(ss) => {
-                // Parameters built by hand without a medium leave nothing to
-                // simulate; the path ends as at a black surface.
-                let Some(medium) = ss.params.medium else {
-                    break;
-                };
-                // As in the path tracer, the side the ray arrives from is
-                // "outside", so a mesh wound inside-out still works.
-                let n_out = if si.front { si.ng } else { -si.ng };
-                let frame = Frame::from_normal(n_out);
-                let s = dielectric::sample(ss.eta(), frame.to_local(wo), rng.uniform());
-                beta *= s.weight;
-                prev = None;
-                let wi = frame.to_world(s.wi).normalize();
-                if s.transmitted {
-                    let inside = si.spawn(wi, ctx.ray_epsilon);
-                    match walk(ctx, &medium, ss.eta(), inside, rng, counters) {
-                        Some((exit, w)) => {
-                            beta *= w;
-                            ray = exit;
-                        }
-                        None => break,
-                    }
-                } else {
-                    ray = si.spawn(wi, ctx.ray_epsilon);
-                }
-                if !roulette(depth, &mut beta, rng) {
-                    break;
-                }
-                continue;
-            }
-        };
-
-        if ctx.plan.area_lights {
-            l += beta * direct_lighting(ctx, &vertex, rng, counters);
-        }
-        let Some((wi_local, weight, pdf)) = vertex.lobe.sample(vertex.wo_local, rng.uniform2())
-        else {
-            break;
-        };
-        let wi = vertex.frame.to_world(wi_local);
-        if wi.dot(vertex.ng) <= 0.0 {
-            break;
-        }
-        beta *= weight;
-        prev = Some((vertex.p, pdf));
-        ray = Ray::new(offset_origin(vertex.p, vertex.ng, wi, ctx.ray_epsilon), wi);
-        if !roulette(depth, &mut beta, rng) {
-            break;
-        }
-    }
-    l
+        },
+    )
 }
 
 /// Walks from `ray` (just inside the boundary, unit direction) through the
