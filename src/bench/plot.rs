@@ -1,49 +1,18 @@
 //! The bench's plots: per query, time per ray against triangle count on the
 //! displaced spheres, log-log, one line per (backend, threads); and build
-//! time against triangle count per backend. PNGs drawn by plotters into a
-//! buffer and encoded with `image`; text through plotters' `ab_glyph` from
-//! a TrueType file (`$LUCENT_FONT` or Debian's `fonts-dejavu-core`), so no
-//! fontconfig is needed. The font is `lucent study`'s
-//! ([`crate::study::plots::ensure_font`]).
+//! time against triangle count per backend. Canvas, PNG writing, palette,
+//! axis ranges and font are `lucent study`'s ([`crate::study::plots`]):
+//! plotters' `ab_glyph` text from a TrueType file (`$LUCENT_FONT` or
+//! Debian's `fonts-dejavu-core`), so no fontconfig is needed.
 
-use std::error::Error;
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
 use super::{QueryKind, Row};
-use crate::study::plots::ensure_font;
-
-/// The family `study::plots::ensure_font` registers the font under.
-const FONT: &str = "sans-serif";
-const W: u32 = 1000;
-const H: u32 = 700;
+use crate::study::plots::{color, ensure_font, log_range, png, FONT};
 
 type Series = (String, Vec<(f64, f64)>);
-
-fn color(i: usize) -> RGBColor {
-    const C: [(u8, u8, u8); 8] = [
-        (31, 119, 180),
-        (255, 127, 14),
-        (44, 160, 44),
-        (214, 39, 40),
-        (148, 103, 189),
-        (140, 86, 75),
-        (227, 119, 194),
-        (127, 127, 127),
-    ];
-    let (r, g, b) = C[i % C.len()];
-    RGBColor(r, g, b)
-}
-
-fn log_range(v: impl Iterator<Item = f64>) -> Option<std::ops::Range<f64>> {
-    let (lo, hi) = v
-        .filter(|x| x.is_finite() && *x > 0.0)
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
-            (lo.min(x), hi.max(x))
-        });
-    (hi > 0.0).then(|| lo / 1.5..if hi > lo { hi * 1.5 } else { lo * 2.0 })
-}
 
 /// Draws a log-log line plot of `series` into `path`.
 fn line_plot(path: &Path, title: &str, ylabel: &str, series: &[Series]) -> Result<(), String> {
@@ -51,52 +20,41 @@ fn line_plot(path: &Path, title: &str, ylabel: &str, series: &[Series]) -> Resul
         log_range(series.iter().flat_map(|s| s.1.iter().map(|p| p.0))).ok_or("no data to plot")?;
     let yr =
         log_range(series.iter().flat_map(|s| s.1.iter().map(|p| p.1))).ok_or("no data to plot")?;
-    let mut buf = vec![0u8; (W * H * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (W, H)).into_drawing_area();
-        let draw = || -> Result<(), Box<dyn Error>> {
-            root.fill(&WHITE)?;
-            let mut chart = ChartBuilder::on(&root)
-                .caption(title, (FONT, 22))
-                .margin(15)
-                .x_label_area_size(50)
-                .y_label_area_size(80)
-                .build_cartesian_2d(xr.log_scale(), yr.log_scale())?;
+    png(path, |root| {
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, (FONT, 22))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(xr.log_scale(), yr.log_scale())?;
+        chart
+            .configure_mesh()
+            .x_desc("triangles")
+            .y_desc(ylabel)
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 16))
+            .x_label_formatter(&|x| super::short_count(x.round() as usize))
+            .draw()?;
+        for (i, (name, pts)) in series.iter().enumerate() {
+            let c = color(i);
+            let style = ShapeStyle::from(&c).stroke_width(2);
             chart
-                .configure_mesh()
-                .x_desc("triangles")
-                .y_desc(ylabel)
-                .label_style((FONT, 14))
-                .axis_desc_style((FONT, 16))
-                .x_label_formatter(&|x| super::short_count(x.round() as usize))
-                .draw()?;
-            for (i, (name, pts)) in series.iter().enumerate() {
-                let c = color(i);
-                let style = ShapeStyle::from(&c).stroke_width(2);
-                chart
-                    .draw_series(LineSeries::new(pts.iter().copied(), style))?
-                    .label(name.as_str())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
-                    });
-                chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
-            }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .label_font((FONT, 14))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()?;
-            root.present()?;
-            Ok(())
-        };
-        draw().map_err(|e| format!("plot {}: {e}", path.display()))?;
-    }
-    let img = image::RgbImage::from_raw(W, H, buf).ok_or("bad plot buffer")?;
-    crate::film::atomic_write(path, |tmp| {
-        img.save_with_format(tmp, image::ImageFormat::Png)
-            .map_err(|e| e.to_string())
+                .draw_series(LineSeries::new(pts.iter().copied(), style))?
+                .label(name.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+        Ok(())
     })
 }
 

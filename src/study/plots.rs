@@ -30,7 +30,7 @@ pub const FONT_PATHS: [&str; 3] = [
     "/usr/share/fonts/truetype/freefont/FreeSans.ttf",
 ];
 
-const FONT: &str = "sans-serif";
+pub(crate) const FONT: &str = "sans-serif";
 const W: u32 = 1200;
 const H: u32 = 800;
 
@@ -60,13 +60,13 @@ pub fn ensure_font() -> Result<(), String> {
     .clone()
 }
 
-type Res = Result<(), Box<dyn Error>>;
+pub(crate) type Res = Result<(), Box<dyn Error>>;
 
 /// (x, bias %, 2σ %) points of one labelled series.
 type BiasSeries = (String, Vec<(f64, f64, f64)>);
 
 /// Draws with `draw` into a W×H RGB buffer and writes it to `path` as PNG.
-fn png(
+pub(crate) fn png(
     path: &Path,
     draw: impl FnOnce(DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Res,
 ) -> Result<(), String> {
@@ -83,7 +83,7 @@ fn png(
     })
 }
 
-fn color(i: usize) -> RGBColor {
+pub(crate) fn color(i: usize) -> RGBColor {
     // Tableau-like, then darker variants: distinct for ~20 lines.
     const C: [(u8, u8, u8); 10] = [
         (31, 119, 180),
@@ -106,7 +106,7 @@ fn color(i: usize) -> RGBColor {
 }
 
 /// A log axis range covering `v` (positive values) with some margin.
-fn log_range(v: impl Iterator<Item = f64>) -> Option<std::ops::Range<f64>> {
+pub(crate) fn log_range(v: impl Iterator<Item = f64>) -> Option<std::ops::Range<f64>> {
     let (lo, hi) = v
         .filter(|x| x.is_finite() && *x > 0.0)
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
