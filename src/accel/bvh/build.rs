@@ -23,8 +23,8 @@ use rayon::prelude::*;
 
 /// Centroid bins per axis; 32 is the usual quality/speed point.
 const BINS: usize = 32;
-/// Cost of visiting a node relative to one triangle test (the pair of box
-/// tests is cheaper than a watertight triangle test).
+/// Cost of visiting a node relative to testing one block of primitives
+/// (an 8-box SSE test against a 4-triangle SSE test: about the same).
 const TRAVERSAL_COST: f32 = 1.0;
 /// Nodes with more primitives than this are built in parallel.
 const PAR_SUBTREE: usize = 4096;
@@ -91,7 +91,9 @@ impl NodeW {
 }
 
 /// A built hierarchy: `root` (whose box is `bounds`) references node 0 or
-/// is a single leaf; `order` maps leaf positions to primitive ids.
+/// is a single leaf. Leaves reference blocks of slots; `order`
+/// maps slots to primitive ids, with [`PAD`] in the slots that fill a
+/// leaf's last block.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Tree {
     pub nodes: Vec<NodeW>,
@@ -99,6 +101,9 @@ pub(super) struct Tree {
     pub bounds: [[f32; 3]; 2],
     pub order: Vec<u32>,
 }
+
+/// The primitive id of an unused slot.
+pub(super) const PAD: u32 = u32::MAX;
 
 impl Tree {
     pub fn is_empty(&self) -> bool {
@@ -252,8 +257,16 @@ impl Bins {
     }
 }
 
+/// Blocks needed for `n` primitives: the SAH counts leaf cost per block,
+/// since a block is tested at once (Wald et al. 2008 do the same for
+/// 4-triangle leaves), which favours leaves that fill their blocks.
+#[inline(always)]
+fn blocks(n: u32, block: u32) -> f32 {
+    n.div_ceil(block) as f32
+}
+
 /// Best SAH split: (cost, axis, number of bins on the left).
-fn best_split(bins: &Bins, extent: Vec3) -> Option<(f32, usize, usize)> {
+fn best_split(bins: &Bins, extent: Vec3, block: u32) -> Option<(f32, usize, usize)> {
     let mut best: Option<(f32, usize, usize)> = None;
     for a in 0..3 {
         if extent[a] <= 0.0 {
@@ -267,7 +280,7 @@ fn best_split(bins: &Bins, extent: Vec3) -> Option<(f32, usize, usize)> {
         for i in (1..BINS).rev() {
             acc = acc.union(bins.b[a][i]);
             n += bins.n[a][i];
-            right_cost[i] = acc.half_area() * n as f32;
+            right_cost[i] = acc.half_area() * blocks(n, block);
             right_n[i] = n;
         }
         let mut acc = Aabb::EMPTY;
@@ -278,7 +291,7 @@ fn best_split(bins: &Bins, extent: Vec3) -> Option<(f32, usize, usize)> {
             if n == 0 || right_n[i] == 0 {
                 continue;
             }
-            let cost = acc.half_area() * n as f32 + right_cost[i];
+            let cost = acc.half_area() * blocks(n, block) + right_cost[i];
             if best.map_or(true, |b| cost < b.0) {
                 best = Some((cost, a, i));
             }
@@ -292,6 +305,8 @@ enum BuildNode {
         bounds: Aabb,
         first: u32,
         count: u32,
+        /// First slot in the padded order (set after the build).
+        slot: u32,
     },
     Inner {
         bounds: Aabb,
@@ -299,13 +314,21 @@ enum BuildNode {
     },
 }
 
-fn build_rec(prims: &mut [PrimRef], first: usize, depth: u32, max_leaf: usize) -> BuildNode {
+/// What is fixed for a whole build.
+#[derive(Clone, Copy)]
+struct Params {
+    max_leaf: usize,
+    block: u32,
+}
+
+fn build_rec(prims: &mut [PrimRef], first: usize, depth: u32, par: Params) -> BuildNode {
     let n = prims.len();
     let (bounds, cbounds) = bounds(prims);
     let leaf = BuildNode::Leaf {
         bounds,
         first: first as u32,
         count: n as u32,
+        slot: 0,
     };
     if n <= 1 {
         return leaf;
@@ -321,15 +344,15 @@ fn build_rec(prims: &mut [PrimRef], first: usize, depth: u32, max_leaf: usize) -
         } else {
             Bins::fill(&binner, prims)
         };
-        best_split(&bins, extent).map(|(cost, axis, nb)| (cost, axis, nb, binner))
+        best_split(&bins, extent, par.block).map(|(cost, axis, nb)| (cost, axis, nb, binner))
     } else {
         None
     };
     let mid = match split {
         Some((cost, axis, nb, binner)) => {
-            let leaf_cost = n as f32 * bounds.half_area();
+            let leaf_cost = blocks(n as u32, par.block) * bounds.half_area();
             let split_cost = TRAVERSAL_COST * bounds.half_area() + cost;
-            if n <= max_leaf && leaf_cost <= split_cost {
+            if n <= par.max_leaf && leaf_cost <= split_cost {
                 return leaf;
             }
             let mid = partition(prims, |p| binner.bin(p.centroid(), axis) < nb);
@@ -337,7 +360,7 @@ fn build_rec(prims: &mut [PrimRef], first: usize, depth: u32, max_leaf: usize) -
             mid
         }
         None => {
-            if n <= max_leaf {
+            if n <= par.max_leaf {
                 return leaf;
             }
             // Coincident centroids or too deep: halve by count.
@@ -347,13 +370,13 @@ fn build_rec(prims: &mut [PrimRef], first: usize, depth: u32, max_leaf: usize) -
     let (l, r) = prims.split_at_mut(mid);
     let (a, b) = if n > PAR_SUBTREE {
         rayon::join(
-            || build_rec(l, first, depth + 1, max_leaf),
-            || build_rec(r, first + mid, depth + 1, max_leaf),
+            || build_rec(l, first, depth + 1, par),
+            || build_rec(r, first + mid, depth + 1, par),
         )
     } else {
         (
-            build_rec(l, first, depth + 1, max_leaf),
-            build_rec(r, first + mid, depth + 1, max_leaf),
+            build_rec(l, first, depth + 1, par),
+            build_rec(r, first + mid, depth + 1, par),
         )
     };
     BuildNode::Inner {
@@ -390,11 +413,30 @@ impl BuildNode {
     }
 }
 
+/// Gives each leaf its first slot, in primitive order (left subtrees hold
+/// the lower primitives), rounding each leaf up to whole blocks; returns
+/// the slot after the last.
+fn assign_slots(b: &mut BuildNode, next: u32, block: u32) -> u32 {
+    match b {
+        BuildNode::Leaf { count, slot, .. } => {
+            *slot = next;
+            next + count.div_ceil(block) * block
+        }
+        BuildNode::Inner { kids, .. } => {
+            let [l, r] = &mut **kids;
+            let next = assign_slots(l, next, block);
+            assign_slots(r, next, block)
+        }
+    }
+}
+
 /// Collapses the binary subtree `b` into wide nodes appended to `nodes`
 /// (parents before children) and returns its reference.
-fn collapse(b: &BuildNode, nodes: &mut Vec<NodeW>) -> NodeRef {
+fn collapse(b: &BuildNode, block: u32, nodes: &mut Vec<NodeW>) -> NodeRef {
     let kids = match b {
-        BuildNode::Leaf { first, count, .. } => return leaf_ref(*first, *count),
+        BuildNode::Leaf { count, slot, .. } => {
+            return leaf_ref(slot / block, count.div_ceil(block));
+        }
         BuildNode::Inner { kids, .. } => kids,
     };
     let mut adopt: Vec<&BuildNode> = vec![&kids[0], &kids[1]];
@@ -427,16 +469,17 @@ fn collapse(b: &BuildNode, nodes: &mut Vec<NodeW>) -> NodeRef {
             node.b[2 * a][k] = bb.lo[a];
             node.b[2 * a + 1][k] = bb.hi[a];
         }
-        node.child[k] = collapse(kid, nodes);
+        node.child[k] = collapse(kid, block, nodes);
     }
     nodes[at] = node;
     at as NodeRef
 }
 
 /// Builds a hierarchy over `prims` (whose bounds must be finite) with
-/// leaves of at most `max_leaf` (≤ [`MAX_LEAF_COUNT`]) primitives.
-pub(super) fn build(mut prims: Vec<PrimRef>, max_leaf: usize) -> Tree {
-    assert!((1..=MAX_LEAF_COUNT).contains(&max_leaf));
+/// leaves of at most `max_leaf` primitives in blocks of `block`; a leaf
+/// reference counts blocks (at most [`MAX_LEAF_COUNT`]).
+pub(super) fn build(mut prims: Vec<PrimRef>, max_leaf: usize, block: usize) -> Tree {
+    assert!(block >= 1 && (1..=MAX_LEAF_COUNT * block).contains(&max_leaf));
     assert!(
         prims.len() <= MAX_PRIMS,
         "more than 2^28 triangles in one mesh"
@@ -444,9 +487,17 @@ pub(super) fn build(mut prims: Vec<PrimRef>, max_leaf: usize) -> Tree {
     if prims.is_empty() {
         return Tree::default();
     }
-    let root = build_rec(&mut prims, 0, 0, max_leaf);
+    let par = Params {
+        max_leaf,
+        block: block as u32,
+    };
+    let mut root = build_rec(&mut prims, 0, 0, par);
+    let slots = assign_slots(&mut root, 0, par.block) as usize;
+    assert!(slots <= MAX_PRIMS, "more than 2^28 slots in one tree");
+    let mut order = vec![PAD; slots];
     let mut tmp = Vec::with_capacity(prims.len() / 4 + 1);
-    let root_ref = collapse(&root, &mut tmp);
+    let root_ref = collapse(&root, par.block, &mut tmp);
+    fill_order(&root, &prims, &mut order);
     // Copied once more into an exactly sized, huge-page-backed array.
     let mut nodes = super::mem::with_huge_pages(tmp.len());
     nodes.extend_from_slice(&tmp);
@@ -455,7 +506,25 @@ pub(super) fn build(mut prims: Vec<PrimRef>, max_leaf: usize) -> Tree {
         nodes,
         root: root_ref,
         bounds: [bb.lo.to_array(), bb.hi.to_array()],
-        order: prims.iter().map(|p| p.id).collect(),
+        order,
+    }
+}
+
+/// Writes each leaf's primitive ids into its slots.
+fn fill_order(b: &BuildNode, prims: &[PrimRef], order: &mut [u32]) {
+    match b {
+        BuildNode::Leaf {
+            first, count, slot, ..
+        } => {
+            let src = &prims[*first as usize..(*first + *count) as usize];
+            for (dst, p) in order[*slot as usize..].iter_mut().zip(src) {
+                *dst = p.id;
+            }
+        }
+        BuildNode::Inner { kids, .. } => {
+            fill_order(&kids[0], prims, order);
+            fill_order(&kids[1], prims, order);
+        }
     }
 }
 
@@ -481,7 +550,7 @@ mod tests {
 
     /// Every node bounds its subtree, every leaf its primitives, and every
     /// primitive is referenced by exactly one leaf.
-    fn check(tree: &Tree, prims: &[PrimRef], max_leaf: usize) {
+    fn check(tree: &Tree, prims: &[PrimRef], max_leaf: usize, block: usize) {
         let mut seen = vec![0u32; prims.len()];
         let inside =
             |lo: Vec3, hi: Vec3, blo: Vec3, bhi: Vec3| blo.cmple(lo).all() && bhi.cmpge(hi).all();
@@ -490,9 +559,16 @@ mod tests {
         while let Some((r, (blo, bhi))) = stack.pop() {
             if is_leaf(r) {
                 let (first, count) = leaf_range(r);
-                assert!(count as usize <= max_leaf);
-                for k in first..first + count {
-                    let id = tree.order[k as usize];
+                let b = block as u32;
+                let ids: Vec<u32> = (first * b..(first + count) * b)
+                    .map(|k| tree.order[k as usize])
+                    .collect();
+                let used = ids.iter().take_while(|&&id| id != PAD).count();
+                // Padding only fills the last block.
+                assert!(ids[used..].iter().all(|&id| id == PAD));
+                assert!(used > (count - 1) as usize * b as usize);
+                assert!(used <= max_leaf);
+                for &id in &ids[..used] {
                     seen[id as usize] += 1;
                     let p = &prims[id as usize];
                     assert!(inside(p.lo, p.hi, blo, bhi));
@@ -520,13 +596,27 @@ mod tests {
     fn random_boxes_build_a_valid_tree() {
         for (n, seed) in [(1, 1), (2, 2), (7, 3), (1000, 4), (100_000, 5)] {
             let prims = random_prims(n, seed);
-            let tree = build(prims.clone(), 8);
-            check(&tree, &prims, 8);
+            let tree = build(prims.clone(), 8, 1);
+            check(&tree, &prims, 8, 1);
+            let tree = build(prims.clone(), 8, 4);
+            check(&tree, &prims, 8, 4);
             if n == 100_000 {
                 // SAH trees on uniform data are near balanced.
                 assert!(tree.depth() < 40, "depth {}", tree.depth());
             }
         }
+    }
+
+    #[test]
+    fn block_leaves_fill_their_blocks() {
+        let prims = random_prims(50_000, 9);
+        let tree = build(prims.clone(), 8, 4);
+        check(&tree, &prims, 8, 4);
+        // The block-counting SAH leaves little padding: most leaves hold 4
+        // or 8 primitives.
+        let pads = tree.order.iter().filter(|&&id| id == PAD).count();
+        assert!(pads * 5 < prims.len(), "{pads} padding slots");
+        assert_eq!(tree.order.len() % 4, 0);
     }
 
     #[test]
@@ -537,8 +627,8 @@ mod tests {
             id: 0,
         };
         let prims: Vec<PrimRef> = (0..1000).map(|id| PrimRef { id, ..p }).collect();
-        let tree = build(prims.clone(), 4);
-        check(&tree, &prims, 4);
+        let tree = build(prims.clone(), 4, 1);
+        check(&tree, &prims, 4, 1);
         assert!(tree.depth() <= 10);
     }
 
@@ -556,8 +646,8 @@ mod tests {
                 }
             })
             .collect();
-        let tree = build(prims.clone(), 1);
-        check(&tree, &prims, 1);
+        let tree = build(prims.clone(), 1, 1);
+        check(&tree, &prims, 1, 1);
         assert!(tree.depth() <= MAX_DEPTH, "depth {}", tree.depth());
     }
 }

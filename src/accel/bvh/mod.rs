@@ -7,8 +7,10 @@
 //! ray meets; [`Accel::hits_on_segment`] asks about one mesh and so walks
 //! only that mesh's tree. Triangles are tested with the watertight test of
 //! Woop et al. 2013 ([`triangle`]), with inclusive edges, so a ray through a
-//! shared edge or vertex is never lost; their vertices are copied in leaf
-//! order so that a leaf's triangles are contiguous in memory.
+//! shared edge or vertex is never lost. Their vertices are copied in leaf
+//! order, four triangles to a [`Tri4`] packet tested at once with SSE, so
+//! a leaf (one or two packets) is contiguous in memory; the SAH counts a
+//! leaf's cost per packet.
 //!
 //! Triangles that can never be hit (non-finite coordinates, or zero area)
 //! are left out of the hierarchy, which keeps NaN out of the SAH and box
@@ -22,27 +24,21 @@ pub mod triangle;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use self::build::{PrimRef, Tree};
+use self::build::{PrimRef, Tree, PAD};
 use self::traverse::{traverse, RayBox, Visit};
-use self::triangle::RayTri;
+use self::triangle::{RayTri, Tri4};
 use super::{Accel, Hit, ProbeHits};
 use crate::geometry::{Mesh, Ray};
 
-/// Most triangles per leaf; the SAH usually stops earlier.
+/// Most triangles per leaf (two packets); the SAH usually stops earlier.
 const MAX_LEAF: usize = 8;
 
-/// A triangle's vertices, stored in leaf order.
-#[derive(Clone, Copy, Debug)]
-struct Tri {
-    p: [Vec3; 3],
-}
-
-/// One mesh's hierarchy; `tree.order[i]` is the mesh-level index of
-/// `tris[i]`.
+/// One mesh's hierarchy; `tree.order[4 * i + k]` is the mesh-level index
+/// of lane `k` of `tris[i]` (or [`PAD`] for an empty lane).
 #[derive(Clone, Debug, Default)]
 struct MeshBvh {
     tree: Tree,
-    tris: Vec<Tri>,
+    tris: Vec<Tri4>,
 }
 
 /// Whether a triangle can ever be hit by [`RayTri::intersect`]: finite
@@ -72,10 +68,16 @@ impl MeshBvh {
                 })
             })
             .collect();
-        let tree = build::build(prims, MAX_LEAF);
-        let mut tris = mem::with_huge_pages(tree.order.len());
-        tris.par_extend(tree.order.par_iter().map(|&id| Tri {
-            p: mesh.triangle(id),
+        let tree = build::build(prims, MAX_LEAF, 4);
+        let mut tris = mem::with_huge_pages(tree.order.len() / 4);
+        tris.par_extend(tree.order.par_chunks(4).map(|ids| {
+            let mut t = Tri4::EMPTY;
+            for (k, &id) in ids.iter().enumerate() {
+                if id != PAD {
+                    t.set(k, mesh.triangle(id));
+                }
+            }
+            t
         }));
         MeshBvh { tree, tris }
     }
@@ -107,7 +109,7 @@ impl Bvh {
             })
             .collect();
         Bvh {
-            top: build::build(prims, 1),
+            top: build::build(prims, 1, 1),
             meshes: built,
         }
     }
@@ -140,20 +142,20 @@ impl Accel for Bvh {
         }
         let rb = RayBox::new(ray);
         let rt = RayTri::new(ray);
-        // (geom, leaf-order index, u, v) of the nearest hit so far; its t is
-        // the running tmax.
-        let mut best: Option<(u32, u32, f32, f32)> = None;
+        // (geom, slot, u, v) of the nearest hit so far; its t is the
+        // running tmax.
+        let mut best: Option<(u32, usize, f32, f32)> = None;
         let mut t = tmax;
         traverse(&self.top, &[()], &rb, tmin, &mut t, |first, count, t| {
             for k in first..first + count {
                 let g = self.top.order[k as usize];
                 let m = &self.meshes[g as usize];
                 traverse(&m.tree, &m.tris, &rb, tmin, t, |first, count, t| {
-                    for i in first..first + count {
-                        let p = &m.tris[i as usize].p;
-                        if let Some((th, u, v)) = rt.intersect(p[0], p[1], p[2], tmin, *t) {
-                            *t = th;
-                            best = Some((g, i, u, v));
+                    for i in first as usize..(first + count) as usize {
+                        let h = rt.intersect4(&m.tris[i], tmin, *t);
+                        if let Some(k) = h.nearest() {
+                            *t = h.t[k];
+                            best = Some((g, 4 * i + k, h.u[k], h.v[k]));
                         }
                     }
                     Visit::Continue
@@ -164,7 +166,7 @@ impl Accel for Bvh {
         best.map(|(geom, i, u, v)| Hit {
             t,
             geom,
-            prim: self.meshes[geom as usize].tree.order[i as usize],
+            prim: self.meshes[geom as usize].tree.order[i],
             u,
             v,
         })
@@ -183,10 +185,7 @@ impl Accel for Bvh {
                 let hit = traverse(&m.tree, &m.tris, &rb, tmin, t, |first, count, t| {
                     let any = m.tris[first as usize..(first + count) as usize]
                         .iter()
-                        .any(|tri| {
-                            let p = &tri.p;
-                            rt.intersect(p[0], p[1], p[2], tmin, *t).is_some()
-                        });
+                        .any(|tri| rt.intersect4(tri, tmin, *t).mask != 0);
                     if any {
                         Visit::Stop
                     } else {
@@ -209,15 +208,18 @@ impl Accel for Bvh {
                 let rt = RayTri::new(ray);
                 let mut t = tmax;
                 traverse(&m.tree, &m.tris, &rb, 0.0, &mut t, |first, count, t| {
-                    for i in first..first + count {
-                        let p = &m.tris[i as usize].p;
-                        if let Some((th, u, v)) = rt.intersect(p[0], p[1], p[2], 0.0, *t) {
+                    for i in first as usize..(first + count) as usize {
+                        let h = rt.intersect4(&m.tris[i], 0.0, *t);
+                        let mut lanes = h.mask;
+                        while lanes != 0 {
+                            let k = lanes.trailing_zeros() as usize;
+                            lanes &= lanes - 1;
                             out.record(Hit {
-                                t: th,
+                                t: h.t[k],
                                 geom,
-                                prim: m.tree.order[i as usize],
-                                u,
-                                v,
+                                prim: m.tree.order[4 * i + k],
+                                u: h.u[k],
+                                v: h.v[k],
                             });
                         }
                     }
@@ -301,7 +303,7 @@ mod tests {
         // good, NaN, repeated vertex, collinear
         let idx = vec![[0, 1, 2], [0, 3, 1], [0, 0, 2], [0, 1, 4]];
         let bvh = Bvh::build(&[Mesh::new(p, idx, None)]);
-        assert_eq!(bvh.meshes[0].tris.len(), 1);
+        assert_eq!(bvh.meshes[0].tree.order, [0, PAD, PAD, PAD]);
         let h = bvh
             .intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z), 0.0, 9.0)
             .unwrap();

@@ -13,8 +13,14 @@
 //! come out exactly zero in `f32` are recomputed in `f64`, as the paper
 //! prescribes, so a zero caused by rounding is not mistaken for an edge.
 //!
-//! The query backends and the brute-force reference in the tests share this
-//! one function, so they agree bit for bit.
+//! The BVH stores its triangles four to a [`Tri4`] packet and tests a
+//! packet with [`RayTri::intersect4`], the same arithmetic on four SSE
+//! lanes: every lane performs exactly the scalar test's operations in the
+//! same order (no fused multiply-add), so it returns bit-identical
+//! results, and a lane whose edge function comes out zero is redone by the
+//! scalar test with its `f64` fallback. The brute-force reference in the
+//! tests uses the scalar [`RayTri::intersect`], so the two agree bit for
+//! bit.
 
 use crate::geometry::{Ray, Vec3};
 
@@ -127,6 +133,186 @@ impl RayTri {
     }
 }
 
+/// Four triangles in structure-of-arrays form, `p[vertex][axis][lane]`,
+/// so that one SSE load fetches an axis of a vertex of all four. Unused
+/// lanes hold NaN coordinates, which no ray hits.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct Tri4 {
+    pub p: [[[f32; 4]; 3]; 3],
+}
+
+impl Tri4 {
+    pub const EMPTY: Tri4 = Tri4 {
+        p: [[[f32::NAN; 4]; 3]; 3],
+    };
+
+    /// Puts triangle `p` in `lane`.
+    pub fn set(&mut self, lane: usize, p: [Vec3; 3]) {
+        for (v, q) in p.iter().enumerate() {
+            for a in 0..3 {
+                self.p[v][a][lane] = q[a];
+            }
+        }
+    }
+
+    /// The triangle in `lane`.
+    #[inline(always)]
+    pub fn get(&self, lane: usize) -> [Vec3; 3] {
+        let l = lane & 3;
+        self.p.map(|v| Vec3::new(v[0][l], v[1][l], v[2][l]))
+    }
+}
+
+/// What [`RayTri::intersect4`] found: a bit per hit lane and each lane's
+/// (t, u, v), meaningful only for the hit lanes.
+#[derive(Clone, Copy, Debug)]
+pub struct Hits4 {
+    pub mask: u32,
+    pub t: [f32; 4],
+    pub u: [f32; 4],
+    pub v: [f32; 4],
+}
+
+impl Hits4 {
+    /// The hit lane with the smallest t, if any.
+    #[inline(always)]
+    pub fn nearest(&self) -> Option<usize> {
+        let mut m = self.mask;
+        let mut best: Option<usize> = None;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            if best.map_or(true, |b| self.t[k] < self.t[b]) {
+                best = Some(k);
+            }
+        }
+        best
+    }
+}
+
+impl RayTri {
+    /// [`intersect`](Self::intersect) on the four triangles of a packet.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub fn intersect4(&self, tri: &Tri4, tmin: f32, tmax: f32) -> Hits4 {
+        use std::arch::x86_64::*;
+        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        let o = self.o.to_array();
+        let mut out = Hits4 {
+            mask: 0,
+            t: [0.0; 4],
+            u: [0.0; 4],
+            v: [0.0; 4],
+        };
+        // SAFETY: SSE2 is part of the x86_64 baseline; the loads read
+        // 16-byte-aligned rows of an aligned `Tri4`, the stores write the
+        // local arrays of `out`.
+        let zero_edges = unsafe {
+            let rel = |v: usize, k: usize| {
+                _mm_sub_ps(_mm_load_ps(tri.p[v][k].as_ptr()), _mm_set1_ps(o[k]))
+            };
+            let (sx, sy, sz) = (
+                _mm_set1_ps(self.sx),
+                _mm_set1_ps(self.sy),
+                _mm_set1_ps(self.sz),
+            );
+            let (a_z, b_z, c_z) = (rel(0, kz), rel(1, kz), rel(2, kz));
+            let ax = _mm_sub_ps(rel(0, kx), _mm_mul_ps(sx, a_z));
+            let ay = _mm_sub_ps(rel(0, ky), _mm_mul_ps(sy, a_z));
+            let bx = _mm_sub_ps(rel(1, kx), _mm_mul_ps(sx, b_z));
+            let by = _mm_sub_ps(rel(1, ky), _mm_mul_ps(sy, b_z));
+            let cx = _mm_sub_ps(rel(2, kx), _mm_mul_ps(sx, c_z));
+            let cy = _mm_sub_ps(rel(2, ky), _mm_mul_ps(sy, c_z));
+            let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+            let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+            let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+            let zero = _mm_setzero_ps();
+            let or3 = |a, b, c| _mm_or_ps(_mm_or_ps(a, b), c);
+            let zero_edges = _mm_movemask_ps(or3(
+                _mm_cmpeq_ps(u, zero),
+                _mm_cmpeq_ps(v, zero),
+                _mm_cmpeq_ps(w, zero),
+            )) as u32;
+            let neg = or3(
+                _mm_cmplt_ps(u, zero),
+                _mm_cmplt_ps(v, zero),
+                _mm_cmplt_ps(w, zero),
+            );
+            let pos = or3(
+                _mm_cmpgt_ps(u, zero),
+                _mm_cmpgt_ps(v, zero),
+                _mm_cmpgt_ps(w, zero),
+            );
+            let det = _mm_add_ps(_mm_add_ps(u, v), w);
+            let tt = _mm_add_ps(
+                _mm_add_ps(
+                    _mm_mul_ps(u, _mm_mul_ps(sz, a_z)),
+                    _mm_mul_ps(v, _mm_mul_ps(sz, b_z)),
+                ),
+                _mm_mul_ps(w, _mm_mul_ps(sz, c_z)),
+            );
+            let rcp = _mm_div_ps(_mm_set1_ps(1.0), det);
+            let t = _mm_mul_ps(tt, rcp);
+            // cmpneq is true for NaN, as `!(det == 0.0)` is; a NaN t then
+            // fails both interval comparisons.
+            let ok = _mm_andnot_ps(
+                _mm_and_ps(neg, pos),
+                _mm_and_ps(
+                    _mm_cmpneq_ps(det, zero),
+                    _mm_and_ps(
+                        _mm_cmpge_ps(t, _mm_set1_ps(tmin)),
+                        _mm_cmple_ps(t, _mm_set1_ps(tmax)),
+                    ),
+                ),
+            );
+            out.mask = _mm_movemask_ps(ok) as u32 & !zero_edges;
+            if out.mask != 0 {
+                _mm_storeu_ps(out.t.as_mut_ptr(), t);
+                _mm_storeu_ps(out.u.as_mut_ptr(), _mm_mul_ps(v, rcp));
+                _mm_storeu_ps(out.v.as_mut_ptr(), _mm_mul_ps(w, rcp));
+            }
+            zero_edges
+        };
+        if zero_edges != 0 {
+            self.redo_lanes(tri, zero_edges, tmin, tmax, &mut out);
+        }
+        out
+    }
+
+    /// [`intersect`](Self::intersect) on the four triangles of a packet,
+    /// one at a time.
+    #[cfg(not(target_arch = "x86_64"))]
+    #[inline(always)]
+    pub fn intersect4(&self, tri: &Tri4, tmin: f32, tmax: f32) -> Hits4 {
+        let mut out = Hits4 {
+            mask: 0,
+            t: [0.0; 4],
+            u: [0.0; 4],
+            v: [0.0; 4],
+        };
+        self.redo_lanes(tri, 0xf, tmin, tmax, &mut out);
+        out
+    }
+
+    /// Runs the scalar test on the lanes in `lanes`: those whose edge
+    /// functions need the `f64` fallback (rays through edges and vertices,
+    /// rare), or all of them without SSE.
+    #[inline(never)]
+    fn redo_lanes(&self, tri: &Tri4, lanes: u32, tmin: f32, tmax: f32, out: &mut Hits4) {
+        for k in 0..4 {
+            if lanes & 1 << k == 0 {
+                continue;
+            }
+            let [p0, p1, p2] = tri.get(k);
+            if let Some((t, u, v)) = self.intersect(p0, p1, p2, tmin, tmax) {
+                out.mask |= 1 << k;
+                (out.t[k], out.u[k], out.v[k]) = (t, u, v);
+            }
+        }
+    }
+}
+
 /// `a·b − c·d` with exact products (two f32 products are exact in f64).
 #[inline(never)]
 #[cold]
@@ -206,6 +392,73 @@ mod tests {
             assert!(rt.intersect(a, a, a, -10.0, 10.0).is_none());
             assert!(rt.intersect(nan, P[1], P[2], -10.0, 10.0).is_none());
         }
+    }
+
+    /// The packet test must be the scalar test, bit for bit, lane by lane:
+    /// random triangles, triangles on an integer grid hit through their
+    /// edges and vertices (the `f64` fallback), and NaN (empty) lanes.
+    #[test]
+    fn packet_test_is_the_scalar_test_on_each_lane() {
+        let mut rng = crate::sampling::Rng::from_key(5);
+        let mut r3 = |s: f32| {
+            Vec3::new(
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+            ) * s
+        };
+        let (mut hits, mut grid_hits) = (0, 0);
+        for i in 0..40_000 {
+            let grid = i % 2 == 1;
+            let snap = |v: Vec3| if grid { v.round() } else { v };
+            let mut tri = Tri4::EMPTY;
+            let mut lanes = Vec::new();
+            for k in 0..4 {
+                if i % 7 == 3 && k == 2 {
+                    continue; // an empty lane
+                }
+                let p = [snap(r3(4.0)), snap(r3(4.0)), snap(r3(4.0))];
+                tri.set(k, p);
+                lanes.push((k, p));
+            }
+            let o = snap(r3(20.0));
+            let target = if grid {
+                lanes[0].1[0] + snap(r3(2.0)) * 0.5
+            } else {
+                lanes[0].1[0] + r3(2.0)
+            };
+            let rt = RayTri::new(&Ray::new(o, target - o));
+            let (tmin, tmax) = if i % 5 == 0 { (0.5, 1.5) } else { (0.0, 10.0) };
+            let got = rt.intersect4(&tri, tmin, tmax);
+            let mut want_mask = 0;
+            for &(k, p) in &lanes {
+                let want = rt.intersect(p[0], p[1], p[2], tmin, tmax);
+                if let Some((t, u, v)) = want {
+                    want_mask |= 1 << k;
+                    assert_eq!(
+                        (got.t[k].to_bits(), got.u[k].to_bits(), got.v[k].to_bits()),
+                        (t.to_bits(), u.to_bits(), v.to_bits()),
+                        "lane {k} of case {i}"
+                    );
+                    hits += 1;
+                    grid_hits += grid as usize;
+                }
+            }
+            assert_eq!(got.mask, want_mask, "case {i}");
+        }
+        assert!(hits > 5_000 && grid_hits > 1_000, "{hits} {grid_hits}");
+    }
+
+    #[test]
+    fn nearest_lane_has_the_smallest_t() {
+        let h = Hits4 {
+            mask: 0b1011,
+            t: [3.0, 1.0, 0.5, 2.0],
+            u: [0.0; 4],
+            v: [0.0; 4],
+        };
+        assert_eq!(h.nearest(), Some(1));
+        assert_eq!(Hits4 { mask: 0, ..h }.nearest(), None);
     }
 
     #[test]
