@@ -21,8 +21,13 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-/// Centroid bins per axis; 32 is the usual quality/speed point.
+/// Centroid bins per axis for big nodes; 32 is the usual quality/speed
+/// point. Small nodes use one bin per primitive (at least [`MIN_BINS`]):
+/// the sweep over the bins costs as much as binning 32 primitives, and
+/// most nodes of a tree are small, so 32 bins everywhere spent a third of
+/// the build sweeping mostly empty bins.
 const BINS: usize = 32;
+const MIN_BINS: usize = 8;
 /// Cost of visiting a node relative to testing one block of primitives
 /// (an 8-box SSE test against a 4-triangle SSE test: about the same).
 const TRAVERSAL_COST: f32 = 1.0;
@@ -204,20 +209,27 @@ fn bounds(prims: &[PrimRef]) -> (Aabb, Aabb) {
 struct Binner {
     lo: Vec3,
     scale: Vec3,
+    /// Bins in use, ≤ [`BINS`].
+    count: usize,
 }
 
 impl Binner {
-    fn new(c: &Aabb) -> Self {
+    fn new(c: &Aabb, prims: usize) -> Self {
+        let count = prims.clamp(MIN_BINS, BINS);
         let ext = c.hi - c.lo;
-        // Slightly under BINS so the maximum lands in the last bin.
-        let k = BINS as f32 * (1.0 - 1e-5);
+        // Slightly under `count` so the maximum lands in the last bin.
+        let k = count as f32 * (1.0 - 1e-5);
         let scale = Vec3::select(ext.cmpgt(Vec3::ZERO), Vec3::splat(k) / ext, Vec3::ZERO);
-        Binner { lo: c.lo, scale }
+        Binner {
+            lo: c.lo,
+            scale,
+            count,
+        }
     }
     #[inline(always)]
     fn bin(&self, c: Vec3, axis: usize) -> usize {
         let b = ((c[axis] - self.lo[axis]) * self.scale[axis]) as usize;
-        b.min(BINS - 1)
+        b.min(self.count - 1)
     }
 }
 
@@ -266,18 +278,18 @@ fn blocks(n: u32, block: u32) -> f32 {
 }
 
 /// Best SAH split: (cost, axis, number of bins on the left).
-fn best_split(bins: &Bins, extent: Vec3, block: u32) -> Option<(f32, usize, usize)> {
+fn best_split(bins: &Bins, count: usize, extent: Vec3, block: u32) -> Option<(f32, usize, usize)> {
     let mut best: Option<(f32, usize, usize)> = None;
     for a in 0..3 {
         if extent[a] <= 0.0 {
             continue;
         }
-        // right-to-left sweep: SAH term and count of bins [i, BINS)
+        // right-to-left sweep: SAH term and count of bins [i, count)
         let mut right_cost = [0f32; BINS];
         let mut right_n = [0u32; BINS];
         let mut acc = Aabb::EMPTY;
         let mut n = 0u32;
-        for i in (1..BINS).rev() {
+        for i in (1..count).rev() {
             acc = acc.union(bins.b[a][i]);
             n += bins.n[a][i];
             right_cost[i] = acc.half_area() * blocks(n, block);
@@ -285,7 +297,7 @@ fn best_split(bins: &Bins, extent: Vec3, block: u32) -> Option<(f32, usize, usiz
         }
         let mut acc = Aabb::EMPTY;
         let mut n = 0u32;
-        for i in 1..BINS {
+        for i in 1..count {
             acc = acc.union(bins.b[a][i - 1]);
             n += bins.n[a][i - 1];
             if n == 0 || right_n[i] == 0 {
@@ -330,12 +342,14 @@ fn build_rec(prims: &mut [PrimRef], first: usize, depth: u32, par: Params) -> Bu
         count: n as u32,
         slot: 0,
     };
-    if n <= 1 {
+    // One block is always a leaf: a split would cost a traversal step
+    // plus at least as many block tests.
+    if n <= 1 || n <= (par.block as usize).min(par.max_leaf) {
         return leaf;
     }
     let extent = cbounds.hi - cbounds.lo;
     let split = if depth < SAH_DEPTH && extent.max_element() > 0.0 {
-        let binner = Binner::new(&cbounds);
+        let binner = Binner::new(&cbounds, n);
         let bins = if n > PAR_BINNING {
             prims
                 .par_chunks(PAR_BINNING / 4)
@@ -344,7 +358,8 @@ fn build_rec(prims: &mut [PrimRef], first: usize, depth: u32, par: Params) -> Bu
         } else {
             Bins::fill(&binner, prims)
         };
-        best_split(&bins, extent, par.block).map(|(cost, axis, nb)| (cost, axis, nb, binner))
+        best_split(&bins, binner.count, extent, par.block)
+            .map(|(cost, axis, nb)| (cost, axis, nb, binner))
     } else {
         None
     };
