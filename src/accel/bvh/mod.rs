@@ -146,11 +146,11 @@ impl Accel for Bvh {
         // running tmax.
         let mut best: Option<(u32, usize, f32, f32)> = None;
         let mut t = tmax;
-        traverse(&self.top, &[()], &rb, tmin, &mut t, |first, count, t| {
+        traverse::<true, _>(&self.top, &[()], &rb, tmin, &mut t, |first, count, t| {
             for k in first..first + count {
                 let g = self.top.order[k as usize];
                 let m = &self.meshes[g as usize];
-                traverse(&m.tree, &m.tris, &rb, tmin, t, |first, count, t| {
+                traverse::<true, _>(&m.tree, &m.tris, &rb, tmin, t, |first, count, t| {
                     for i in first as usize..(first + count) as usize {
                         let h = rt.intersect4(&m.tris[i], tmin, *t);
                         if let Some(k) = h.nearest() {
@@ -179,10 +179,10 @@ impl Accel for Bvh {
         let rb = RayBox::new(ray);
         let rt = RayTri::new(ray);
         let mut t = tmax;
-        traverse(&self.top, &[()], &rb, tmin, &mut t, |first, count, t| {
+        traverse::<true, _>(&self.top, &[()], &rb, tmin, &mut t, |first, count, t| {
             for k in first..first + count {
                 let m = &self.meshes[self.top.order[k as usize] as usize];
-                let hit = traverse(&m.tree, &m.tris, &rb, tmin, t, |first, count, t| {
+                let hit = traverse::<true, _>(&m.tree, &m.tris, &rb, tmin, t, |first, count, t| {
                     let any = m.tris[first as usize..(first + count) as usize]
                         .iter()
                         .any(|tri| rt.intersect4(tri, tmin, *t).mask != 0);
@@ -207,7 +207,7 @@ impl Accel for Bvh {
                 let rb = RayBox::new(ray);
                 let rt = RayTri::new(ray);
                 let mut t = tmax;
-                traverse(&m.tree, &m.tris, &rb, 0.0, &mut t, |first, count, t| {
+                traverse::<false, _>(&m.tree, &m.tris, &rb, 0.0, &mut t, |first, count, t| {
                     for i in first as usize..(first + count) as usize {
                         let h = rt.intersect4(&m.tris[i], 0.0, *t);
                         let mut lanes = h.mask;

@@ -164,13 +164,16 @@ pub(super) enum Visit {
     Stop,
 }
 
-/// Visits, nearest box first, every leaf whose box the ray meets within
-/// [tmin, *tmax]. `leaf(first, count, tmax)` may shrink `*tmax` (nearest
-/// hit): boxes entered beyond it are then skipped, also when popped from
-/// the stack. Returns true if a leaf asked to stop. `leaf_data` is what
-/// leaves index (triangles), prefetched when a leaf's box is hit.
+/// Visits every leaf whose box the ray meets within [tmin, *tmax], nearest
+/// box first if `ORDERED`. `leaf(first, count, tmax)` may shrink `*tmax`
+/// (nearest hit): boxes entered beyond it are then skipped, also when
+/// popped from the stack. Returns true if a leaf asked to stop. `leaf_data`
+/// is what leaves index (triangles), prefetched when a leaf's box is hit.
+///
+/// Queries that must visit every leaf on the segment anyway (all hits of a
+/// probe ray) gain nothing from the order and skip sorting the children.
 #[inline(always)]
-pub(super) fn traverse<L>(
+pub(super) fn traverse<const ORDERED: bool, L>(
     tree: &Tree,
     leaf_data: &[L],
     ray: &RayBox,
@@ -203,14 +206,14 @@ pub(super) fn traverse<L>(
             }
             let n = &tree.nodes[r as usize];
             let (t, mut hit) = ray.hit_w(n, tmin, *tmax);
-            // Hit children, sorted nearest first (insertion sort).
+            // Hit children, sorted nearest first (insertion sort) if ORDERED.
             let mut kids = [(0 as NodeRef, 0f32); WIDTH];
             let mut m = 0;
             while hit != 0 {
                 let k = hit.trailing_zeros() as usize;
                 hit &= hit - 1;
                 let mut j = m;
-                while j > 0 && kids[j - 1].1 > t[k] {
+                while ORDERED && j > 0 && kids[j - 1].1 > t[k] {
                     kids[j] = kids[j - 1];
                     j -= 1;
                 }
