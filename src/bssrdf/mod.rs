@@ -8,6 +8,7 @@
 //! - [`params`]: presets, measured and artist parameters → per-channel (A, d);
 //! - [`radius`]: the four radius samplers with their disk pdfs;
 //! - [`probe`]: the probe-ray estimator the integrator calls;
+//! - [`fast`]: its per-hit density and weight in f32, for the exact samplers;
 //! - [`fresnel_moment`]: Ft and the normalized exit lobe Sw.
 //!
 //! The separable BSSRDF is S = C·Ft(xi, wi)·Rd(|xo − xi|)·Ft(xo, wo) with
@@ -28,6 +29,7 @@
 //! }
 //! ```
 
+pub mod fast;
 pub mod fresnel_moment;
 pub mod params;
 pub mod probe;

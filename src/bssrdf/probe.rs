@@ -36,6 +36,7 @@
 
 use glam::DVec3;
 
+use super::fast::FastProbe;
 use super::params::SubsurfaceParams;
 use super::profile;
 use super::radius::{RadialDist, RadiusSampler};
@@ -166,6 +167,9 @@ pub struct ProbeSampler {
     active: [usize; 3],
     n_active: usize,
     rmax: f64,
+    /// The f32 evaluation of the weights, for the exact samplers when the
+    /// channels' d are within its range; None falls back to f64.
+    fast: Option<FastProbe>,
 }
 
 impl ProbeSampler {
@@ -194,6 +198,16 @@ impl ProbeSampler {
             active[n_active] = c;
             n_active += 1;
         }
+        let fast = match opts.radius {
+            RadiusSampler::Analytic | RadiusSampler::Mixture => FastProbe::new(
+                params.d,
+                scale,
+                std::array::from_fn(|c| dists[c].as_ref().map_or(0.0, |d| d.profile_mass())),
+                std::array::from_fn(|c| dists[c].is_some()),
+                rmax,
+            ),
+            RadiusSampler::Uniform | RadiusSampler::Table { .. } => None,
+        };
         Ok(ProbeSampler {
             opts: *opts,
             scale,
@@ -202,6 +216,7 @@ impl ProbeSampler {
             active,
             n_active,
             rmax,
+            fast,
         })
     }
 
@@ -254,16 +269,17 @@ impl ProbeSampler {
     fn pdf_area_d(&self, d: DVec3, frame: &Frame, n_hit: DVec3) -> [f64; 3] {
         let axes = [frame.t.as_dvec3(), frame.b.as_dvec3(), frame.n.as_dvec3()];
         let probs = self.axis_probs();
-        let d2 = d.length_squared();
+        // Disk radii from the squares of the other two local coordinates:
+        // |d|² − (d·V)² would cancel when r ≪ |d|.
+        let sq = axes.map(|v| d.dot(v).powi(2));
         let mut pdf = [0.0; 3];
         for a in 0..3 {
             if probs[a] == 0.0 {
                 continue;
             }
-            let along = d.dot(axes[a]);
             // Rounding can put a hit just outside the sphere; keep its
             // projection on the disk so the sampled axis never scores 0.
-            let r_a = (d2 - along * along).max(0.0).sqrt().min(self.rmax);
+            let r_a = (sq[(a + 1) % 3] + sq[(a + 2) % 3]).sqrt().min(self.rmax);
             let cos = axes[a].dot(n_hit).abs();
             if cos == 0.0 {
                 continue;
@@ -320,11 +336,13 @@ impl ProbeSampler {
         let ci = ((u.channel * self.n_active as f64) as usize).min(self.n_active - 1);
         let ch = self.active[ci];
         let dist = self.dists[ch].as_ref()?;
-        let (r, _) = dist.sample(u.radius);
-        let phi = 2.0 * std::f64::consts::PI * u.angle;
+        let r = dist.sample_radius(u.radius);
+        // The angle in f32: its rounding moves p0 by ~1e-7·r, below the f32
+        // rounding of p0 itself.
+        let (sin, cos) = (2.0 * std::f32::consts::PI * u.angle as f32).sin_cos();
         let h = (self.rmax * self.rmax - r * r).max(0.0).sqrt();
         let xo64 = xo.as_dvec3();
-        let p0 = xo64 + (t1 * phi.cos() + t2 * phi.sin()) * r + v * h;
+        let p0 = xo64 + (t1 * cos as f64 + t2 * sin as f64) * r + v * h;
         let ray = Ray::new(p0.as_vec3(), (-v).as_vec3());
         accel.hits_on_segment(&ray, (2.0 * h) as f32, geom, u.seed, hits);
         let kept = hits.hits();
@@ -344,33 +362,61 @@ impl ProbeSampler {
             return None;
         }
         let dvec = xi - xo64;
-        let pdf = self.pdf_area_d(dvec, frame, n_hit);
-        let dist3 = dvec.length();
-        let mut w = [0.0f64; 3];
-        match self.opts.channel {
-            ChannelStrategy::Single => {
-                let p = pdf[ch] / self.n_active as f64;
-                if !(p > 0.0 && p.is_finite()) {
-                    return None;
-                }
-                w[ch] = self.scale[ch] * profile::profile(dist3, self.d[ch]) / p * total;
-            }
-            ChannelStrategy::Mis => {
-                let p = pdf.iter().sum::<f64>() / self.n_active as f64;
-                if !(p > 0.0 && p.is_finite()) {
-                    return None;
-                }
-                for &c in &self.active[..self.n_active] {
-                    w[c] = self.scale[c] * profile::profile(dist3, self.d[c]) / p * total;
-                }
-            }
-        }
+        let w = match &self.fast {
+            Some(fast) => self.weights_f32(fast, dvec, frame, n_hit, ch)?,
+            None => self.weights_f64(dvec, frame, n_hit, ch)?,
+        };
         Some(ProbeSample {
             hit,
             point: xi.as_vec3(),
             normal: n_hit.as_vec3(),
-            weight: Vec3::new(w[0] as f32, w[1] as f32, w[2] as f32),
+            weight: Vec3::from_array(w) * total as f32,
         })
+    }
+
+    /// The sampled channel when each sample estimates only one.
+    fn single(&self, ch: usize) -> Option<usize> {
+        match self.opts.channel {
+            ChannelStrategy::Single => Some(ch),
+            ChannelStrategy::Mis => None,
+        }
+    }
+
+    /// Rd(|d|)/p(xi) per channel (before the hit count) for an entry point
+    /// at xi = xo + d with unit normal `n_hit`, `ch` the sampled channel:
+    /// the f64 reference.
+    fn weights_f64(&self, d: DVec3, frame: &Frame, n_hit: DVec3, ch: usize) -> Option<[f32; 3]> {
+        let pdf = self.pdf_area_d(d, frame, n_hit);
+        let dist3 = d.length();
+        let p = match self.single(ch) {
+            Some(ch) => pdf[ch],
+            None => pdf.iter().sum::<f64>(),
+        } / self.n_active as f64;
+        if !(p > 0.0 && p.is_finite()) {
+            return None;
+        }
+        let w = |c: usize| (self.scale[c] * profile::profile(dist3, self.d[c]) / p) as f32;
+        Some(match self.single(ch) {
+            Some(ch) => std::array::from_fn(|c| if c == ch { w(c) } else { 0.0 }),
+            None => std::array::from_fn(w),
+        })
+    }
+
+    /// The same in f32 ([`super::fast`]).
+    #[inline]
+    fn weights_f32(
+        &self,
+        fast: &FastProbe,
+        d: DVec3,
+        frame: &Frame,
+        n_hit: DVec3,
+        ch: usize,
+    ) -> Option<[f32; 3]> {
+        let axes = [frame.t, frame.b, frame.n].map(|v| v.as_dvec3());
+        let local = axes.map(|v| d.dot(v));
+        let cos = axes.map(|v| v.dot(n_hit).abs() as f32);
+        let probs = self.axis_probs().map(|p| p as f32);
+        fast.weights(local, cos, probs, self.single(ch), self.n_active)
     }
 }
 
@@ -1057,6 +1103,107 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn f32_weights_match_the_f64_reference() {
+        // The f32 path against the f64 one on entry points spread over the
+        // probe sphere, many nearly on an axis (disk radius down to 1e-12
+        // Rmax, below the RHO_MIN clamp), for materials whose channels span
+        // up to the f32 path's range of r/d, in scene units from 1e-6 to 1e6.
+        use crate::sampling::uniform_sphere;
+        let marble = SubsurfaceParams::from_preset("marble", 1.0, profile::Fit::Searchlight);
+        let skin = SubsurfaceParams::from_preset("skin1", 1.0, profile::Fit::Searchlight);
+        let wide = SubsurfaceParams {
+            albedo: [0.9, 0.0, 0.3],
+            d: [1.0, 0.7, 0.0835],
+            eta: 1.3,
+            medium: None,
+        };
+        let mut materials = vec![marble.unwrap(), skin.unwrap(), wide];
+        materials.push(materials[0].scaled(1e-6));
+        materials.push(materials[1].scaled(1e6));
+        let mut rng = Rng::from_key(99);
+        let mut worst = 0.0f64;
+        for params in &materials {
+            for axes in [ProbeAxes::Normal, ProbeAxes::Mis3] {
+                for channel in [ChannelStrategy::Single, ChannelStrategy::Mis] {
+                    for radius in [RadiusSampler::Analytic, RadiusSampler::Mixture] {
+                        for renormalize in [false, true] {
+                            let opts = ProbeOptions {
+                                axes,
+                                channel,
+                                radius,
+                                rmax_quantile: 0.999,
+                                renormalize,
+                            };
+                            let s = ProbeSampler::new(params, &opts).unwrap();
+                            let fast = s.fast.as_ref().expect("f32 path in range");
+                            for _ in 0..2_000 {
+                                let frame = Frame::from_normal(uniform_sphere(rng.uniform2()));
+                                let mut local = [0.0f64; 3];
+                                let a = (rng.uniform() * 3.0) as usize % 3;
+                                let rm = s.rmax();
+                                let perp = rm * 10f64.powf(-12.0 * rng.uniform_f64());
+                                let phi = std::f64::consts::TAU * rng.uniform_f64();
+                                local[(a + 1) % 3] = perp * phi.cos();
+                                local[(a + 2) % 3] = perp * phi.sin();
+                                // along the axis, inside the sphere
+                                local[a] = (rm * rm - perp * perp).max(0.0).sqrt()
+                                    * (2.0 * rng.uniform_f64() - 1.0);
+                                let local = if rng.uniform() < 0.5 {
+                                    local
+                                } else {
+                                    // anywhere in the sphere
+                                    let u = uniform_sphere(rng.uniform2()).as_dvec3();
+                                    (u * rng.uniform_f64().cbrt() * rm).to_array()
+                                };
+                                let (t, b, n) =
+                                    (frame.t.as_dvec3(), frame.b.as_dvec3(), frame.n.as_dvec3());
+                                let d = t * local[0] + b * local[1] + n * local[2];
+                                let n_hit = uniform_sphere(rng.uniform2()).as_dvec3().normalize();
+                                let ch = s.active
+                                    [(rng.uniform() * s.n_active as f32) as usize % s.n_active];
+                                let f = s.weights_f32(fast, d, &frame, n_hit, ch);
+                                let r = s.weights_f64(d, &frame, n_hit, ch);
+                                let (Some(f), Some(r)) = (f, r) else {
+                                    assert_eq!(f.is_some(), r.is_some(), "{opts:?} {d} {n_hit}");
+                                    continue;
+                                };
+                                for c in 0..3 {
+                                    // relative, but not among subnormal weights
+                                    let e = ((f[c] - r[c]) as f64).abs() / (r[c] as f64).max(1e-35);
+                                    // exp(−ρ/3) inherits the f32 rounding of its
+                                    // argument times ρ/3 (a few ulp, 6e-8 each),
+                                    // in Rd and in the density: the bound grows
+                                    // with r/d (≤ 240 on this path).
+                                    let rho = d.length() / params.d[c];
+                                    let tol = 1e-6 + 3.6e-7 * rho / 3.0;
+                                    assert!(
+                                        e < tol,
+                                        "{params:?} {opts:?} ch{c}: {} vs {} at {local:?}",
+                                        f[c],
+                                        r[c]
+                                    );
+                                    worst = worst.max(e / tol);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        println!("f32 weights: worst relative error {worst:.3} of the bound");
+        // the other samplers, and a channel ratio beyond the range, use f64
+        let opts = ProbeOptions::seed(RadiusSampler::table(64));
+        assert!(ProbeSampler::new(&materials[0], &opts)
+            .unwrap()
+            .fast
+            .is_none());
+        let mut far = materials[2];
+        far.d[2] = 0.05;
+        let s = ProbeSampler::new(&far, &ProbeOptions::default()).unwrap();
+        assert!(s.fast.is_none());
     }
 
     #[test]

@@ -329,6 +329,14 @@ impl RadialDist {
     /// Draws r ∈ [RHO_MIN·d, Rmax] from u ∈ [0, 1); returns (r, disk pdf).
     #[inline]
     pub fn sample(&self, u: f64) -> (f64, f64) {
+        let r = self.sample_radius(u);
+        (r, self.pdf(r))
+    }
+
+    /// [`sample`](Self::sample) without the pdf, for callers that evaluate
+    /// the density of the point the radius leads to instead.
+    #[inline]
+    pub fn sample_radius(&self, u: f64) -> f64 {
         let u = u.clamp(0.0, 1.0 - f64::EPSILON / 2.0);
         let d = self.d;
         let r = match &self.kind {
@@ -350,8 +358,7 @@ impl RadialDist {
                 }
             }
         };
-        let r = r.max(RHO_MIN * d).min(self.rmax);
-        (r, self.pdf(r))
+        r.max(RHO_MIN * d).min(self.rmax)
     }
 
     /// The disk pdf (per unit area) of radius r; 0 beyond Rmax.
