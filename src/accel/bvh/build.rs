@@ -18,7 +18,7 @@
 //! nodes gave 0.40-0.46 Mrays/s and 8-wide 0.56-0.57 on the 1.31M-triangle
 //! displaced sphere (one thread of a shared, loaded machine).
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
 /// Centroid bins per axis for big nodes; 32 is the usual quality/speed
@@ -145,26 +145,34 @@ pub(super) struct PrimRef {
 
 impl PrimRef {
     #[inline(always)]
-    fn centroid(&self) -> Vec3 {
-        (self.lo + self.hi) * 0.5
+    fn centroid(&self) -> Vec3A {
+        (Vec3A::from(self.lo) + Vec3A::from(self.hi)) * 0.5
+    }
+    #[inline(always)]
+    fn bounds(&self) -> Aabb {
+        Aabb {
+            lo: self.lo.into(),
+            hi: self.hi.into(),
+        }
     }
 }
 
 #[derive(Clone, Copy, Debug)]
 struct Aabb {
-    lo: Vec3,
-    hi: Vec3,
+    // SIMD vectors: growing the bins' boxes is most of the build.
+    lo: Vec3A,
+    hi: Vec3A,
 }
 
 impl Aabb {
     const EMPTY: Aabb = Aabb {
-        lo: Vec3::splat(f32::INFINITY),
-        hi: Vec3::splat(f32::NEG_INFINITY),
+        lo: Vec3A::splat(f32::INFINITY),
+        hi: Vec3A::splat(f32::NEG_INFINITY),
     };
     #[inline(always)]
-    fn grow(&mut self, lo: Vec3, hi: Vec3) {
-        self.lo = self.lo.min(lo);
-        self.hi = self.hi.max(hi);
+    fn grow(&mut self, b: Aabb) {
+        self.lo = self.lo.min(b.lo);
+        self.hi = self.hi.max(b.hi);
     }
     #[inline(always)]
     fn union(self, o: Aabb) -> Aabb {
@@ -176,7 +184,7 @@ impl Aabb {
     /// Half the surface area (the factor cancels in the SAH).
     #[inline(always)]
     fn half_area(&self) -> f32 {
-        let e = (self.hi - self.lo).max(Vec3::ZERO);
+        let e = (self.hi - self.lo).max(Vec3A::ZERO);
         e.x * e.y + e.y * e.z + e.z * e.x
     }
 }
@@ -187,9 +195,9 @@ fn bounds(prims: &[PrimRef]) -> (Aabb, Aabb) {
         let mut b = Aabb::EMPTY;
         let mut c = Aabb::EMPTY;
         for p in ps {
-            b.grow(p.lo, p.hi);
+            b.grow(p.bounds());
             let m = p.centroid();
-            c.grow(m, m);
+            c.grow(Aabb { lo: m, hi: m });
         }
         (b, c)
     };
@@ -207,8 +215,8 @@ fn bounds(prims: &[PrimRef]) -> (Aabb, Aabb) {
 /// partitioning so that both agree exactly.
 #[derive(Clone, Copy)]
 struct Binner {
-    lo: Vec3,
-    scale: Vec3,
+    lo: Vec3A,
+    scale: Vec3A,
     /// Bins in use, ≤ [`BINS`].
     count: usize,
 }
@@ -219,17 +227,37 @@ impl Binner {
         let ext = c.hi - c.lo;
         // Slightly under `count` so the maximum lands in the last bin.
         let k = count as f32 * (1.0 - 1e-5);
-        let scale = Vec3::select(ext.cmpgt(Vec3::ZERO), Vec3::splat(k) / ext, Vec3::ZERO);
+        let scale = Vec3A::select(ext.cmpgt(Vec3A::ZERO), Vec3A::splat(k) / ext, Vec3A::ZERO);
         Binner {
             lo: c.lo,
             scale,
             count,
         }
     }
+    /// The bin of centroid `c` along each axis, computed for all three at
+    /// once (the binning loop needs all three; a per-axis `Vec3A` index is
+    /// a branchy match).
     #[inline(always)]
-    fn bin(&self, c: Vec3, axis: usize) -> usize {
-        let b = ((c[axis] - self.lo[axis]) * self.scale[axis]) as usize;
-        b.min(self.count - 1)
+    fn bins(&self, c: Vec3A) -> [usize; 3] {
+        let f = (c - self.lo) * self.scale;
+        // Truncation in one instruction; Rust's saturating `as` casts cost
+        // more than the rest of the binning. Out-of-range lanes (not
+        // expected: centroids lie in the bounds the scale came from) give
+        // i32::MIN and are clamped like any other.
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of the x86_64 baseline; the conversion is a
+        // plain register operation.
+        let i: [i32; 4] = unsafe {
+            use std::arch::x86_64::{__m128, _mm_cvttps_epi32};
+            std::mem::transmute(_mm_cvttps_epi32(__m128::from(f)))
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let i = f.to_array().map(|x| x as i32);
+        [0, 1, 2].map(|a| (i[a].max(0) as usize).min(self.count - 1))
+    }
+    #[inline(always)]
+    fn bin(&self, c: Vec3A, axis: usize) -> usize {
+        self.bins(c)[axis]
     }
 }
 
@@ -249,10 +277,9 @@ impl Bins {
     fn fill(binner: &Binner, prims: &[PrimRef]) -> Self {
         let mut s = Bins::new();
         for p in prims {
-            let c = p.centroid();
-            for a in 0..3 {
-                let i = binner.bin(c, a);
-                s.b[a][i].grow(p.lo, p.hi);
+            let b = p.bounds();
+            for (a, i) in binner.bins(p.centroid()).into_iter().enumerate() {
+                s.b[a][i].grow(b);
                 s.n[a][i] += 1;
             }
         }
@@ -278,7 +305,7 @@ fn blocks(n: u32, block: u32) -> f32 {
 }
 
 /// Best SAH split: (cost, axis, number of bins on the left).
-fn best_split(bins: &Bins, count: usize, extent: Vec3, block: u32) -> Option<(f32, usize, usize)> {
+fn best_split(bins: &Bins, count: usize, extent: Vec3A, block: u32) -> Option<(f32, usize, usize)> {
     let mut best: Option<(f32, usize, usize)> = None;
     for a in 0..3 {
         if extent[a] <= 0.0 {
