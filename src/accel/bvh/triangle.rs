@@ -328,6 +328,18 @@ mod tests {
         Ray::new(Vec3::from(o), Vec3::from(d))
     }
 
+    /// Points uniform in the cube of side `s` centred on the origin.
+    fn random_points(seed: u64) -> impl FnMut(f32) -> Vec3 {
+        let mut rng = crate::sampling::Rng::from_key(seed);
+        move |s| {
+            Vec3::new(
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+            ) * s
+        }
+    }
+
     const P: [Vec3; 3] = [
         Vec3::new(0.0, 0.0, 0.0),
         Vec3::new(1.0, 0.0, 0.0),
@@ -399,14 +411,7 @@ mod tests {
     /// edges and vertices (the `f64` fallback), and NaN (empty) lanes.
     #[test]
     fn packet_test_is_the_scalar_test_on_each_lane() {
-        let mut rng = crate::sampling::Rng::from_key(5);
-        let mut r3 = |s: f32| {
-            Vec3::new(
-                rng.uniform() - 0.5,
-                rng.uniform() - 0.5,
-                rng.uniform() - 0.5,
-            ) * s
-        };
+        let mut r3 = random_points(5);
         let (mut hits, mut grid_hits) = (0, 0);
         for i in 0..40_000 {
             let grid = i % 2 == 1;
@@ -466,14 +471,7 @@ mod tests {
         // Two triangles sharing edge (p, q); rays aimed at random points of
         // the edge must hit at least one (with inclusive edges: both if the
         // point is exactly on it, which rounding rarely allows).
-        let mut rng = crate::sampling::Rng::from_key(11);
-        let mut r3 = |s: f32| {
-            Vec3::new(
-                rng.uniform() - 0.5,
-                rng.uniform() - 0.5,
-                rng.uniform() - 0.5,
-            ) * s
-        };
+        let mut r3 = random_points(11);
         for _ in 0..20_000 {
             let (p, q) = (r3(2.0), r3(2.0));
             let (a, b) = (r3(2.0), r3(2.0));
