@@ -86,7 +86,9 @@ enum Command {
     },
     /// Benchmark the ray-query backends on the same meshes and rays: build
     /// time and memory, Mrays/s of camera, incoherent, shadow and probe
-    /// rays; bench.csv, report.txt and plots in the output directory.
+    /// rays; bench.csv, report.txt and plots in the output directory. With
+    /// --scene: the render's end-to-end ray rate against the backend's raw
+    /// rate on the render's own queries (render-mix.csv, render-mix.txt).
     Bench(BenchArgs),
     /// Print the build's ray-query backends and versions.
     Info,
@@ -391,14 +393,69 @@ struct BenchArgs {
     /// Rays per query set (default 500000, quick 16384).
     #[arg(long, value_parser = lucent::bench::parse_rays)]
     rays: Option<usize>,
+    /// Backends to measure: bvh | embree | both (default: every backend of
+    /// this build).
+    #[arg(long, value_enum)]
+    accel: Option<BenchAccelArg>,
+    /// Render this scene, record its ray queries and replay them on the bare
+    /// backend: end-to-end against raw ray rate (instead of the meshes).
+    #[arg(long, conflicts_with_all = ["quick", "sizes", "rays"])]
+    scene: Option<PathBuf>,
+    /// Samples per pixel of the scene's renders (with --scene; default 2).
+    #[arg(long, requires = "scene")]
+    spp: Option<u32>,
     /// No progress bar.
     #[arg(short, long)]
     quiet: bool,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum BenchAccelArg {
+    Bvh,
+    Embree,
+    Both,
+}
+
+/// The backends `--accel` asks for; one this build lacks is bad input.
+fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Failure> {
+    let want = match a {
+        None | Some(BenchAccelArg::Both) => return Ok(lucent::bench::available_backends()),
+        Some(BenchAccelArg::Bvh) => Backend::Bvh,
+        Some(BenchAccelArg::Embree) => Backend::Embree,
+    };
+    if !lucent::bench::available_backends().contains(&want) {
+        // accel::build says why and how to get it.
+        let why = accel::build(&std::sync::Arc::new(Vec::new()), want).err();
+        return Err(Failure::Input(why.unwrap_or_else(|| {
+            format!("backend {} is not available", want.name())
+        })));
+    }
+    Ok(vec![want])
+}
+
 fn run_bench(a: BenchArgs) -> Result<(), Failure> {
     use lucent::bench::{self, BenchError};
+    let backends = bench_backends(a.accel)?;
+    if let Some(scene) = &a.scene {
+        let mut s = bench::replay::Settings::new(scene, &a.output);
+        s.spp = a.spp.unwrap_or(s.spp);
+        if !a.threads.is_empty() {
+            s.threads = a.threads;
+        }
+        s.backends = backends;
+        s.progress = !a.quiet;
+        let o = bench::replay::run(&s).map_err(|e| match e {
+            BenchError::Input(m) => Failure::Input(m),
+            BenchError::Runtime(m) => Failure::Runtime(m),
+        })?;
+        print!("{}", o.report);
+        if !a.quiet {
+            eprintln!("{} rows in {}", o.rows.len(), o.csv.display());
+        }
+        return Ok(());
+    }
     let mut s = bench::Settings::new(&a.output, a.quick);
+    s.backends = backends;
     if !a.sizes.is_empty() {
         s.sizes = a.sizes;
     }

@@ -215,3 +215,188 @@ fn bad_flags_exit_with_2_and_say_why() {
     }
     assert!(!dir.path().join("bench.csv").exists());
 }
+
+/// A marble ball on a floor under an area light, 32×24: every query kind
+/// of the renderer (camera, bounces, shadow rays, probes) in a second.
+const TINY_SCENE: &str = r#"
+units_per_mm = 0.1
+[camera]
+look_from = [0.0, 3.0, 8.0]
+look_at = [0.0, 1.0, 0.0]
+fov_y = 35.0
+resolution = [32, 24]
+[render]
+spp = 64
+max_depth = 6
+[environment]
+radiance = [0.05, 0.06, 0.08]
+[materials.floor]
+type = "diffuse"
+albedo = [0.7, 0.7, 0.7]
+[materials.lamp]
+type = "diffuse"
+albedo = [0.0, 0.0, 0.0]
+[materials.marble]
+type = "subsurface"
+preset = "marble"
+[[shapes]]
+name = "floor"
+type = "quad"
+material = "floor"
+scale = 10
+rotate = [[-90, 1, 0, 0]]
+[[shapes]]
+name = "light"
+type = "quad"
+material = "lamp"
+emission = [8, 8, 8]
+rotate = [[90, 1, 0, 0]]
+translate = [0, 5, 0]
+[[shapes]]
+name = "ball"
+type = "sphere"
+subdivisions = 3
+material = "marble"
+translate = [0, 1, 0]
+"#;
+
+/// The render-mix CSV as maps from column name to value.
+fn parse_mix(text: &str) -> Vec<BTreeMap<String, String>> {
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            assert_eq!(f.len(), head.len(), "{l}");
+            head.iter()
+                .zip(f)
+                .map(|(h, v)| (h.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn scene_bench_replays_the_renders_queries() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiny.toml");
+    std::fs::write(&scene, TINY_SCENE).unwrap();
+    let out_dir = dir.path().join("out");
+    let out = lucent()
+        .args(["bench", "--spp", "1", "--threads", "1,2", "-q", "--scene"])
+        .arg(&scene)
+        .arg("-o")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("ratio") && stdout.contains("probe"),
+        "{stdout}"
+    );
+    assert!(out_dir.join("render-mix.txt").is_file());
+
+    let rows = parse_mix(&std::fs::read_to_string(out_dir.join("render-mix.csv")).unwrap());
+    let backends = backends();
+    // build.rs sets cfg(lucent_embree) for the tests as for the binary.
+    assert_eq!(backends.contains("embree"), cfg!(lucent_embree));
+    let seen: BTreeSet<(String, String)> = rows
+        .iter()
+        .map(|r| (r["backend"].clone(), r["threads"].clone()))
+        .collect();
+    let want: BTreeSet<(String, String)> = backends
+        .iter()
+        .flat_map(|b| ["1", "2"].map(|t| (b.clone(), t.to_string())))
+        .collect();
+    assert_eq!(seen, want);
+    assert_eq!(rows.len(), want.len());
+
+    let num = |r: &BTreeMap<String, String>, c: &str| -> f64 {
+        r[c].parse()
+            .unwrap_or_else(|e| panic!("{c} = {:?}: {e}", r[c]))
+    };
+    let kinds = ["camera", "nearest", "occluded", "probe"];
+    for r in &rows {
+        assert_eq!(r["scene"], "tiny");
+        assert_eq!(
+            (num(r, "width"), num(r, "height"), num(r, "spp")),
+            (32.0, 24.0, 1.0)
+        );
+        let ratio = num(r, "ratio");
+        assert!(ratio > 0.0 && ratio <= 1.5, "ratio {ratio}: {r:?}");
+        // Every ray the renderer counts is one recorded query.
+        let rays = num(r, "render_rays");
+        assert!(rays > 0.0);
+        assert_eq!(num(r, "records"), rays, "{r:?}");
+        // The kinds partition the records: one camera ray per pixel, and
+        // the other kinds all occur in this scene.
+        let sum: f64 = kinds.iter().map(|k| num(r, &format!("{k}_queries"))).sum();
+        assert_eq!(sum, rays);
+        assert_eq!(num(r, "camera_queries"), 32.0 * 24.0);
+        for k in kinds {
+            assert!(num(r, &format!("{k}_queries")) > 0.0, "{k}: {r:?}");
+            let m = num(r, &format!("{k}_mrays_per_s"));
+            assert!(m > 0.0 && m.is_finite(), "{k}: {r:?}");
+        }
+        // The derived columns agree with the raw ones.
+        let render = num(r, "render_mrays_per_s");
+        let raw = num(r, "raw_mrays_per_s");
+        assert!((render / raw / ratio - 1.0).abs() < 0.01, "{r:?}");
+        assert!((rays / num(r, "render_s") / 1e6 / render - 1.0).abs() < 0.01);
+        // Records = rays, so the ratio is the queries' share of the render.
+        assert!((num(r, "query_share") / ratio - 1.0).abs() < 0.01, "{r:?}");
+        assert!(num(r, "render_cpu_per_wall") > 0.0);
+        let rc = num(r, "ratio_cpu");
+        assert!(rc > 0.0 && rc <= 2.0, "ratio_cpu {rc}: {r:?}");
+    }
+    // The same render on any thread count issues the same queries with the
+    // same answers.
+    for b in &backends {
+        let rs: Vec<_> = rows.iter().filter(|r| &r["backend"] == b).collect();
+        for c in [
+            "render_rays",
+            "camera_hits",
+            "nearest_hits",
+            "occluded_hits",
+            "probe_hits",
+        ] {
+            assert_eq!(rs[0][c], rs[1][c], "{b} {c}");
+        }
+    }
+}
+
+#[test]
+fn scene_bench_bad_input_exits_with_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiny.toml");
+    std::fs::write(&scene, TINY_SCENE).unwrap();
+    let missing = dir.path().join("nope.toml");
+    let s = scene.to_str().unwrap();
+    let mut cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--scene", missing.to_str().unwrap()], "nope.toml"),
+        (vec!["--scene", s, "--spp", "0"], "--spp"),
+        (vec!["--scene", s, "--quick"], "--quick"),
+        (vec!["--scene", s, "--sizes", "1k"], "--sizes"),
+        (vec!["--spp", "4"], "--scene"),
+        (vec!["--scene", s, "--accel", "optix"], "optix"),
+    ];
+    if !cfg!(lucent_embree) {
+        cases.push((vec!["--scene", s, "--accel", "embree"], "without Embree"));
+    }
+    for (args, needle) in cases {
+        let out = lucent()
+            .arg("bench")
+            .args(&args)
+            .arg("-o")
+            .arg(dir.path().join("out"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    assert!(!dir.path().join("out").join("render-mix.csv").exists());
+}

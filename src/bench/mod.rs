@@ -20,10 +20,15 @@
 //! difference beyond rays that graze an edge is an error. Results go to
 //! `DIR/bench.csv`, a table on stdout (also `DIR/report.txt`) and log-log
 //! plots `DIR/bench-<query>.png` of time per ray against triangle count.
+//!
+//! With a scene ([`replay`], `lucent bench --scene`) it measures instead the
+//! renderer's end-to-end ray rate against the backend's raw rate on the
+//! very queries that render issued (recorded, then replayed).
 
 pub mod measure;
 pub mod plot;
 pub mod rays;
+pub mod replay;
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
