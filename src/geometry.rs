@@ -94,7 +94,11 @@ impl Mesh {
         self.indices.len()
     }
     pub fn triangle(&self, prim: u32) -> [Vec3; 3] {
-        let [a, b, c] = self.indices[prim as usize];
+        self.vertices(self.indices[prim as usize])
+    }
+    /// The positions of the vertices with indices `[a, b, c]`.
+    #[inline]
+    pub fn vertices(&self, [a, b, c]: [u32; 3]) -> [Vec3; 3] {
         let p = &self.positions;
         [p[a as usize], p[b as usize], p[c as usize]]
     }

@@ -3,20 +3,35 @@
 //! proportion to its power (area × luminance) and a uniform point on it
 //! (pbrt-v4 §12.5 and §12.6, without light BVHs).
 
-use crate::geometry::{Mesh, Vec3};
+use crate::geometry::Vec3;
 use crate::sampling::{uniform_triangle, Distribution1D};
 use crate::scene::Scene;
 
 /// The emissive triangles of a scene and the distribution NEE samples from.
 #[derive(Clone, Debug, Default)]
 pub struct LightSet {
-    /// (geom, prim) of each emissive triangle, in distribution order.
-    tris: Vec<(u32, u32)>,
+    /// Each emissive triangle, in distribution order.
+    tris: Vec<LightTri>,
     dist: Distribution1D,
     /// For each geom: index of its first triangle in `tris`, or None.
     first: Vec<Option<u32>>,
 }
 
+/// What sampling a point on one emissive triangle needs, computed once so
+/// next-event estimation and the MIS weight of emission found by lobe
+/// sampling do not redo the cross product, area and pmf at every vertex.
+#[derive(Clone, Copy, Debug)]
+struct LightTri {
+    a: Vec3,
+    /// b − a and c − a.
+    e1: Vec3,
+    e2: Vec3,
+    /// Unit front-face normal.
+    normal: Vec3,
+    radiance: Vec3,
+    /// pmf / area: the area density of a point on it; 0 if degenerate.
+    pdf_area: f32,
+}
 /// A point sampled on a light.
 pub struct LightSample {
     pub point: Vec3,
@@ -44,15 +59,30 @@ impl LightSet {
             }
             first[g] = Some(tris.len() as u32);
             for p in 0..mesh.triangle_count() as u32 {
-                tris.push((g as u32, p));
+                let [a, b, c] = mesh.triangle(p);
+                let n = (b - a).cross(c - a);
+                tris.push(LightTri {
+                    a,
+                    e1: b - a,
+                    e2: c - a,
+                    normal: n.normalize_or_zero(),
+                    radiance: le,
+                    pdf_area: 0.0,
+                });
                 weights.push(mesh.area(p) as f64 * power);
             }
         }
-        LightSet {
-            tris,
-            dist: Distribution1D::new(&weights),
-            first,
+        let dist = Distribution1D::new(&weights);
+        for (i, t) in tris.iter_mut().enumerate() {
+            let area = 0.5 * t.e1.cross(t.e2).length();
+            let pmf = dist.pmf(i);
+            t.pdf_area = if pmf > 0.0 && area > 0.0 {
+                pmf / area
+            } else {
+                0.0
+            };
         }
+        LightSet { tris, dist, first }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -60,41 +90,28 @@ impl LightSet {
     }
 
     /// Samples a light point with one selection number and two for the point.
-    pub fn sample(&self, scene: &Scene, u_pick: f32, u: [f32; 2]) -> Option<LightSample> {
+    pub fn sample(&self, u_pick: f32, u: [f32; 2]) -> Option<LightSample> {
         if self.is_empty() {
             return None;
         }
-        let (i, pmf) = self.dist.sample(u_pick);
-        let (g, p) = self.tris[i];
-        let mesh = &scene.meshes[g as usize];
-        let [a, b, c] = mesh.triangle(p);
-        let [b1, b2] = uniform_triangle(u);
-        let point = a * (1.0 - b1 - b2) + b * b1 + c * b2;
-        let n = (b - a).cross(c - a);
-        let area = 0.5 * n.length();
-        if pmf <= 0.0 || area <= 0.0 {
+        let t = &self.tris[self.dist.sample_index(u_pick)];
+        if t.pdf_area <= 0.0 {
             return None;
         }
+        let [b1, b2] = uniform_triangle(u);
         Some(LightSample {
-            point,
-            normal: n.normalize(),
-            radiance: scene.objects[g as usize].emission.unwrap_or(Vec3::ZERO),
-            pdf_area: pmf / area,
+            point: t.a + t.e1 * b1 + t.e2 * b2,
+            normal: t.normal,
+            radiance: t.radiance,
+            pdf_area: t.pdf_area,
         })
     }
 
     /// The area density with which [`sample`](Self::sample) picks a point on
     /// triangle (geom, prim); 0 for non-emitters.
-    pub fn pdf_area(&self, meshes: &[Mesh], geom: u32, prim: u32) -> f32 {
+    pub fn pdf_area(&self, geom: u32, prim: u32) -> f32 {
         match self.first.get(geom as usize).copied().flatten() {
-            Some(f) => {
-                let area = meshes[geom as usize].area(prim);
-                if area > 0.0 {
-                    self.dist.pmf((f + prim) as usize) / area
-                } else {
-                    0.0
-                }
-            }
+            Some(f) => self.tris[(f + prim) as usize].pdf_area,
             None => 0.0,
         }
     }

@@ -20,10 +20,13 @@ pub struct Interaction {
 
 impl Interaction {
     pub fn new(mesh: &Mesh, ray: &Ray, hit: &Hit) -> Self {
-        let [a, b, c] = mesh.triangle(hit.prim);
+        let idx = mesh.indices[hit.prim as usize];
+        let [a, b, c] = mesh.vertices(idx);
         let (u, v) = (hit.u, hit.v);
-        let p = a * (1.0 - u - v) + b * u + c * v;
-        let ng = (b - a).cross(c - a).normalize_or_zero();
+        // The edges serve both the point and the normal.
+        let (e1, e2) = (b - a, c - a);
+        let p = a + e1 * u + e2 * v;
+        let ng = e1.cross(e2).normalize_or_zero();
         // Degenerate triangles never hit in either backend, but keep a valid
         // normal if one does.
         let ng = if ng == Vec3::ZERO {
@@ -33,7 +36,7 @@ impl Interaction {
         };
         let ns = match &mesh.normals {
             Some(ns) => {
-                let [i0, i1, i2] = mesh.indices[hit.prim as usize];
+                let [i0, i1, i2] = idx;
                 let n = ns[i0 as usize] * (1.0 - u - v) + ns[i1 as usize] * u + ns[i2 as usize] * v;
                 let n = n.normalize_or_zero();
                 if n == Vec3::ZERO {

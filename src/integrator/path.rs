@@ -299,9 +299,8 @@ fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3
         None => 1.0,
         Some((p0, pdf_lobe)) => {
             let cos_l = wo.dot(si.ng);
-            let pdf_light = ctx.lights.pdf_area(&ctx.scene.meshes, si.geom, si.prim)
-                * (si.p - p0).length_squared()
-                / cos_l;
+            let pdf_light =
+                ctx.lights.pdf_area(si.geom, si.prim) * (si.p - p0).length_squared() / cos_l;
             power(pdf_lobe, pdf_light)
         }
     }
@@ -312,7 +311,7 @@ fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3
 fn direct_lighting(ctx: &Context, v: &Vertex, rng: &mut Rng, counters: &mut Counters) -> Vec3 {
     let u_pick = rng.uniform();
     let u = rng.uniform2();
-    let Some(ls) = ctx.lights.sample(ctx.scene, u_pick, u) else {
+    let Some(ls) = ctx.lights.sample(u_pick, u) else {
         return Vec3::ZERO;
     };
     let to_light = ls.point - v.p;

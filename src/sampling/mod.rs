@@ -95,12 +95,16 @@ impl Distribution1D {
     }
     /// Returns (index, probability of that index).
     pub fn sample(&self, u: f32) -> (usize, f32) {
-        let target = u as f64 * self.total;
-        let i = self
-            .cdf
-            .partition_point(|&c| c <= target)
-            .min(self.cdf.len() - 1);
+        let i = self.sample_index(u);
         (i, self.pmf(i))
+    }
+    /// The index alone, for callers that stored its probability.
+    #[inline]
+    pub fn sample_index(&self, u: f32) -> usize {
+        let target = u as f64 * self.total;
+        self.cdf
+            .partition_point(|&c| c <= target)
+            .min(self.cdf.len() - 1)
     }
     pub fn pmf(&self, i: usize) -> f32 {
         let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
