@@ -125,13 +125,19 @@ pub struct ProbeRandoms {
 }
 
 impl ProbeRandoms {
+    /// Four draws instead of six: only the radius needs 53 bits (its
+    /// inverse CDF resolves the tails); the discrete choices and the angle
+    /// share draws at 32 bits each.
     pub fn from_rng(rng: &mut Rng) -> Self {
+        let radius = rng.uniform_f64();
+        let [axis, channel] = rng.uniform2_f64_32();
+        let [angle, hit] = rng.uniform2_f64_32();
         ProbeRandoms {
-            axis: rng.uniform_f64(),
-            channel: rng.uniform_f64(),
-            radius: rng.uniform_f64(),
-            angle: rng.uniform_f64(),
-            hit: rng.uniform_f64(),
+            axis,
+            channel,
+            radius,
+            angle,
+            hit,
             seed: rng.next_u32(),
         }
     }

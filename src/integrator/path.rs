@@ -309,9 +309,8 @@ fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3
 /// Next-event estimation at a vertex: one light sample, weighted by the
 /// power heuristic against lobe sampling of the same direction.
 fn direct_lighting(ctx: &Context, v: &Vertex, rng: &mut Rng, counters: &mut Counters) -> Vec3 {
-    let u_pick = rng.uniform();
-    let u = rng.uniform2();
-    let Some(ls) = ctx.lights.sample(u_pick, u) else {
+    let [u_pick, u0, u1] = rng.uniform3();
+    let Some(ls) = ctx.lights.sample(u_pick, [u0, u1]) else {
         return Vec3::ZERO;
     };
     let to_light = ls.point - v.p;
