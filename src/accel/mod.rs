@@ -122,13 +122,19 @@ impl ProbeHits {
     /// Sorts the kept hits by t (ties by prim), called once after traversal.
     pub fn finish(&mut self) {
         let n = self.len;
+        // Most probe segments meet the surface once or twice: no sort then.
+        if n < 2 {
+            return;
+        }
+        if n == 2 {
+            if by_t(&self.hits[0], &self.hits[1]).is_gt() {
+                self.hits.swap(0, 1);
+                self.keys.swap(0, 1);
+            }
+            return;
+        }
         let mut idx: [usize; MAX_PROBE_HITS] = std::array::from_fn(|i| i);
-        idx[..n].sort_unstable_by(|&a, &b| {
-            let (ha, hb) = (&self.hits[a], &self.hits[b]);
-            ha.t.total_cmp(&hb.t)
-                .then(ha.geom.cmp(&hb.geom))
-                .then(ha.prim.cmp(&hb.prim))
-        });
+        idx[..n].sort_unstable_by(|&a, &b| by_t(&self.hits[a], &self.hits[b]));
         let hits = self.hits;
         let keys = self.keys;
         for (dst, &src) in idx[..n].iter().enumerate() {
@@ -145,6 +151,13 @@ impl ProbeHits {
     pub fn total(&self) -> usize {
         self.total
     }
+}
+
+/// The order of [`ProbeHits::hits`]: by t, ties by (geom, prim).
+fn by_t(a: &Hit, b: &Hit) -> std::cmp::Ordering {
+    a.t.total_cmp(&b.t)
+        .then(a.geom.cmp(&b.geom))
+        .then(a.prim.cmp(&b.prim))
 }
 
 /// A ray-query backend built over the scene's meshes (mesh index = `geom`).
