@@ -79,9 +79,7 @@ impl Settings {
     /// Defaults of the full run, or of `--quick` (3 sizes up to 80k
     /// triangles, 16k rays, short timing): under a minute on two busy cores.
     pub fn new(out: impl Into<PathBuf>, quick: bool) -> Settings {
-        let all = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let mut threads = vec![1, all];
-        threads.dedup();
+        let threads = default_threads();
         Settings {
             out: out.into(),
             sizes: if quick {
@@ -111,6 +109,14 @@ pub fn default_bunny() -> Option<PathBuf> {
     ]
     .into_iter()
     .find(|p| p.is_file())
+}
+
+/// One thread and all cores (just `[1]` on a one-core machine).
+pub fn default_threads() -> Vec<usize> {
+    let all = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut threads = vec![1, all];
+    threads.dedup();
+    threads
 }
 
 /// Our BVH, and Embree when lucent was built with it.

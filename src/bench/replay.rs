@@ -441,9 +441,7 @@ pub const DEFAULT_MAX_RECORDS: usize = 32_000_000;
 
 impl Settings {
     pub fn new(scene: impl Into<PathBuf>, out: impl Into<PathBuf>) -> Settings {
-        let all = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let mut threads = vec![1, all];
-        threads.dedup();
+        let threads = super::default_threads();
         Settings {
             scene: scene.into(),
             out: out.into(),
