@@ -216,49 +216,12 @@ fn bad_flags_exit_with_2_and_say_why() {
     assert!(!dir.path().join("bench.csv").exists());
 }
 
-/// A marble ball on a floor under an area light, 32×24: every query kind
-/// of the renderer (camera, bounces, shadow rays, probes) in a second.
-const TINY_SCENE: &str = r#"
-units_per_mm = 0.1
-[camera]
-look_from = [0.0, 3.0, 8.0]
-look_at = [0.0, 1.0, 0.0]
-fov_y = 35.0
-resolution = [32, 24]
-[render]
-spp = 64
-max_depth = 6
-[environment]
-radiance = [0.05, 0.06, 0.08]
-[materials.floor]
-type = "diffuse"
-albedo = [0.7, 0.7, 0.7]
-[materials.lamp]
-type = "diffuse"
-albedo = [0.0, 0.0, 0.0]
-[materials.marble]
-type = "subsurface"
-preset = "marble"
-[[shapes]]
-name = "floor"
-type = "quad"
-material = "floor"
-scale = 10
-rotate = [[-90, 1, 0, 0]]
-[[shapes]]
-name = "light"
-type = "quad"
-material = "lamp"
-emission = [8, 8, 8]
-rotate = [[90, 1, 0, 0]]
-translate = [0, 5, 0]
-[[shapes]]
-name = "ball"
-type = "sphere"
-subdivisions = 3
-material = "marble"
-translate = [0, 1, 0]
-"#;
+/// A marble ball on a floor under an area light, 24×16: every query kind
+/// of the renderer (camera rays, bounces, shadow rays, probes) in a second.
+const MARBLE_BALL: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/fixtures/marble-ball.toml"
+);
 
 /// The render-mix CSV as maps from column name to value.
 fn parse_mix(text: &str) -> Vec<BTreeMap<String, String>> {
@@ -279,12 +242,10 @@ fn parse_mix(text: &str) -> Vec<BTreeMap<String, String>> {
 #[test]
 fn scene_bench_replays_the_renders_queries() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("tiny.toml");
-    std::fs::write(&scene, TINY_SCENE).unwrap();
     let out_dir = dir.path().join("out");
     let out = lucent()
         .args(["bench", "--spp", "1", "--threads", "1,2", "-q", "--scene"])
-        .arg(&scene)
+        .arg(MARBLE_BALL)
         .arg("-o")
         .arg(&out_dir)
         .output()
@@ -319,13 +280,16 @@ fn scene_bench_replays_the_renders_queries() {
     };
     let kinds = ["camera", "nearest", "occluded", "probe"];
     for r in &rows {
-        assert_eq!(r["scene"], "tiny");
+        assert_eq!(r["scene"], "marble-ball");
         assert_eq!(
             (num(r, "width"), num(r, "height"), num(r, "spp")),
-            (32.0, 24.0, 1.0)
+            (24.0, 16.0, 1.0)
         );
+        // Only that the timings are there: the render and the replay take
+        // a few milliseconds each here, too short for their ratio to mean
+        // anything on a shared machine (that is the bench's job, at size).
         let ratio = num(r, "ratio");
-        assert!(ratio > 0.0 && ratio <= 1.5, "ratio {ratio}: {r:?}");
+        assert!(ratio > 0.0 && ratio.is_finite(), "ratio {ratio}: {r:?}");
         // Every ray the renderer counts is one recorded query.
         let rays = num(r, "render_rays");
         assert!(rays > 0.0);
@@ -334,7 +298,7 @@ fn scene_bench_replays_the_renders_queries() {
         // the other kinds all occur in this scene.
         let sum: f64 = kinds.iter().map(|k| num(r, &format!("{k}_queries"))).sum();
         assert_eq!(sum, rays);
-        assert_eq!(num(r, "camera_queries"), 32.0 * 24.0);
+        assert_eq!(num(r, "camera_queries"), 24.0 * 16.0);
         for k in kinds {
             assert!(num(r, &format!("{k}_queries")) > 0.0, "{k}: {r:?}");
             let m = num(r, &format!("{k}_mrays_per_s"));
@@ -349,7 +313,7 @@ fn scene_bench_replays_the_renders_queries() {
         assert!((num(r, "query_share") / ratio - 1.0).abs() < 0.01, "{r:?}");
         assert!(num(r, "render_cpu_per_wall") > 0.0);
         let rc = num(r, "ratio_cpu");
-        assert!(rc > 0.0 && rc <= 2.0, "ratio_cpu {rc}: {r:?}");
+        assert!(rc > 0.0 && rc.is_finite(), "ratio_cpu {rc}: {r:?}");
     }
     // The same render on any thread count issues the same queries with the
     // same answers.
@@ -370,10 +334,8 @@ fn scene_bench_replays_the_renders_queries() {
 #[test]
 fn scene_bench_bad_input_exits_with_2() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("tiny.toml");
-    std::fs::write(&scene, TINY_SCENE).unwrap();
     let missing = dir.path().join("nope.toml");
-    let s = scene.to_str().unwrap();
+    let s = MARBLE_BALL;
     let mut cases: Vec<(Vec<&str>, &str)> = vec![
         (vec!["--scene", missing.to_str().unwrap()], "nope.toml"),
         (vec!["--scene", s, "--spp", "0"], "--spp"),

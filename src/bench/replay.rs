@@ -1016,48 +1016,7 @@ mod tests {
     use std::sync::Arc;
 
     /// A marble sphere on a floor under an area light: every query kind.
-    const SCENE: &str = r#"
-units_per_mm = 0.1
-[camera]
-look_from = [0.0, 3.0, 8.0]
-look_at = [0.0, 1.0, 0.0]
-fov_y = 35.0
-resolution = [24, 16]
-[render]
-spp = 2
-max_depth = 6
-[environment]
-radiance = [0.05, 0.06, 0.08]
-[materials.floor]
-type = "diffuse"
-albedo = [0.7, 0.7, 0.7]
-[materials.lamp]
-type = "diffuse"
-albedo = [0.0, 0.0, 0.0]
-[materials.marble]
-type = "subsurface"
-preset = "marble"
-[[shapes]]
-name = "floor"
-type = "quad"
-material = "floor"
-scale = 10
-rotate = [[-90, 1, 0, 0]]
-[[shapes]]
-name = "light"
-type = "quad"
-material = "lamp"
-emission = [8, 8, 8]
-scale = [1, 1, 1]
-rotate = [[90, 1, 0, 0]]
-translate = [0, 5, 0]
-[[shapes]]
-name = "ball"
-type = "sphere"
-subdivisions = 3
-material = "marble"
-translate = [0, 1, 0]
-"#;
+    const SCENE: &str = include_str!("../../tests/fixtures/marble-ball.toml");
 
     fn scene() -> Scene {
         crate::scene::load::load_str(SCENE, Path::new("test.toml")).unwrap()
