@@ -25,7 +25,7 @@ fn setup() -> (Vec<Tri4>, Vec<[Vec3; 3]>, Vec<RayTri>) {
         for lane in 0..4 {
             let a = p();
             let tri = [a, a + (p() - 0.5) * 0.4, a + (p() - 0.5) * 0.4];
-            t4.set(lane, tri);
+            t4.set(lane, tri, lane as u32);
             tris.push(tri);
         }
         packets.push(t4);

@@ -111,8 +111,10 @@ pub(super) struct Tree {
 pub(super) const PAD: u32 = u32::MAX;
 
 impl Tree {
+    /// No primitives. (Not `order.is_empty()`: a mesh's tree hands its
+    /// order over to the triangle packets.)
     pub fn is_empty(&self) -> bool {
-        self.order.is_empty()
+        self.nodes.is_empty() && !is_leaf(self.root)
     }
     /// Depth of the deepest leaf (a root leaf has depth 0).
     pub fn depth(&self) -> usize {

@@ -33,8 +33,8 @@ use crate::geometry::{Mesh, Ray};
 /// Most triangles per leaf (two packets); the SAH usually stops earlier.
 const MAX_LEAF: usize = 8;
 
-/// One mesh's hierarchy; `tree.order[4 * i + k]` is the mesh-level index
-/// of lane `k` of `tris[i]` (or [`PAD`] for an empty lane).
+/// One mesh's hierarchy; leaves index `tris`, whose packets carry the
+/// mesh's triangle ids (the tree's `order` is handed over to them).
 #[derive(Clone, Debug, Default)]
 struct MeshBvh {
     tree: Tree,
@@ -68,13 +68,14 @@ impl MeshBvh {
                 })
             })
             .collect();
-        let tree = build::build(prims, MAX_LEAF, 4);
-        let mut tris = mem::with_huge_pages(tree.order.len() / 4);
-        tris.par_extend(tree.order.par_chunks(4).map(|ids| {
+        let mut tree = build::build(prims, MAX_LEAF, 4);
+        let order = std::mem::take(&mut tree.order);
+        let mut tris = mem::with_huge_pages(order.len() / 4);
+        tris.par_extend(order.par_chunks(4).map(|ids| {
             let mut t = Tri4::EMPTY;
             for (k, &id) in ids.iter().enumerate() {
                 if id != PAD {
-                    t.set(k, mesh.triangle(id));
+                    t.set(k, mesh.triangle(id), id);
                 }
             }
             t
@@ -142,9 +143,9 @@ impl Accel for Bvh {
         }
         let rb = RayBox::new(ray);
         let rt = RayTri::new(ray);
-        // (geom, slot, u, v) of the nearest hit so far; its t is the
+        // (geom, prim, u, v) of the nearest hit so far; its t is the
         // running tmax.
-        let mut best: Option<(u32, usize, f32, f32)> = None;
+        let mut best: Option<(u32, u32, f32, f32)> = None;
         let mut t = tmax;
         traverse::<true, _>(&self.top, &[()], &rb, tmin, &mut t, |first, count, t| {
             for k in first..first + count {
@@ -155,7 +156,7 @@ impl Accel for Bvh {
                         let h = rt.intersect4(&m.tris[i], tmin, *t);
                         if let Some(k) = h.nearest() {
                             *t = h.t[k];
-                            best = Some((g, 4 * i + k, h.u[k], h.v[k]));
+                            best = Some((g, m.tris[i].id[k], h.u[k], h.v[k]));
                         }
                     }
                     Visit::Continue
@@ -163,10 +164,10 @@ impl Accel for Bvh {
             }
             Visit::Continue
         });
-        best.map(|(geom, i, u, v)| Hit {
+        best.map(|(geom, prim, u, v)| Hit {
             t,
             geom,
-            prim: self.meshes[geom as usize].tree.order[i],
+            prim,
             u,
             v,
         })
@@ -208,8 +209,8 @@ impl Accel for Bvh {
                 let rt = RayTri::new(ray);
                 let mut t = tmax;
                 traverse::<false, _>(&m.tree, &m.tris, &rb, 0.0, &mut t, |first, count, t| {
-                    for i in first as usize..(first + count) as usize {
-                        let h = rt.intersect4(&m.tris[i], 0.0, *t);
+                    for tri in &m.tris[first as usize..(first + count) as usize] {
+                        let h = rt.intersect4(tri, 0.0, *t);
                         let mut lanes = h.mask;
                         while lanes != 0 {
                             let k = lanes.trailing_zeros() as usize;
@@ -217,7 +218,7 @@ impl Accel for Bvh {
                             out.record(Hit {
                                 t: h.t[k],
                                 geom,
-                                prim: m.tree.order[4 * i + k],
+                                prim: tri.id[k],
                                 u: h.u[k],
                                 v: h.v[k],
                             });
@@ -303,7 +304,8 @@ mod tests {
         // good, NaN, repeated vertex, collinear
         let idx = vec![[0, 1, 2], [0, 3, 1], [0, 0, 2], [0, 1, 4]];
         let bvh = Bvh::build(&[Mesh::new(p, idx, None)]);
-        assert_eq!(bvh.meshes[0].tree.order, [0, PAD, PAD, PAD]);
+        assert_eq!(bvh.meshes[0].tris.len(), 1);
+        assert_eq!(bvh.meshes[0].tris[0].id, [0, PAD, PAD, PAD]);
         let h = bvh
             .intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z), 0.0, 9.0)
             .unwrap();
