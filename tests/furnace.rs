@@ -1,6 +1,9 @@
 //! White-furnace tests of the path tracer: closed-form answers for scenes
 //! where light transport can be summed by hand.
 
+mod common;
+
+use common::backends;
 use std::sync::Arc;
 
 use lucent::accel::{self, Backend};
@@ -9,14 +12,6 @@ use lucent::geometry::Vec3;
 use lucent::materials::Material;
 use lucent::render::{render, RenderOptions};
 use lucent::scene::{shapes, Camera, Object, RenderSettings, Scene};
-
-fn backends() -> Vec<Backend> {
-    let mut b = vec![Backend::Bvh];
-    if cfg!(lucent_embree) {
-        b.push(Backend::Embree);
-    }
-    b
-}
 
 fn scene_with(
     mesh: lucent::geometry::Mesh,

@@ -19,6 +19,9 @@
 // Per-channel arrays are indexed by channel number.
 #![allow(clippy::needless_range_loop)]
 
+mod common;
+
+use common::mean_se;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -128,25 +131,6 @@ fn looking_down(h: f32, fov: f32, res: u32) -> Camera {
 
 fn render_on(scene: &Scene, accel: &dyn Accel) -> (Film, RenderStats) {
     render(scene, accel, &RenderOptions::default()).unwrap()
-}
-
-/// Per-channel mean over the pixels and its standard error.
-fn mean_se(film: &Film) -> ([f64; 3], [f64; 3]) {
-    let n = film.pixels.len() as f64;
-    let mut mean = [0.0; 3];
-    let mut se = [0.0; 3];
-    for c in 0..3 {
-        let m = film.pixels.iter().map(|p| p[c] as f64).sum::<f64>() / n;
-        let var = film
-            .pixels
-            .iter()
-            .map(|p| (p[c] as f64 - m).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
-        mean[c] = m;
-        se[c] = (var / n).sqrt();
-    }
-    (mean, se)
 }
 
 /// No discarded sample, every pixel finite, ≥ 0 and ≤ `bound` (per channel).

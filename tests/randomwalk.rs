@@ -3,6 +3,8 @@
 //! diffusion BSSRDF on the flat-slab ground truth, determinism across thread
 //! counts, and clean termination on open meshes.
 
+mod common;
+
 use std::sync::Arc;
 
 use lucent::accel::{self, Backend};
@@ -91,15 +93,9 @@ fn run(scene: &Scene, integrator: IntegratorKind, threads: Option<usize>) -> (Fi
 
 /// Mean over the image and its standard error (pixels are independent).
 fn mean_and_error(film: &Film) -> (Vec3, Vec3) {
-    let n = film.pixels.len() as f32;
-    let mean = film.pixels.iter().copied().sum::<Vec3>() / n;
-    let var = film
-        .pixels
-        .iter()
-        .map(|p| (*p - mean) * (*p - mean))
-        .sum::<Vec3>()
-        / (n - 1.0);
-    (mean, (var / n).map(f32::sqrt))
+    let (m, se) = common::mean_se(film);
+    let v = |x: [f64; 3]| Vec3::new(x[0] as f32, x[1] as f32, x[2] as f32);
+    (v(m), v(se))
 }
 
 /// A slab 200 × `thickness` × 200 with its top face at y = 0.

@@ -15,6 +15,8 @@
 //!    beam would need ~10⁴ times the samples: the probe would have to land
 //!    on the beam's tiny footprint by chance.
 
+mod common;
+
 use std::path::Path;
 use std::sync::Arc;
 
@@ -26,13 +28,7 @@ use lucent::materials::{Material, SubsurfaceOverrides};
 use lucent::render::{render, RenderOptions};
 use lucent::scene::{self, Camera, Object, Scene};
 
-fn backends() -> Vec<Backend> {
-    let mut b = vec![Backend::Bvh];
-    if cfg!(lucent_embree) {
-        b.push(Backend::Embree);
-    }
-    b
-}
+use common::{backends, mean_se};
 
 fn slab_scene() -> Scene {
     scene::load(Path::new(concat!(
@@ -66,26 +62,6 @@ fn render_film(scene: &Scene, backend: Backend, spp: u32, seed: u64) -> Film {
     )
     .unwrap()
     .0
-}
-
-/// Per-channel mean over the image and its standard error (pixels are
-/// independent estimates).
-fn mean_and_se(film: &Film) -> ([f64; 3], [f64; 3]) {
-    let n = film.pixels.len() as f64;
-    let mut mean = [0.0; 3];
-    let mut se = [0.0; 3];
-    for c in 0..3 {
-        let m = film.pixels.iter().map(|p| p[c] as f64).sum::<f64>() / n;
-        let var = film
-            .pixels
-            .iter()
-            .map(|p| (p[c] as f64 - m).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
-        mean[c] = m;
-        se[c] = (var / n).sqrt();
-    }
-    (mean, se)
 }
 
 /// Ground truth 1. Tolerance 1 % of A per channel for the exact samplers
@@ -139,7 +115,7 @@ fn uniformly_lit_slab_reflects_its_albedo() {
             };
             let mut scene = base.clone();
             ov.apply_all(&mut scene.materials).unwrap();
-            let (mean, se) = mean_and_se(&render_film(&scene, backend, spp, i as u64));
+            let (mean, se) = mean_se(&render_film(&scene, backend, spp, i as u64));
             eprintln!("{backend:?} {ov:?}: mean {mean:.4?} se {se:.5?}");
             for c in 0..3 {
                 let err = (mean[c] - a[c] as f64).abs() / a[c] as f64;
@@ -244,7 +220,7 @@ fn pencil_beam_profile_follows_a_times_r() {
                 emission: Some(Vec3::splat(le)),
             });
             let film = render_film(&s, backend, 32768, 100 + bin as u64);
-            let (mean, se) = mean_and_se(&film);
+            let (mean, se) = mean_se(&film);
             for c in 0..3 {
                 let expect = annulus_reference(
                     ss.params.albedo[c],

@@ -2,6 +2,8 @@
 //! that follow from the math (docs/bssrdf.md), resumption from the CSV, the
 //! outputs, and the command line's handling of bad input.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -10,6 +12,8 @@ use lucent::film::Film;
 use lucent::materials::Material;
 use lucent::study::results::Row;
 use lucent::study::{self, config, Axis, Settings};
+
+use common::mean_se;
 
 fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -27,21 +31,6 @@ fn row<'a>(rows: &'a [Row], config: &str, spp: u32) -> &'a Row {
     rows.iter()
         .find(|r| r.config == config && r.spp == spp)
         .unwrap_or_else(|| panic!("no row {config} @ {spp}"))
-}
-
-/// Per channel: mean over pixels and its standard error.
-fn channel_means(f: &Film) -> [(f64, f64); 3] {
-    let n = f.pixels.len() as f64;
-    std::array::from_fn(|c| {
-        let m = f.pixels.iter().map(|p| p[c] as f64).sum::<f64>() / n;
-        let var = f
-            .pixels
-            .iter()
-            .map(|p| (p[c] as f64 - m).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
-        (m, (var / n).sqrt())
-    })
 }
 
 fn assert_png(path: &Path) {
@@ -106,8 +95,9 @@ fn slab_exact_samplers_are_unbiased_and_outputs_exist() {
                 .join(format!("{}.exr", study::slug(name))),
         )
         .unwrap();
-        for (c, (m, se)) in channel_means(&img).into_iter().enumerate() {
-            let e = expected[c];
+        let (mean, se) = mean_se(&img);
+        for c in 0..3 {
+            let (m, se, e) = (mean[c], se[c], expected[c]);
             assert!(
                 (m - e).abs() < 4.0 * se + 2e-4 * e,
                 "{name} channel {c}: mean {m} vs A·CDF(Rmax) {e} (se {se})"
