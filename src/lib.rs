@@ -11,6 +11,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod lights;
 pub mod materials;
+pub mod plot;
 pub mod render;
 pub mod sampling;
 pub mod scene;

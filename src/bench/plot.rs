@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use plotters::prelude::*;
 
 use super::{QueryKind, Row};
-use crate::study::plots::{color, ensure_font, log_range, png, FONT};
+use crate::plot::{color, ensure_font, log_range, png, FONT};
 
 type Series = (String, Vec<(f64, f64)>);
 
