@@ -1,9 +1,7 @@
 //! The bench's plots: per query, time per ray against triangle count on the
 //! displaced spheres, log-log, one line per (backend, threads); and build
 //! time against triangle count per backend. Canvas, PNG writing, palette,
-//! axis ranges and font are `lucent study`'s ([`crate::study::plots`]):
-//! plotters' `ab_glyph` text from a TrueType file (`$LUCENT_FONT` or
-//! Debian's `fonts-dejavu-core`), so no fontconfig is needed.
+//! axis ranges and font are the shared ones of [`crate::plot`].
 
 use std::path::{Path, PathBuf};
 
