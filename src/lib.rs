@@ -1,6 +1,6 @@
 //! lucent: a CPU path tracer for translucent materials.
 //!
-//! Data flows one way: [`scene::load`] → [`accel::build`] →
+//! Data flows one way: [`scene::load()`] → [`accel::build`] →
 //! [`integrator`] (rendered in tiles by [`render`]) → [`film`] output.
 
 pub mod accel;

@@ -1,7 +1,7 @@
 //! Serde structures of the TOML scene format (`docs/scene-format.md`).
 //!
 //! These types only describe the *shape* of a scene file: every table
-//! rejects unknown keys, and every value that [`super::load`] validates
+//! rejects unknown keys, and every value that [`super::load()`] validates
 //! afterwards is wrapped in [`Spanned`] so a rejected value can be reported
 //! with its line. Range checks, name resolution and conversion to a
 //! [`super::Scene`] live in `load.rs`.

@@ -1,4 +1,4 @@
-//! Scene loading and validation: TOML text → [`format::SceneFile`] →
+//! Scene loading and validation: TOML text → [`super::format::SceneFile`] →
 //! checked values → [`Scene`].
 //!
 //! Every failure is a [`SceneError`] that names the file, the line whenever

@@ -1,5 +1,5 @@
 //! The scene: camera, render settings, meshes with their materials and
-//! emission, and the environment. [`load`] reads one from a TOML file (the
+//! emission, and the environment. [`load()`] reads one from a TOML file (the
 //! format is documented in `docs/scene-format.md`); everything downstream
 //! only reads a finished `Scene`.
 

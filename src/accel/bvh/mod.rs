@@ -1,7 +1,7 @@
 //! Our own BVH: the reference [`Accel`] backend.
 //!
 //! Two levels: one binned-SAH hierarchy per mesh, collapsed to 8-wide
-//! nodes ([`build`]), and a small top-level hierarchy over the meshes'
+//! nodes (`build.rs`), and a small top-level hierarchy over the meshes'
 //! bounds. Nearest-hit and occlusion
 //! queries walk the top level and descend into the meshes whose boxes the
 //! ray meets; [`Accel::hits_on_segment`] asks about one mesh and so walks
