@@ -19,14 +19,15 @@ pub struct Interaction {
 }
 
 impl Interaction {
-    pub fn new(mesh: &Mesh, ray: &Ray, hit: &Hit) -> Self {
+    /// `face_normals` is [`face_normals`] of `mesh`: the unit normal is
+    /// per triangle, so it is normalized once per scene instead of at every
+    /// hit.
+    pub fn new(mesh: &Mesh, face_normals: &[Vec3], ray: &Ray, hit: &Hit) -> Self {
         let idx = mesh.indices[hit.prim as usize];
         let [a, b, c] = mesh.vertices(idx);
         let (u, v) = (hit.u, hit.v);
-        // The edges serve both the point and the normal.
-        let (e1, e2) = (b - a, c - a);
-        let p = a + e1 * u + e2 * v;
-        let ng = e1.cross(e2).normalize_or_zero();
+        let p = a + (b - a) * u + (c - a) * v;
+        let ng = face_normals[hit.prim as usize];
         // Degenerate triangles never hit in either backend, but keep a valid
         // normal if one does.
         let ng = if ng == Vec3::ZERO {
@@ -76,6 +77,18 @@ impl Interaction {
     pub fn spawn(&self, dir: Vec3, eps: f32) -> Ray {
         Ray::new(offset_origin(self.p, self.ng, dir, eps), dir)
     }
+}
+
+/// The unit geometric normal of each triangle of `mesh` (front face by
+/// counter-clockwise winding), zero for degenerate triangles.
+pub fn face_normals(mesh: &Mesh) -> Vec<Vec3> {
+    mesh.indices
+        .iter()
+        .map(|&idx| {
+            let [a, b, c] = mesh.vertices(idx);
+            (b - a).cross(c - a).normalize_or_zero()
+        })
+        .collect()
 }
 
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3, eps: f32) -> Vec3 {

@@ -27,6 +27,8 @@ pub struct Context<'a> {
     pub plan: Plan,
     /// Minimum offset for spawned rays, from the scene's size.
     pub ray_epsilon: f32,
+    /// Per mesh, [`interaction::face_normals`].
+    pub face_normals: Vec<Vec<glam::Vec3>>,
 }
 
 impl<'a> Context<'a> {
@@ -44,7 +46,15 @@ impl<'a> Context<'a> {
             lights: LightSet::new(scene),
             plan: Plan::new(scene),
             ray_epsilon: extent * 1e-6,
+            face_normals: scene.meshes.iter().map(interaction::face_normals).collect(),
         }
+    }
+
+    /// The surface geometry at `hit` on the ray `ray`.
+    #[inline]
+    pub fn interaction(&self, ray: &crate::geometry::Ray, hit: &crate::accel::Hit) -> Interaction {
+        let g = hit.geom as usize;
+        Interaction::new(&self.scene.meshes[g], &self.face_normals[g], ray, hit)
     }
 }
 

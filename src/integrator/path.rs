@@ -145,9 +145,8 @@ pub(crate) fn trace<'s>(
             }
             break;
         };
-        let mesh = &scene.meshes[hit.geom as usize];
         let object = &scene.objects[hit.geom as usize];
-        let si = Interaction::new(mesh, &ray, &hit);
+        let si = ctx.interaction(&ray, &hit);
         let wo = -ray.d;
 
         // Le, MIS-weighted against next-event estimation.

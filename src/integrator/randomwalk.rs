@@ -47,7 +47,7 @@
 //! [`Counters::walks_escaped`]) instead of scattering through infinite space.
 
 use super::path::{trace, Scatter, Scratch};
-use super::{Context, Counters, Interaction};
+use super::{Context, Counters};
 use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
 use crate::geometry::{Frame, Ray, Vec3};
@@ -200,8 +200,7 @@ fn cross_boundary(
     hit: &Hit,
     rng: &mut Rng,
 ) -> (bool, Ray, f32) {
-    let mesh = &ctx.scene.meshes[hit.geom as usize];
-    let si = Interaction::new(mesh, ray, hit);
+    let si = ctx.interaction(ray, hit);
     // Outside is where the ray is heading.
     let n_out = if ray.d.dot(si.ng) > 0.0 {
         si.ng
