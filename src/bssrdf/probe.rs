@@ -345,7 +345,7 @@ impl ProbeSampler {
         let r = dist.sample_radius(u.radius);
         // The angle in f32: its rounding moves p0 by ~1e-7·r, below the f32
         // rounding of p0 itself.
-        let (sin, cos) = (2.0 * std::f32::consts::PI * u.angle as f32).sin_cos();
+        let (sin, cos) = crate::sampling::sin_cos_turns(u.angle as f32);
         let h = (self.rmax * self.rmax - r * r).max(0.0).sqrt();
         let xo64 = xo.as_dvec3();
         let p0 = xo64 + (t1 * cos as f64 + t2 * sin as f64) * r + v * h;
