@@ -39,13 +39,20 @@ impl Interaction {
             Some(ns) => {
                 let [i0, i1, i2] = idx;
                 let n = ns[i0 as usize] * (1.0 - u - v) + ns[i1 as usize] * u + ns[i2 as usize] * v;
-                let n = n.normalize_or_zero();
-                if n == Vec3::ZERO {
-                    ng
-                } else if n.dot(ng) < 0.0 {
-                    -n
+                // normalize_or_zero's test without its zero vector: the
+                // reciprocal length is finite and positive exactly when
+                // 0 < |n|² < ∞ (the smallest subnormal |n|² still has a
+                // finite 1/|n|), so this is the same normal bit for bit.
+                let len2 = n.length_squared();
+                if len2 > 0.0 && len2 < f32::INFINITY {
+                    let n = n * (1.0 / len2.sqrt());
+                    if n.dot(ng) < 0.0 {
+                        -n
+                    } else {
+                        n
+                    }
                 } else {
-                    n
+                    ng
                 }
             }
             None => ng,
@@ -92,7 +99,14 @@ pub fn face_normals(mesh: &Mesh) -> Vec<Vec3> {
 }
 
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3, eps: f32) -> Vec3 {
-    let e = eps.max(p.abs().max_element() * 4e-6);
     let n = if dir.dot(ng) >= 0.0 { ng } else { -ng };
+    offset_along(p, n, eps)
+}
+
+/// [`offset_origin`] for callers that already know the ray leaves on the
+/// side `n` faces (they tested `dir · n > 0` to cull the direction).
+#[inline]
+pub fn offset_along(p: Vec3, n: Vec3, eps: f32) -> Vec3 {
+    let e = eps.max(p.abs().max_element() * 4e-6);
     p + n * e
 }

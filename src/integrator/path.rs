@@ -15,7 +15,7 @@
 //! `max_depth` bounces or by Russian roulette once their throughput is
 //! small (pbrt-v4 §13.1.1).
 
-use super::interaction::offset_origin;
+use super::interaction::offset_along;
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
 use crate::bssrdf::ProbeRandoms;
@@ -206,7 +206,7 @@ pub(crate) fn trace<'s>(
         }
         beta *= weight;
         prev = Some((vertex.p, pdf));
-        ray = Ray::new(offset_origin(vertex.p, vertex.ng, wi, ctx.ray_epsilon), wi);
+        ray = Ray::new(offset_along(vertex.p, vertex.ng, ctx.ray_epsilon), wi);
         if !roulette(depth, &mut beta, rng) {
             break;
         }
@@ -329,7 +329,7 @@ fn direct_lighting(ctx: &Context, v: &Vertex, rng: &mut Rng, counters: &mut Coun
     }
     let pdf_light = ls.pdf_area * dist2 / cos_l;
     counters.rays += 1;
-    let origin = offset_origin(v.p, v.ng, wi, ctx.ray_epsilon);
+    let origin = offset_along(v.p, v.ng, ctx.ray_epsilon);
     // t is in units of |d| = the distance to the light point; stop just short
     // of it so the light's own triangle does not shadow itself.
     if ctx
