@@ -170,12 +170,15 @@ fn render_tile(
     let mut counters = Counters::default();
     let mut scratch = Scratch::default();
     let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+    let seed_key = Rng::seed_key(scene.settings.seed);
     for y in y0..y1 {
         for x in x0..x1 {
             let pixel = y as u64 * w as u64 + x as u64;
+            let pixel_key = Rng::pixel_key(seed_key, pixel);
             let mut sum = [0f64; 3];
             for s in 0..spp {
-                let mut rng = Rng::new(scene.settings.seed, pixel, s as u64);
+                // = Rng::new(seed, pixel, s), hashing the seed and pixel once
+                let mut rng = Rng::for_sample(pixel_key, s as u64);
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 let l = integrator.radiance(ctx, ray, &mut rng, &mut scratch, &mut counters);

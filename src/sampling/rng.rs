@@ -23,10 +23,30 @@ fn mix64(mut z: u64) -> u64 {
 impl Rng {
     /// The stream for one (seed, pixel, sample) triple.
     pub fn new(seed: u64, pixel: u64, sample: u64) -> Self {
-        let k = mix64(seed ^ 0x6a09_e667_f3bc_c909);
-        let k = mix64(k ^ pixel.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        let k = mix64(k ^ sample.wrapping_mul(0xd1b5_4a32_d192_ed03));
-        Rng { key: k, counter: 0 }
+        Rng::for_sample(Rng::pixel_key(Rng::seed_key(seed), pixel), sample)
+    }
+
+    /// The key is hashed level by level (seed, then pixel, then sample), so
+    /// a renderer can hash the seed once per render and the pixel once per
+    /// pixel: `for_sample(pixel_key(seed_key(s), p), i)` is `new(s, p, i)`.
+    #[inline]
+    pub fn seed_key(seed: u64) -> u64 {
+        mix64(seed ^ 0x6a09_e667_f3bc_c909)
+    }
+
+    /// See [`seed_key`](Self::seed_key).
+    #[inline]
+    pub fn pixel_key(seed_key: u64, pixel: u64) -> u64 {
+        mix64(seed_key ^ pixel.wrapping_mul(0x9e37_79b9_7f4a_7c15))
+    }
+
+    /// See [`seed_key`](Self::seed_key).
+    #[inline]
+    pub fn for_sample(pixel_key: u64, sample: u64) -> Self {
+        Rng {
+            key: mix64(pixel_key ^ sample.wrapping_mul(0xd1b5_4a32_d192_ed03)),
+            counter: 0,
+        }
     }
 
     /// A stream keyed by an arbitrary value (tests, studies, benches).
@@ -108,6 +128,19 @@ mod tests {
             let c: Vec<u64> = (0..8).map(|_| r.next_u64()).collect();
             assert_ne!(a, c);
         }
+    }
+
+    #[test]
+    fn stream_keys_were_not_changed() {
+        // the first draws of two streams, as before the key was split into
+        // levels: changing them would change every rendered image
+        let mut r = Rng::new(1, 2, 3);
+        let first = [r.next_u64(), r.next_u64()];
+        let mut r = Rng::for_sample(Rng::pixel_key(Rng::seed_key(1), 2), 3);
+        assert_eq!(first, [r.next_u64(), r.next_u64()]);
+        // computed from the original one-function key derivation
+        let mut r = Rng::new(0, 0, 0);
+        assert_eq!(r.next_u64(), 0xa65b_97c9_51aa_8759);
     }
 
     #[test]
