@@ -179,7 +179,7 @@ fn render_tile(
             for s in 0..spp {
                 // = Rng::new(seed, pixel, s), hashing the seed and pixel once
                 let mut rng = Rng::for_sample(pixel_key, s as u64);
-                let [jx, jy] = rng.uniform2();
+                let [jx, jy] = rng.uniform2_packed();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 let l = integrator.radiance(ctx, ray, &mut rng, &mut scratch, &mut counters);
                 if l.is_finite() {

@@ -194,7 +194,8 @@ pub(crate) fn trace<'s>(
         if ctx.plan.area_lights {
             l += beta * direct_lighting(ctx, &vertex, rng, counters);
         }
-        let Some((wi_local, weight, pdf)) = vertex.lobe.sample(vertex.wo_local, rng.uniform2())
+        let Some((wi_local, weight, pdf)) =
+            vertex.lobe.sample(vertex.wo_local, rng.uniform2_packed())
         else {
             break;
         };

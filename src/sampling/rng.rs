@@ -85,6 +85,18 @@ impl Rng {
         [self.uniform(), self.uniform()]
     }
 
+    /// Two uniforms in [0, 1) with 24 random bits each from one draw (bits
+    /// 40–63 and 16–39, as the first two of [`uniform3`](Self::uniform3)),
+    /// for the integrator's per-vertex pairs; [`uniform2`](Self::uniform2)
+    /// keeps its two draws so the streams of the mesh and ray generators do
+    /// not change.
+    #[inline]
+    pub fn uniform2_packed(&mut self) -> [f32; 2] {
+        let x = self.next_u64();
+        let k = 1.0 / (1u64 << 24) as f32;
+        [(x >> 40) as f32 * k, ((x >> 16) & 0xff_ffff) as f32 * k]
+    }
+
     /// Three uniforms in [0, 1) with 24 random bits each from two draws
     /// (the first draw's 64 bits hold two of them), for hot paths where
     /// the hashing is a noticeable part of the cost.
@@ -148,11 +160,18 @@ mod tests {
         // chi-square on 8×8 joint bins of each pair drawn together
         let bins = 8;
         let n = 256_000;
-        let mut joint = [vec![0u64; bins * bins], vec![0u64; bins * bins]];
+        let mut joint = [
+            vec![0u64; bins * bins],
+            vec![0u64; bins * bins],
+            vec![0u64; bins * bins],
+        ];
         let mut r = Rng::new(3, 1, 4);
         for _ in 0..n {
             let [a, b, c] = r.uniform3();
             let [d, e] = r.uniform2_f64_32();
+            let [f, g] = r.uniform2_packed();
+            assert!((0.0..1.0).contains(&f) && (0.0..1.0).contains(&g));
+            joint[2][(f * bins as f32) as usize * bins + (g * bins as f32) as usize] += 1;
             for u in [a, b, c] {
                 assert!((0.0..1.0).contains(&u));
             }
