@@ -22,6 +22,7 @@ impl Interaction {
     /// `face_normals` is [`face_normals`] of `mesh`: the unit normal is
     /// per triangle, so it is normalized once per scene instead of at every
     /// hit.
+    #[inline]
     pub fn new(mesh: &Mesh, face_normals: &[Vec3], ray: &Ray, hit: &Hit) -> Self {
         let idx = mesh.indices[hit.prim as usize];
         let [a, b, c] = mesh.vertices(idx);
