@@ -15,7 +15,7 @@ use crate::film::Film;
 use crate::geometry::Vec3;
 use crate::integrator::path::Scratch;
 use crate::integrator::{Context, Counters, IntegratorKind};
-use crate::sampling::Rng;
+use crate::sampling::{Draw, Rng, SampleRng};
 use crate::scene::Scene;
 
 pub const TILE: u32 = 16;
@@ -177,8 +177,9 @@ fn render_tile(
             let pixel_key = Rng::pixel_key(seed_key, pixel);
             let mut sum = [0f64; 3];
             for s in 0..spp {
-                // = Rng::new(seed, pixel, s), hashing the seed and pixel once
-                let mut rng = Rng::for_sample(pixel_key, s as u64);
+                // = SampleRng::new(seed, pixel, s), hashing the seed and
+                // pixel once
+                let mut rng = SampleRng::for_sample(pixel_key, s as u64);
                 let [jx, jy] = rng.uniform2_packed();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 let l = integrator.radiance(ctx, ray, &mut rng, &mut scratch, &mut counters);

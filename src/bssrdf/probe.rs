@@ -42,7 +42,7 @@ use super::profile;
 use super::radius::{RadialDist, RadiusSampler};
 use crate::accel::{Accel, Hit, ProbeHits};
 use crate::geometry::{Frame, Mesh, Ray, Vec3};
-use crate::sampling::Rng;
+use crate::sampling::Draw;
 
 /// Which axes probes are shot along.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -128,7 +128,7 @@ impl ProbeRandoms {
     /// Four draws instead of six: only the radius needs 53 bits (its
     /// inverse CDF resolves the tails); the discrete choices and the angle
     /// share draws at 32 bits each.
-    pub fn from_rng(rng: &mut Rng) -> Self {
+    pub fn from_rng(rng: &mut impl Draw) -> Self {
         let radius = rng.uniform_f64();
         let [axis, channel] = rng.uniform2_f64_32();
         let [angle, hit] = rng.uniform2_f64_32();
@@ -433,6 +433,7 @@ mod tests {
     use super::*;
     use crate::accel::MAX_PROBE_HITS;
     use crate::bssrdf::radius::TableSpacing;
+    use crate::sampling::Rng;
 
     /// A brute-force [`Accel`]: every query loops over every triangle with a
     /// Möller–Trumbore test in f64. Slow, obviously right, and independent of

@@ -87,7 +87,7 @@ impl IntegratorKind {
         self,
         ctx: &Context,
         ray: crate::geometry::Ray,
-        rng: &mut crate::sampling::Rng,
+        rng: &mut crate::sampling::SampleRng,
         scratch: &mut path::Scratch,
         counters: &mut Counters,
     ) -> crate::geometry::Vec3 {

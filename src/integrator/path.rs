@@ -21,7 +21,7 @@ use crate::accel::ProbeHits;
 use crate::bssrdf::ProbeRandoms;
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::materials::{dielectric, diffuse, fresnel, Material, Subsurface};
-use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Rng};
+use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Draw, SampleRng};
 
 /// Bounces after which Russian roulette may end a path.
 const RR_START: u32 = 3;
@@ -96,7 +96,7 @@ pub(crate) enum Scatter<'a> {
 pub fn radiance(
     ctx: &Context,
     camera_ray: Ray,
-    rng: &mut Rng,
+    rng: &mut SampleRng,
     scratch: &mut Scratch,
     counters: &mut Counters,
 ) -> Vec3 {
@@ -116,14 +116,14 @@ pub fn radiance(
 pub(crate) fn trace<'s>(
     ctx: &'s Context,
     camera_ray: Ray,
-    rng: &mut Rng,
+    rng: &mut SampleRng,
     counters: &mut Counters,
     mut subsurface: impl FnMut(
         &'s Subsurface,
         &Interaction,
         Vec3,
         &mut Vec3,
-        &mut Rng,
+        &mut SampleRng,
         &mut Counters,
     ) -> Scatter<'s>,
 ) -> Vec3 {
@@ -225,7 +225,7 @@ fn subsurface_probe<'s>(
     si: &Interaction,
     wo: Vec3,
     beta: &mut Vec3,
-    rng: &mut Rng,
+    rng: &mut SampleRng,
     scratch: &mut Scratch,
     counters: &mut Counters,
 ) -> Scatter<'s> {
@@ -281,7 +281,7 @@ fn subsurface_probe<'s>(
 
 /// Russian roulette after `RR_START` bounces: survive with probability
 /// min(1, max β) and reweight; false ends the path.
-fn roulette(depth: u32, beta: &mut Vec3, rng: &mut Rng) -> bool {
+fn roulette(depth: u32, beta: &mut Vec3, rng: &mut SampleRng) -> bool {
     if depth < RR_START {
         return true;
     }
@@ -308,7 +308,12 @@ fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3
 
 /// Next-event estimation at a vertex: one light sample, weighted by the
 /// power heuristic against lobe sampling of the same direction.
-fn direct_lighting(ctx: &Context, v: &Vertex, rng: &mut Rng, counters: &mut Counters) -> Vec3 {
+fn direct_lighting(
+    ctx: &Context,
+    v: &Vertex,
+    rng: &mut SampleRng,
+    counters: &mut Counters,
+) -> Vec3 {
     let [u_pick, u0, u1] = rng.uniform3();
     let Some(ls) = ctx.lights.sample(u_pick, [u0, u1]) else {
         return Vec3::ZERO;

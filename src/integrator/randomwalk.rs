@@ -52,7 +52,7 @@ use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::materials::dielectric;
-use crate::sampling::Rng;
+use crate::sampling::{Draw, SampleRng};
 
 /// Events (scatterings and internal reflections) after which a walk is
 /// stopped. Marble-like media (single-scattering albedo 0.999) need a few
@@ -70,7 +70,7 @@ const WALK_RR_START: u32 = 16;
 pub fn radiance(
     ctx: &Context,
     camera_ray: Ray,
-    rng: &mut Rng,
+    rng: &mut SampleRng,
     _scratch: &mut Scratch,
     counters: &mut Counters,
 ) -> Vec3 {
@@ -116,7 +116,7 @@ pub fn walk(
     m: &Medium,
     eta: f32,
     mut ray: Ray,
-    rng: &mut Rng,
+    rng: &mut SampleRng,
     counters: &mut Counters,
 ) -> Option<(Ray, Vec3)> {
     let sigma_t = m.sigma_t();
@@ -198,7 +198,7 @@ fn cross_boundary(
     eta: f32,
     ray: &Ray,
     hit: &Hit,
-    rng: &mut Rng,
+    rng: &mut SampleRng,
 ) -> (bool, Ray, f32) {
     let si = ctx.interaction(ray, hit);
     // Outside is where the ray is heading.

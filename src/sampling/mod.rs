@@ -3,7 +3,7 @@
 
 pub mod rng;
 
-pub use rng::Rng;
+pub use rng::{Draw, Rng, SampleRng};
 
 use crate::geometry::Vec3;
 use std::f32::consts::PI;
