@@ -90,6 +90,7 @@ impl LightSet {
     }
 
     /// Samples a light point with one selection number and two for the point.
+    #[inline]
     pub fn sample(&self, u_pick: f32, u: [f32; 2]) -> Option<LightSample> {
         if self.is_empty() {
             return None;

@@ -6,6 +6,8 @@
 //! mixer (the SplitMix64 / Stafford "variant 13" finalizer, applied twice
 //! with the counter folded in between), in the spirit of counter-based
 //! generators (Salmon et al. 2011, "Parallel random numbers: as easy as 1, 2, 3").
+//! The renderer's samples use [`SampleRng`], the same key with one mix per
+//! draw, because the hashing showed in the render's profile.
 
 #[derive(Clone, Debug)]
 pub struct Rng {
