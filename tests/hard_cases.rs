@@ -32,6 +32,7 @@ use lucent::bssrdf::{
 };
 use lucent::film::Film;
 use lucent::geometry::{Frame, Mesh, Ray, Vec3};
+use lucent::integrator::interaction::face_normals;
 use lucent::materials::{Material, Subsurface};
 use lucent::render::{render, RenderOptions, RenderStats};
 use lucent::sampling::Rng;
@@ -422,6 +423,7 @@ fn grazing_probe_hits_on_a_thin_wedge() {
     let p = params([0.8, 0.8, 0.8], [0.025, 0.02, 0.015], 1.0);
     let per_hit_bound = MIS3_FACTOR * 3.0 * 0.8;
     let mesh = thin_wedge(alpha);
+    let normals = face_normals(&mesh);
     let meshes = Arc::new(vec![mesh.clone()]);
     for (backend, acc) in accels(&meshes) {
         let mut max_w = [0.0f64; 2];
@@ -447,7 +449,7 @@ fn grazing_probe_hits_on_a_thin_wedge() {
                     for _ in 0..3000 {
                         let u = ProbeRandoms::from_rng(&mut rng);
                         if let Some(ps) =
-                            s.sample(xo, &frame, &u, acc.as_ref(), 0, &mesh, &mut hits)
+                            s.sample(xo, &frame, &u, acc.as_ref(), 0, &normals, &mut hits)
                         {
                             found += 1;
                             let total = hits.total() as f64;
@@ -540,6 +542,7 @@ fn probes_that_find_nothing_on_geometry_thinner_than_d() {
     let albedo = [0.8, 0.6, 0.4];
     let p = params(albedo, [1.0, 0.8, 0.6], 1.0);
     let thin = cuboid(Vec3::new(1.0, 0.005, 1.0), Vec3::ZERO);
+    let normals = face_normals(&thin);
     let sc = scene(
         vec![thin.clone()],
         vec![plain(p, ProbeOptions::default())],
@@ -562,7 +565,7 @@ fn probes_that_find_nothing_on_geometry_thinner_than_d() {
                 &u,
                 acc.as_ref(),
                 0,
-                &thin,
+                &normals,
                 &mut hits,
             ) {
                 None => none += 1,
@@ -677,6 +680,7 @@ fn extreme_random_numbers_through_the_probe_sampler() {
     let top = 1.0 - f64::EPSILON / 2.0;
     assert!(top < 1.0 && top == 1.0 - 2f64.powi(-53));
     let mesh = shapes::sphere(3);
+    let normals = face_normals(&mesh);
     let p = params([0.8, 0.5, 0.3], [0.1, 0.05, 0.02], 1.3);
     let meshes = Arc::new(vec![mesh.clone()]);
     for (backend, acc) in accels(&meshes) {
@@ -697,7 +701,8 @@ fn extreme_random_numbers_through_the_probe_sampler() {
                         hit: x(4),
                         seed: if bits >> 5 & 1 == 1 { u32::MAX } else { 0 },
                     };
-                    if let Some(ps) = s.sample(xo, &frame, &u, acc.as_ref(), 0, &mesh, &mut hits) {
+                    if let Some(ps) = s.sample(xo, &frame, &u, acc.as_ref(), 0, &normals, &mut hits)
+                    {
                         found += 1;
                         assert!(
                             ps.weight.is_finite() && ps.weight.min_element() >= 0.0,
@@ -850,6 +855,7 @@ fn degenerate_triangles_are_harmless() {
         }
     }
     let dirty = Mesh::new(pos, idx, Some(nrm));
+    let normals = face_normals(&dirty);
     assert!(
         (0..dirty.triangle_count() as u32)
             .filter(|&t| dirty.area(t) == 0.0)
@@ -905,7 +911,8 @@ fn degenerate_triangles_are_harmless() {
                 let frame = Frame::from_normal(dirty.normals.as_ref().unwrap()[v]);
                 for _ in 0..50 {
                     let u = ProbeRandoms::from_rng(&mut rng);
-                    if let Some(ps) = s.sample(xo, &frame, &u, acc.as_ref(), 0, &dirty, &mut hits) {
+                    if let Some(ps) = s.sample(xo, &frame, &u, acc.as_ref(), 0, &normals, &mut hits)
+                    {
                         found += 1;
                         assert!(
                             ps.weight.is_finite() && ps.weight.min_element() >= 0.0,

@@ -41,7 +41,7 @@ use super::params::SubsurfaceParams;
 use super::profile;
 use super::radius::{RadialDist, RadiusSampler};
 use crate::accel::{Accel, Hit, ProbeHits};
-use crate::geometry::{Frame, Mesh, Ray, Vec3};
+use crate::geometry::{Frame, Ray, Vec3};
 use crate::sampling::Draw;
 
 /// Which axes probes are shot along.
@@ -300,7 +300,10 @@ impl ProbeSampler {
     }
 
     /// Samples an entry point xi for exit point `xo` with shading frame
-    /// `frame`, on mesh `geom` (`mesh` is that mesh, for the hit normal).
+    /// `frame`, on mesh `geom`; `face_normals` is
+    /// [`face_normals`](crate::integrator::interaction::face_normals) of that
+    /// mesh (the render computes them once, so a probe hit costs a load
+    /// instead of a cross product and a normalization).
     ///
     /// `hits` is a scratch buffer reused across calls (no allocation here).
     /// Returns None when the probe finds nothing, or hits only degenerate
@@ -314,7 +317,7 @@ impl ProbeSampler {
         u: &ProbeRandoms,
         accel: &dyn Accel,
         geom: u32,
-        mesh: &Mesh,
+        face_normals: &[Vec3],
         hits: &mut ProbeHits,
     ) -> Option<ProbeSample> {
         if self.n_active == 0 {
@@ -362,11 +365,11 @@ impl ProbeSampler {
         // barycentrics on a large triangle err by ~ε·(triangle size), which
         // matters when d is small against the triangles (big flat quads).
         let xi = ray.o.as_dvec3() + ray.d.as_dvec3() * hit.t as f64;
-        let [a, bv, cv] = mesh.triangle(hit.prim).map(|p| p.as_dvec3());
-        let n_hit = (bv - a).cross(cv - a).normalize_or_zero();
-        if n_hit == DVec3::ZERO {
+        let normal = face_normals[hit.prim as usize];
+        if normal == Vec3::ZERO {
             return None;
         }
+        let n_hit = normal.as_dvec3();
         let dvec = xi - xo64;
         let w = match &self.fast {
             Some(fast) => self.weights_f32(fast, dvec, frame, n_hit, ch)?,
@@ -375,7 +378,7 @@ impl ProbeSampler {
         Some(ProbeSample {
             hit,
             point: xi.as_vec3(),
-            normal: n_hit.as_vec3(),
+            normal,
             weight: Vec3::from_array(w) * total as f32,
         })
     }
@@ -433,6 +436,8 @@ mod tests {
     use super::*;
     use crate::accel::MAX_PROBE_HITS;
     use crate::bssrdf::radius::TableSpacing;
+    use crate::geometry::Mesh;
+    use crate::integrator::interaction::face_normals;
     use crate::sampling::Rng;
 
     /// A brute-force [`Accel`]: every query loops over every triangle with a
@@ -549,9 +554,10 @@ mod tests {
         let mut hits = ProbeHits::new();
         let (mut s1, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
         let (mut max, mut found) = (0.0f64, 0);
+        let normals = face_normals(mesh);
         for _ in 0..n {
             let u = ProbeRandoms::from_rng(&mut rng);
-            if let Some(ps) = s.sample(xo, frame, &u, accel, 0, mesh, &mut hits) {
+            if let Some(ps) = s.sample(xo, frame, &u, accel, 0, &normals, &mut hits) {
                 found += 1;
                 assert!(ps.normal.is_finite() && (ps.normal.length() - 1.0).abs() < 1e-5);
                 assert!(ps.point.is_finite());
@@ -707,7 +713,7 @@ mod tests {
                     &u,
                     &accel,
                     0,
-                    &accel.meshes[0],
+                    &face_normals(&accel.meshes[0]),
                     &mut hits,
                 ) {
                     found += 1;
@@ -1005,7 +1011,7 @@ mod tests {
                             &u,
                             &accel,
                             0,
-                            &accel.meshes[0],
+                            &face_normals(&accel.meshes[0]),
                             &mut hits,
                         ) {
                             assert!(

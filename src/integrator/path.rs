@@ -256,14 +256,13 @@ fn subsurface_probe<'s>(
     let frame_o = si.shading_frame_facing(wo);
     let u = ProbeRandoms::from_rng(rng);
     counters.rays += 1;
-    let mesh = &ctx.scene.meshes[si.geom as usize];
     let Some(ps) = ss.probe.sample(
         si.p,
         &frame_o,
         &u,
         ctx.accel,
         si.geom,
-        mesh,
+        &ctx.face_normals[si.geom as usize],
         &mut scratch.probe_hits,
     ) else {
         return Scatter::Absorbed;
