@@ -177,11 +177,12 @@ pub(crate) fn trace<'s>(
             }
             Material::Subsurface(ss) => subsurface(ss, &si, wo, &mut beta, rng, counters),
         };
-        let vertex = match scatter {
+        // Borrowed, not moved out: the vertex stays where it was built.
+        let vertex = match &scatter {
             Scatter::Vertex(v) => v,
             Scatter::Continue(next) => {
                 prev = None;
-                ray = next;
+                ray = *next;
                 if !roulette(depth, &mut beta, rng) {
                     break;
                 }
@@ -192,7 +193,7 @@ pub(crate) fn trace<'s>(
 
         // Next-event estimation, then continue by sampling the lobe.
         if ctx.plan.area_lights {
-            l += beta * direct_lighting(ctx, &vertex, rng, counters);
+            l += beta * direct_lighting(ctx, vertex, rng, counters);
         }
         let Some((wi_local, weight, pdf)) =
             vertex.lobe.sample(vertex.wo_local, rng.uniform2_packed())
