@@ -157,6 +157,8 @@ pub fn render(
     Ok((film, stats))
 }
 
+// Kept out of line so profiles (scripts/profile.sh) can name the tile loop.
+#[inline(never)]
 fn render_tile(
     ctx: &Context,
     integrator: IntegratorKind,
