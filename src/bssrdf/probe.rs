@@ -21,7 +21,7 @@
 //!   V_a. Since Σ_a (V_a·N)² = 1 some axis has |V_a·N| ≥ 1/√3, and since
 //!   r_a ≤ |xo − xi| and R decreases, p_disk(r_a) ≥ R(|xo − xi|) for the
 //!   exact samplers: the weight of one hit is at most
-//!   4√3 · n_active · A / CDF(Rmax)^[renormalize] (× total), independent of
+//!   4√3 · n_active · A / CDF(Rmax)^(renormalize) (× total), independent of
 //!   the geometry.
 //! - [`ChannelStrategy::Single`]: pick one active channel uniformly and
 //!   estimate only it (the others get 0 from this sample) — the seed.

@@ -15,7 +15,7 @@
 //!   interpolation error O(1/n²) in the tail where r(ξ) has a log
 //!   singularity (uniform spacing is O(1/n) there; see the tests).
 //! - [`RadiusSampler::Analytic`]: the closed-form inverse of
-//!   [`profile`](super::profile), truncated by sampling ξ·CDF(Rmax);
+//!   [`profile`], truncated by sampling ξ·CDF(Rmax);
 //!   pdf = R(r)/CDF(Rmax).
 //! - [`RadiusSampler::Mixture`]: the seed's two exponential lobes with
 //!   truncation; the combined one-sample pdf is (w1 p1 + w2 p2)/(w1 + w2),

@@ -65,7 +65,7 @@ const WALK_RR_START: u32 = 16;
 
 /// The radiance arriving along `camera_ray`: one sample of L, with
 /// subsurface objects simulated as media. Same contract as
-/// [`super::path::radiance`], and the same bounce loop ([`trace`]); only
+/// [`super::path::radiance`], and the same bounce loop (`trace`); only
 /// subsurface hits differ.
 pub fn radiance(
     ctx: &Context,
