@@ -4,6 +4,52 @@
 use crate::accel::Hit;
 use crate::geometry::{Frame, Mesh, Ray, Vec3};
 
+/// What [`Interaction::new`] reads of one mesh, laid out per triangle so a
+/// hit costs one bounds-checked load of a contiguous record instead of an
+/// index triple and three gathers each from the positions and the normals.
+#[derive(Clone, Debug, Default)]
+pub struct MeshShading {
+    tris: Vec<TriGeometry>,
+    /// The vertex normals of each triangle, when the mesh has them.
+    normals: Option<Vec<[Vec3; 3]>>,
+}
+
+/// The vertex a and the edges b − a, c − a (the same f32 subtractions the
+/// hit point would otherwise redo), and the unit front-face normal, zero
+/// for a degenerate triangle.
+#[derive(Clone, Copy, Debug)]
+struct TriGeometry {
+    a: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    ng: Vec3,
+}
+
+impl MeshShading {
+    pub fn new(mesh: &Mesh) -> Self {
+        let tris = mesh
+            .indices
+            .iter()
+            .map(|&idx| {
+                let [a, b, c] = mesh.vertices(idx);
+                TriGeometry {
+                    a,
+                    e1: b - a,
+                    e2: c - a,
+                    ng: (b - a).cross(c - a).normalize_or_zero(),
+                }
+            })
+            .collect();
+        let normals = mesh.normals.as_ref().map(|ns| {
+            mesh.indices
+                .iter()
+                .map(|idx| idx.map(|i| ns[i as usize]))
+                .collect()
+        });
+        MeshShading { tris, normals }
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct Interaction {
     pub p: Vec3,
@@ -19,16 +65,13 @@ pub struct Interaction {
 }
 
 impl Interaction {
-    /// `face_normals` is [`face_normals`] of `mesh`: the unit normal is
-    /// per triangle, so it is normalized once per scene instead of at every
-    /// hit.
+    /// `shading` is the [`MeshShading`] of the mesh hit.
     #[inline]
-    pub fn new(mesh: &Mesh, face_normals: &[Vec3], ray: &Ray, hit: &Hit) -> Self {
-        let idx = mesh.indices[hit.prim as usize];
-        let [a, b, c] = mesh.vertices(idx);
+    pub fn new(shading: &MeshShading, ray: &Ray, hit: &Hit) -> Self {
+        let t = &shading.tris[hit.prim as usize];
         let (u, v) = (hit.u, hit.v);
-        let p = a + (b - a) * u + (c - a) * v;
-        let ng = face_normals[hit.prim as usize];
+        let p = t.a + t.e1 * u + t.e2 * v;
+        let ng = t.ng;
         // Degenerate triangles never hit in either backend, but keep a valid
         // normal if one does.
         let ng = if ng == Vec3::ZERO {
@@ -36,10 +79,10 @@ impl Interaction {
         } else {
             ng
         };
-        let ns = match &mesh.normals {
+        let ns = match &shading.normals {
             Some(ns) => {
-                let [i0, i1, i2] = idx;
-                let n = ns[i0 as usize] * (1.0 - u - v) + ns[i1 as usize] * u + ns[i2 as usize] * v;
+                let [n0, n1, n2] = ns[hit.prim as usize];
+                let n = n0 * (1.0 - u - v) + n1 * u + n2 * v;
                 // normalize_or_zero's test without its zero vector: the
                 // reciprocal length is finite and positive exactly when
                 // 0 < |n|² < ∞ (the smallest subnormal |n|² still has a

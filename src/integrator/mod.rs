@@ -29,6 +29,8 @@ pub struct Context<'a> {
     pub ray_epsilon: f32,
     /// Per mesh, [`interaction::face_normals`].
     pub face_normals: Vec<Vec<glam::Vec3>>,
+    /// Per mesh, what [`Interaction::new`] reads.
+    pub shading: Vec<interaction::MeshShading>,
 }
 
 impl<'a> Context<'a> {
@@ -47,14 +49,18 @@ impl<'a> Context<'a> {
             plan: Plan::new(scene),
             ray_epsilon: extent * 1e-6,
             face_normals: scene.meshes.iter().map(interaction::face_normals).collect(),
+            shading: scene
+                .meshes
+                .iter()
+                .map(interaction::MeshShading::new)
+                .collect(),
         }
     }
 
     /// The surface geometry at `hit` on the ray `ray`.
     #[inline]
     pub fn interaction(&self, ray: &crate::geometry::Ray, hit: &crate::accel::Hit) -> Interaction {
-        let g = hit.geom as usize;
-        Interaction::new(&self.scene.meshes[g], &self.face_normals[g], ray, hit)
+        Interaction::new(&self.shading[hit.geom as usize], ray, hit)
     }
 }
 
