@@ -66,7 +66,7 @@ pub struct Interaction {
 
 impl Interaction {
     /// `shading` is the [`MeshShading`] of the mesh hit.
-    #[inline]
+    #[inline(always)]
     pub fn new(shading: &MeshShading, ray: &Ray, hit: &Hit) -> Self {
         let t = &shading.tris[hit.prim as usize];
         let (u, v) = (hit.u, hit.v);
