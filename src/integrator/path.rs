@@ -170,10 +170,7 @@ pub(crate) fn trace<'s>(
                 })
             }
             Material::Dielectric { eta } => {
-                let frame = Frame::from_normal(si.ng);
-                let s = dielectric::sample(*eta, frame.to_local(wo), rng.uniform());
-                beta *= s.weight;
-                Scatter::Continue(si.spawn(frame.to_world(s.wi), ctx.ray_epsilon))
+                Scatter::Continue(dielectric_bounce(ctx, *eta, &si, wo, &mut beta, rng))
             }
             Material::Subsurface(ss) => subsurface(ss, &si, wo, &mut beta, rng, counters),
         };
@@ -214,6 +211,24 @@ pub(crate) fn trace<'s>(
         }
     }
     l
+}
+
+/// A specular bounce off or through a dielectric. Out of line for the same
+/// reason as [`emission_weight`]: rarely taken, and inlined it costs the
+/// bounce loop registers on every bounce.
+#[inline(never)]
+fn dielectric_bounce(
+    ctx: &Context,
+    eta: f32,
+    si: &Interaction,
+    wo: Vec3,
+    beta: &mut Vec3,
+    rng: &mut SampleRng,
+) -> Ray {
+    let frame = Frame::from_normal(si.ng);
+    let s = dielectric::sample(eta, frame.to_local(wo), rng.uniform());
+    *beta *= s.weight;
+    si.spawn(frame.to_world(s.wi), ctx.ray_epsilon)
 }
 
 /// A subsurface hit at xo under the diffusion model: the Fresnel split at
@@ -293,7 +308,10 @@ fn roulette(depth: u32, beta: &mut Vec3, rng: &mut SampleRng) -> bool {
     true
 }
 
-/// The MIS weight of emission found by lobe sampling from `prev`.
+/// The MIS weight of emission found by lobe sampling from `prev`. Out of
+/// line: only paths that hit a light need it, and inlined into the bounce
+/// loop it adds to the values the loop spills around every ray query.
+#[inline(never)]
 fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3, f32)>) -> f32 {
     match prev {
         None => 1.0,
