@@ -233,8 +233,11 @@ fn dielectric_bounce(
 
 /// A subsurface hit at xo under the diffusion model: the Fresnel split at
 /// xo, then one probe ray for the entry point xi, where the path continues
-/// with the entry lobe.
+/// with the entry lobe. Out of line: it makes a ray query of its own, so
+/// the call is cheap next to it, and inlined into the bounce loop its
+/// locals made the loop spill more around the loop's other queries.
 #[allow(clippy::too_many_arguments)]
+#[inline(never)]
 fn subsurface_probe<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
