@@ -22,6 +22,7 @@ use crate::bssrdf::ProbeRandoms;
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::materials::{dielectric, diffuse, fresnel, Material, Subsurface};
 use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Draw, SampleRng};
+use glam::Vec3A;
 
 /// Bounces after which Russian roulette may end a path.
 const RR_START: u32 = 3;
@@ -128,9 +129,12 @@ pub(crate) fn trace<'s>(
     ) -> Scatter<'s>,
 ) -> Vec3 {
     let scene = ctx.scene;
-    let mut l = Vec3::ZERO;
+    // Radiance and throughput live across the ray-query calls, which clobber
+    // every xmm register: as 16-byte Vec3A each spill and reload is one move
+    // instead of a pair, and the lane-wise products round exactly as Vec3's.
+    let mut l = Vec3A::ZERO;
     // Path throughput: the product of f |cos| / pdf (and BSSRDF weights).
-    let mut beta = Vec3::ONE;
+    let mut beta = Vec3A::ONE;
     let mut ray = camera_ray;
     // The last non-specular vertex and the solid-angle pdf with which its
     // lobe sampled the current ray; None after the camera or a specular
@@ -145,7 +149,7 @@ pub(crate) fn trace<'s>(
         counters.rays += 1;
         let Some(hit) = ctx.accel.intersect(&ray, 0.0, f32::INFINITY) else {
             if ctx.plan.environment {
-                l += beta * scene.environment.unwrap_or(Vec3::ZERO);
+                l += beta * Vec3A::from(scene.environment.unwrap_or(Vec3::ZERO));
             }
             break;
         };
@@ -155,7 +159,7 @@ pub(crate) fn trace<'s>(
 
         // Le, MIS-weighted against next-event estimation.
         if let (Some(le), true) = (object.emission, si.front) {
-            l += beta * le * emission_weight(ctx, &si, wo, prev);
+            l += beta * Vec3A::from(le) * emission_weight(ctx, &si, wo, prev);
         }
         if depth == max_depth {
             break;
@@ -174,9 +178,17 @@ pub(crate) fn trace<'s>(
                 })
             }
             Material::Dielectric { eta } => {
-                Scatter::Continue(dielectric_bounce(ctx, *eta, &si, wo, &mut beta, rng))
+                let mut b = Vec3::from(beta);
+                let next = dielectric_bounce(ctx, *eta, &si, wo, &mut b, rng);
+                beta = b.into();
+                Scatter::Continue(next)
             }
-            Material::Subsurface(ss) => subsurface(ss, &si, wo, &mut beta, rng, counters),
+            Material::Subsurface(ss) => {
+                let mut b = Vec3::from(beta);
+                let scatter = subsurface(ss, &si, wo, &mut b, rng, counters);
+                beta = b.into();
+                scatter
+            }
         };
         // Borrowed, not moved out: the vertex stays where it was built.
         let vertex = match &scatter {
@@ -194,7 +206,7 @@ pub(crate) fn trace<'s>(
 
         // Next-event estimation, then continue by sampling the lobe.
         if ctx.plan.area_lights {
-            l += beta * direct_lighting(ctx, vertex, rng, counters);
+            l += beta * Vec3A::from(direct_lighting(ctx, vertex, rng, counters));
         }
         let Some((wi_local, weight, pdf)) =
             vertex.lobe.sample(vertex.wo_local, rng.uniform2_packed())
@@ -207,14 +219,14 @@ pub(crate) fn trace<'s>(
         if wi.dot(vertex.ng) <= 0.0 {
             break;
         }
-        beta *= weight;
+        beta *= Vec3A::from(weight);
         prev = Some((vertex.p, pdf));
         ray = Ray::new(offset_along(vertex.p, vertex.ng, ctx.ray_epsilon), wi);
         if !roulette(depth, &mut beta, rng) {
             break;
         }
     }
-    l
+    l.into()
 }
 
 /// A specular bounce off or through a dielectric. Out of line for the same
@@ -303,7 +315,7 @@ fn subsurface_probe<'s>(
 
 /// Russian roulette after `RR_START` bounces: survive with probability
 /// min(1, max β) and reweight; false ends the path.
-fn roulette(depth: u32, beta: &mut Vec3, rng: &mut SampleRng) -> bool {
+fn roulette(depth: u32, beta: &mut Vec3A, rng: &mut SampleRng) -> bool {
     if depth < RR_START {
         return true;
     }
