@@ -323,6 +323,15 @@ impl ProbeSampler {
         if self.n_active == 0 {
             return None;
         }
+        // Through u32, whose saturating conversions are a few instructions
+        // shorter than usize's: n_active ≤ 3 and the clamp below make the
+        // result the same for every input.
+        let ci = ((u.channel * self.n_active as u32 as f64) as u32 as usize).min(self.n_active - 1);
+        let ch = self.active[ci];
+        let dist = self.dists[ch].as_ref()?;
+        // The radius first: its sampler may call libm, and nothing of the
+        // frame is live across that call yet.
+        let r = dist.sample_radius(u.radius);
         // Axis and its disk basis (T', B' span the plane ⟂ V).
         let (t, b, n) = (frame.t.as_dvec3(), frame.b.as_dvec3(), frame.n.as_dvec3());
         let axis = match self.opts.axes {
@@ -342,10 +351,6 @@ impl ProbeSampler {
             1 => (b, n, t),
             _ => (n, t, b),
         };
-        let ci = ((u.channel * self.n_active as f64) as usize).min(self.n_active - 1);
-        let ch = self.active[ci];
-        let dist = self.dists[ch].as_ref()?;
-        let r = dist.sample_radius(u.radius);
         // The angle in f32: its rounding moves p0 by ~1e-7·r, below the f32
         // rounding of p0 itself.
         let (sin, cos) = crate::sampling::sin_cos_turns(u.angle as f32);
@@ -358,7 +363,8 @@ impl ProbeSampler {
         if kept.is_empty() {
             return None;
         }
-        let hit = kept[((u.hit * kept.len() as f64) as usize).min(kept.len() - 1)];
+        // kept.len() ≤ MAX_PROBE_HITS: u32 as above
+        let hit = kept[((u.hit * kept.len() as u32 as f64) as u32 as usize).min(kept.len() - 1)];
         let total = hits.total() as f64;
 
         // xi from the ray, not the barycentrics: its error is ~ε·Rmax, while
