@@ -363,9 +363,12 @@ impl ProbeSampler {
         if kept.is_empty() {
             return None;
         }
-        // kept.len() ≤ MAX_PROBE_HITS: u32 as above
-        let hit = kept[((u.hit * kept.len() as u32 as f64) as u32 as usize).min(kept.len() - 1)];
-        let total = hits.total() as f64;
+        // kept.len() ≤ MAX_PROBE_HITS: u32 as above (the length through i32,
+        // which converts to f64 in one instruction, where LLVM turns u32
+        // into the long unsigned 64-bit sequence), and the count through
+        // i64 (exact: it is far below 2⁶³)
+        let hit = kept[((u.hit * kept.len() as i32 as f64) as u32 as usize).min(kept.len() - 1)];
+        let total = hits.total() as i64 as f64;
 
         // xi from the ray, not the barycentrics: its error is ~ε·Rmax, while
         // barycentrics on a large triangle err by ~ε·(triangle size), which
