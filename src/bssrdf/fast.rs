@@ -89,13 +89,15 @@ fn pow2_of_magic(t: Vec4) -> Vec4 {
 pub struct FastProbe {
     /// 1/L in scene units.
     inv_len: f64,
-    /// Rmax / L.
-    rmax: f32,
-    /// Per channel: 1/(3 d/L), the exponent's scale.
-    inv3d: [f32; 3],
-    /// Per channel: RHO_MIN·d/L, the radius clamp of `profile::profile`;
-    /// 1 for an inactive channel so it never divides by 0.
-    rmin: [f32; 3],
+    /// Rmax / L in the three disk-radius lanes, ∞ in the distance lane
+    /// (the clamp of the radii; the lanes are built once, not per hit).
+    rmax: Vec4,
+    /// Per channel, in every lane: −1/(3 d/L), the exponent's scale.
+    neg_inv3d: [Vec4; 3],
+    /// Per channel, in every lane: RHO_MIN·d/L, the radius clamp of
+    /// `profile::profile`; 1 for an inactive channel so it never divides
+    /// by 0.
+    rmin: [Vec4; 3],
     /// Per channel: L²·pdf_disk(r)·r/(e^{−ρ} + e^{−ρ/3}) = L/(8π d CDF(Rmax)).
     k_pdf: [f32; 3],
     /// Per channel: L²·Rd(r)·r/(e^{−ρ} + e^{−ρ/3}) = scale·L/(8π d).
@@ -130,9 +132,12 @@ impl FastProbe {
         let pi8 = 8.0 * std::f64::consts::PI;
         Some(FastProbe {
             inv_len: 1.0 / len,
-            rmax: (rmax / len) as f32,
-            inv3d: per(&|c| len / (3.0 * d[c]), 0.0),
-            rmin: per(&|c| RHO_MIN * d[c] / len, 1.0),
+            rmax: {
+                let r = (rmax / len) as f32;
+                Vec4::new(r, r, r, f32::INFINITY)
+            },
+            neg_inv3d: per(&|c| len / (3.0 * d[c]), 0.0).map(|v| Vec4::splat(-v)),
+            rmin: per(&|c| RHO_MIN * d[c] / len, 1.0).map(Vec4::splat),
             k_pdf: per(&|c| len / (pi8 * d[c] * mass[c]), 0.0),
             k_rd: per(&|c| scale[c] * len / (pi8 * d[c]), 0.0),
         })
@@ -161,13 +166,13 @@ impl FastProbe {
         // can put a hit just outside the sphere; the disk radii are kept on
         // the disk so the sampled axis never scores 0 (as the reference).
         let r2 = [y2 + z2, x2 + z2, x2 + y2, x2 + y2 + z2].map(|v| (v as f32).sqrt());
-        let r = Vec4::from_array(r2).min(Vec4::new(self.rmax, self.rmax, self.rmax, f32::INFINITY));
+        let r = Vec4::from_array(r2).min(self.rmax);
         let w = Vec4::new(probs[0] * cos[0], probs[1] * cos[1], probs[2] * cos[2], 0.0);
         let mut pdf = [0.0f32; 3];
         let mut rd = [0.0f32; 3];
         for c in 0..3 {
-            let rc = r.max(Vec4::splat(self.rmin[c]));
-            let e = exp4(rc * -self.inv3d[c]);
+            let rc = r.max(self.rmin[c]);
+            let e = exp4(rc * self.neg_inv3d[c]);
             let v = (e * e * e + e) / rc;
             pdf[c] = self.k_pdf[c] * w.dot(v);
             rd[c] = self.k_rd[c] * v.w;
