@@ -26,17 +26,21 @@ struct TriGeometry {
 }
 
 impl MeshShading {
-    pub fn new(mesh: &Mesh) -> Self {
+    /// `face_normals` is [`face_normals`] of `mesh` (computed once per
+    /// scene and shared with the probe sampler).
+    pub fn new(mesh: &Mesh, face_normals: &[Vec3]) -> Self {
+        debug_assert_eq!(face_normals.len(), mesh.indices.len());
         let tris = mesh
             .indices
             .iter()
-            .map(|&idx| {
+            .zip(face_normals)
+            .map(|(&idx, &ng)| {
                 let [a, b, c] = mesh.vertices(idx);
                 TriGeometry {
                     a,
                     e1: b - a,
                     e2: c - a,
-                    ng: (b - a).cross(c - a).normalize_or_zero(),
+                    ng,
                 }
             })
             .collect();

@@ -42,18 +42,21 @@ impl<'a> Context<'a> {
         } else {
             1.0
         };
+        let face_normals: Vec<_> = scene.meshes.iter().map(interaction::face_normals).collect();
+        let shading = scene
+            .meshes
+            .iter()
+            .zip(&face_normals)
+            .map(|(mesh, ng)| interaction::MeshShading::new(mesh, ng))
+            .collect();
         Context {
             scene,
             accel,
             lights: LightSet::new(scene),
             plan: Plan::new(scene),
             ray_epsilon: extent * 1e-6,
-            face_normals: scene.meshes.iter().map(interaction::face_normals).collect(),
-            shading: scene
-                .meshes
-                .iter()
-                .map(interaction::MeshShading::new)
-                .collect(),
+            face_normals,
+            shading,
         }
     }
 
