@@ -1,0 +1,379 @@
+//! The layering of `src/`, checked from the source text: the modules form a
+//! directed acyclic graph, the subsurface math (`bssrdf`) knows nothing of
+//! ray queries, integrators or materials, and the renderer never reaches
+//! into the measuring tools.
+//!
+//! An edge A → B is any path `crate::B…` written in a file of module A
+//! (imports and fully qualified paths alike, comments excluded), so a
+//! dependency cannot hide behind a qualified call. Within one folder the
+//! sibling files must form a DAG too (`mod.rs`, which declares and
+//! re-exports its children, is left out of that check).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Every `.rs` file under `dir`, sorted.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The source without comments (line comments, doc comments and block
+/// comments) and without the contents of string literals, so that prose
+/// and messages mentioning `crate::x` are not read as dependencies.
+fn code_only(text: &str) -> String {
+    let b = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i..].starts_with(b"//") {
+            while i < b.len() && b[i] != b'\n' {
+                i += 1;
+            }
+        } else if b[i..].starts_with(b"/*") {
+            let mut depth = 0;
+            while i < b.len() {
+                if b[i..].starts_with(b"/*") {
+                    depth += 1;
+                    i += 2;
+                } else if b[i..].starts_with(b"*/") {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+        } else if b[i] == b'"' {
+            i += 1;
+            while i < b.len() && b[i] != b'"' {
+                i += if b[i] == b'\\' { 2 } else { 1 };
+            }
+            i += 1;
+            out.push_str("\"\"");
+        } else if b[i] == b'\'' && i + 2 < b.len() && (b[i + 2] == b'\'' || b[i + 1] == b'\\') {
+            // A char literal such as '"' or '\n' (lifetimes have no closing quote).
+            let end = b[i + 1..].iter().position(|&c| c == b'\'').unwrap_or(0);
+            i += end + 2;
+            out.push_str("' '");
+        } else {
+            let ch = text[i..].chars().next().unwrap();
+            out.push(ch);
+            i += ch.len_utf8();
+        }
+    }
+    out
+}
+
+fn ident_at(s: &str) -> &str {
+    let end = s
+        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .unwrap_or(s.len());
+    &s[..end]
+}
+
+/// The first path segments after each `crate::` (and inside a
+/// `crate::{a, b::c}` group, each group member's first segment).
+fn crate_refs(code: &str) -> BTreeSet<String> {
+    let mut refs = BTreeSet::new();
+    for (pos, _) in code.match_indices("crate::") {
+        // `$crate::` and identifiers ending in "crate" are not our paths.
+        if pos > 0 {
+            let prev = code.as_bytes()[pos - 1];
+            if prev.is_ascii_alphanumeric() || prev == b'_' || prev == b'$' {
+                continue;
+            }
+        }
+        let rest = &code[pos + "crate::".len()..];
+        if let Some(group) = rest.strip_prefix('{') {
+            let mut depth = 0;
+            let mut start = true;
+            for (k, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => break,
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => start = true,
+                    c if start && (c.is_ascii_alphabetic() || c == '_') => {
+                        refs.insert(ident_at(&group[k..]).to_string());
+                        start = false;
+                    }
+                    _ => {}
+                }
+            }
+        } else {
+            let id = ident_at(rest);
+            if !id.is_empty() {
+                refs.insert(id.to_string());
+            }
+        }
+    }
+    refs
+}
+
+/// The first segments after each `super::` (the siblings a file uses).
+fn super_refs(code: &str) -> BTreeSet<String> {
+    let mut refs = BTreeSet::new();
+    for (pos, _) in code.match_indices("super::") {
+        let rest = &code[pos + "super::".len()..];
+        if let Some(group) = rest.strip_prefix('{') {
+            for part in group.split('}').next().unwrap_or("").split(',') {
+                let id = ident_at(part.trim());
+                if !id.is_empty() {
+                    refs.insert(id.to_string());
+                }
+            }
+        } else {
+            let id = ident_at(rest);
+            if !id.is_empty() && id != "super" {
+                refs.insert(id.to_string());
+            }
+        }
+    }
+    refs
+}
+
+/// The code of a file up to its `#[cfg(test)]` module: unit tests may use
+/// whatever they need to check the code, and are not part of the layering.
+fn non_test_code(text: &str) -> String {
+    let code = code_only(text);
+    for (k, _) in code.match_indices("#[cfg(test)]") {
+        // Skip whitespace and further attributes up to the item.
+        let mut rest = code[k + "#[cfg(test)]".len()..].trim_start();
+        while rest.starts_with("#[") {
+            rest = rest[rest.find(']').map_or(rest.len(), |e| e + 1)..].trim_start();
+        }
+        if rest.starts_with("mod ") {
+            return code[..k].to_string();
+        }
+    }
+    code
+}
+
+/// Top-level module of a file under src/: `src/bssrdf/probe.rs` → bssrdf,
+/// `src/render.rs` → render; None for the crate roots.
+fn top_module(src: &Path, file: &Path) -> Option<String> {
+    let rel = file.strip_prefix(src).unwrap();
+    let first = rel.components().next()?.as_os_str().to_str()?.to_string();
+    let name = first.strip_suffix(".rs").unwrap_or(&first).to_string();
+    (name != "lib" && name != "main").then_some(name)
+}
+
+/// A cycle in `graph`, if any, as the list of its nodes.
+fn find_cycle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    #[derive(Clone, Copy, PartialEq)]
+    enum Mark {
+        New,
+        Open,
+        Done,
+    }
+    fn visit(
+        n: &str,
+        graph: &BTreeMap<String, BTreeSet<String>>,
+        mark: &mut BTreeMap<String, Mark>,
+        path: &mut Vec<String>,
+    ) -> Option<Vec<String>> {
+        mark.insert(n.to_string(), Mark::Open);
+        path.push(n.to_string());
+        for m in graph.get(n).into_iter().flatten() {
+            match mark.get(m.as_str()).copied().unwrap_or(Mark::New) {
+                Mark::Open => {
+                    let k = path.iter().position(|p| p == m).unwrap();
+                    let mut cycle = path[k..].to_vec();
+                    cycle.push(m.clone());
+                    return Some(cycle);
+                }
+                Mark::New => {
+                    if let Some(c) = visit(m, graph, mark, path) {
+                        return Some(c);
+                    }
+                }
+                Mark::Done => {}
+            }
+        }
+        path.pop();
+        mark.insert(n.to_string(), Mark::Done);
+        None
+    }
+    let mut mark = BTreeMap::new();
+    for n in graph.keys() {
+        if mark.get(n.as_str()).copied().unwrap_or(Mark::New) == Mark::New {
+            if let Some(c) = visit(n, graph, &mut mark, &mut Vec::new()) {
+                return Some(c);
+            }
+        }
+    }
+    None
+}
+
+struct Source {
+    src: PathBuf,
+    files: Vec<(PathBuf, String)>,
+}
+
+impl Source {
+    fn load() -> Self {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let files = rust_files(&src)
+            .into_iter()
+            .map(|f| {
+                let text = std::fs::read_to_string(&f).unwrap();
+                (f, non_test_code(&text))
+            })
+            .collect();
+        Source { src, files }
+    }
+
+    /// Top-level module → the top-level modules its files name.
+    fn top_graph(&self) -> BTreeMap<String, BTreeSet<String>> {
+        let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+        for (f, code) in &self.files {
+            let Some(m) = top_module(&self.src, f) else {
+                continue;
+            };
+            let e = g.entry(m.clone()).or_default();
+            for r in crate_refs(code) {
+                if r != m {
+                    e.insert(r);
+                }
+            }
+        }
+        g
+    }
+
+    /// Files of `top` that name module `target` (file: first line doing so).
+    fn files_naming(&self, top: &str, target: &str) -> Vec<String> {
+        let mut out = Vec::new();
+        for (f, code) in &self.files {
+            if top_module(&self.src, f).as_deref() != Some(top) {
+                continue;
+            }
+            if crate_refs(code).contains(target) {
+                let line = code
+                    .lines()
+                    .position(|l| crate_refs(l).contains(target))
+                    .map_or(0, |k| k + 1);
+                out.push(format!(
+                    "{}:{line}",
+                    f.strip_prefix(&self.src).unwrap().display()
+                ));
+            }
+        }
+        out
+    }
+}
+
+#[test]
+fn the_scanner_reads_paths_groups_and_skips_comments_and_strings() {
+    let code = code_only(
+        "use crate::{accel::Hit, geometry::{Ray, Vec3}};\n\
+         // crate::film in a comment\n\
+         /* crate::study */ let x = crate::sampling::draw();\n\
+         let s = \"crate::plot\"; let c = '\"'; let t = crate::render::x;\n\
+         fn f<'a>(x: &'a str) -> $crate::nope {}\n",
+    );
+    let refs: Vec<_> = crate_refs(&code).into_iter().collect();
+    assert_eq!(refs, ["accel", "geometry", "render", "sampling"]);
+    let sup: Vec<_> = super_refs("use super::{fast::X, profile};\nsuper::radius::f()")
+        .into_iter()
+        .collect();
+    assert_eq!(sup, ["fast", "profile", "radius"]);
+    let mut g = BTreeMap::new();
+    g.insert("a".to_string(), BTreeSet::from(["b".to_string()]));
+    g.insert("b".to_string(), BTreeSet::from(["a".to_string()]));
+    assert_eq!(find_cycle(&g), Some(vec!["a".into(), "b".into(), "a".into()]));
+    g.remove("b");
+    assert_eq!(find_cycle(&g), None);
+}
+
+#[test]
+fn top_level_modules_form_a_dag() {
+    let s = Source::load();
+    let g = s.top_graph();
+    assert!(g.len() > 5, "scanned too few modules: {g:?}");
+    if let Some(cycle) = find_cycle(&g) {
+        let edges: Vec<String> = cycle
+            .windows(2)
+            .map(|w| format!("{} → {} ({})", w[0], w[1], s.files_naming(&w[0], &w[1]).join(", ")))
+            .collect();
+        panic!("import cycle among modules of src/:\n  {}", edges.join("\n  "));
+    }
+}
+
+#[test]
+fn sibling_files_form_a_dag_in_every_folder() {
+    let s = Source::load();
+    let mut by_dir: BTreeMap<PathBuf, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
+    for (f, code) in &s.files {
+        let stem = f.file_stem().unwrap().to_str().unwrap().to_string();
+        if stem == "mod" || f.parent() == Some(s.src.as_path()) {
+            continue;
+        }
+        let dir = f.parent().unwrap().to_path_buf();
+        let siblings = by_dir.entry(dir).or_default();
+        let refs = super_refs(code);
+        siblings
+            .entry(stem.clone())
+            .or_default()
+            .extend(refs.into_iter().filter(|r| *r != stem));
+    }
+    for (dir, mut g) in by_dir {
+        // Only edges to files of the same folder count (not mod.rs items).
+        let names: BTreeSet<String> = g.keys().cloned().collect();
+        for e in g.values_mut() {
+            e.retain(|r| names.contains(r));
+        }
+        assert!(
+            find_cycle(&g).is_none(),
+            "import cycle among the files of {}: {:?}",
+            dir.display(),
+            find_cycle(&g)
+        );
+    }
+}
+
+#[test]
+fn the_subsurface_math_knows_no_ray_queries_integrators_or_materials() {
+    let s = Source::load();
+    for forbidden in ["accel", "integrator", "materials", "render", "scene"] {
+        let hits = s.files_naming("bssrdf", forbidden);
+        assert!(
+            hits.is_empty(),
+            "bssrdf must not depend on `{forbidden}`: {}",
+            hits.join(", ")
+        );
+    }
+}
+
+#[test]
+fn the_renderer_never_imports_the_measuring_tools() {
+    let s = Source::load();
+    let g = s.top_graph();
+    let tools = ["tools", "bench", "study", "plot"];
+    for (m, deps) in &g {
+        if tools.contains(&m.as_str()) {
+            continue;
+        }
+        for t in tools {
+            assert!(
+                !deps.contains(t),
+                "renderer module `{m}` imports the measuring tool `{t}`: {}",
+                s.files_naming(m, t).join(", ")
+            );
+        }
+    }
+}
