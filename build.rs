@@ -1,9 +1,12 @@
-//! Finds Embree 3 and, if present, links it and enables `cfg(lucent_embree)`.
+//! Links Embree 3 when the `embree` feature is on (the default).
 //!
-//! Lookup order: `EMBREE_DIR` (a prefix with `include/embree3/rtcore.h` and
-//! `lib/libembree3.so`), then `pkg-config embree3`, then the standard Debian
-//! locations. Without Embree (or with `LUCENT_NO_EMBREE=1`) lucent still
-//! builds, with only its own BVH.
+//! Whether lucent has the Embree backend is the feature's choice alone; this
+//! script only finds where Embree is: in `EMBREE_DIR` if that is set (a
+//! prefix with `include/embree3/rtcore.h` and `lib/libembree3.so`, the only
+//! place looked at then), else with `pkg-config embree3`, else in the
+//! standard Debian locations. Not found is a build error that says what to
+//! install. Without the feature (`--no-default-features`) it does nothing
+//! and lucent has only its own BVH.
 
 use std::env;
 use std::path::{Path, PathBuf};
@@ -26,23 +29,25 @@ fn has_lib(lib: &Path) -> bool {
     LIB_NAMES.iter().any(|n| lib.join(n).exists())
 }
 
-fn from_embree_dir() -> Option<Embree> {
-    let dir = PathBuf::from(env::var_os("EMBREE_DIR")?);
+/// `EMBREE_DIR` names the one place to look: a prefix that lacks Embree is
+/// an error, not a reason to look elsewhere.
+fn from_embree_dir(dir: &Path) -> Result<Embree, String> {
     let include = dir.join("include");
-    let lib = ["lib", "lib64", "lib/x86_64-linux-gnu"]
-        .iter()
-        .map(|l| dir.join(l))
-        .find(|l| has_lib(l));
+    let lib = [
+        "lib",
+        "lib64",
+        "lib/x86_64-linux-gnu",
+        "lib/aarch64-linux-gnu",
+    ]
+    .iter()
+    .map(|l| dir.join(l))
+    .find(|l| has_lib(l));
     match lib {
-        Some(lib) if has_header(&include) => Some(Embree { include, lib }),
-        _ => {
-            println!(
-                "cargo::warning=EMBREE_DIR={} has no include/embree3/rtcore.h with \
-                 lib/libembree3.so; looking elsewhere",
-                dir.display()
-            );
-            None
-        }
+        Some(lib) if has_header(&include) => Ok(Embree { include, lib }),
+        _ => Err(format!(
+            "EMBREE_DIR={} has no include/embree3/rtcore.h with lib/libembree3.so",
+            dir.display()
+        )),
     }
 }
 
@@ -110,31 +115,27 @@ fn from_standard_paths() -> Option<Embree> {
 }
 
 fn main() {
-    println!("cargo::rustc-check-cfg=cfg(lucent_embree)");
-    println!("cargo::rerun-if-env-changed=EMBREE_DIR");
-    println!("cargo::rerun-if-env-changed=LUCENT_NO_EMBREE");
-    println!("cargo::rerun-if-env-changed=PKG_CONFIG_PATH");
     println!("cargo::rerun-if-changed=build.rs");
-    // Cargo only reruns this script for the paths named here, so installing
-    // or removing Embree with apt would go unnoticed; dpkg's status file
-    // changes on every package operation (named only if it exists, since a
-    // missing path would make Cargo rerun the script on every build).
-    if Path::new("/var/lib/dpkg/status").is_file() {
-        println!("cargo::rerun-if-changed=/var/lib/dpkg/status");
-    }
-
-    // Forces a BVH-only build even where Embree is installed, so CI can
-    // check that configuration compiles and passes too.
-    if env::var_os("LUCENT_NO_EMBREE").is_some_and(|v| !v.is_empty() && v != "0") {
-        println!("cargo::warning=LUCENT_NO_EMBREE is set: lucent is built with its own BVH only.");
+    // The feature decides whether lucent has the Embree backend; nothing on
+    // the build machine does.
+    if env::var_os("CARGO_FEATURE_EMBREE").is_none() {
         return;
     }
+    println!("cargo::rerun-if-env-changed=EMBREE_DIR");
+    println!("cargo::rerun-if-env-changed=PKG_CONFIG_PATH");
 
-    match from_embree_dir()
-        .or_else(from_pkg_config)
-        .or_else(from_standard_paths)
-    {
-        Some(e) => {
+    let found = match env::var_os("EMBREE_DIR") {
+        Some(dir) => from_embree_dir(Path::new(&dir)),
+        None => from_pkg_config()
+            .or_else(from_standard_paths)
+            .ok_or_else(|| {
+                "Embree 3 was found neither by `pkg-config embree3` nor in /usr/include and \
+                 /usr/lib"
+                    .to_string()
+            }),
+    };
+    match found {
+        Ok(e) => {
             // Rebuild if the installed Embree changes (upgraded or replaced).
             println!(
                 "cargo::rerun-if-changed={}",
@@ -142,19 +143,19 @@ fn main() {
             );
             println!("cargo::rustc-link-search=native={}", e.lib.display());
             println!("cargo::rustc-link-lib=dylib=embree3");
-            println!("cargo::rustc-cfg=lucent_embree");
             println!(
                 "cargo::rustc-env=LUCENT_EMBREE_INCLUDE={}",
                 e.include.display()
             );
         }
-        None => {
+        Err(why) => {
+            // A failed build script is rerun by the next build, so installing
+            // Embree and building again is enough.
             println!(
-                "cargo::warning=Embree 3 not found: lucent is built with its own BVH only. \
-                 To enable the Embree backend install it (Debian/Ubuntu: \
-                 `apt-get install -y --no-install-recommends libembree-dev`) or set \
-                 EMBREE_DIR to an Embree 3 prefix, then rebuild (`touch build.rs` if Cargo does \
-                 not notice)."
+                "cargo::error=the `embree` feature (on by default) needs Embree 3, but {why}. \
+                 Install it (Debian 12: `apt-get install -y --no-install-recommends \
+                 libembree-dev`, or scripts/install-deps.sh), or set EMBREE_DIR to an Embree 3 \
+                 prefix, or build the BVH-only renderer with `cargo build --no-default-features`."
             );
         }
     }

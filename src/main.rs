@@ -486,12 +486,12 @@ fn run_bench(a: BenchArgs) -> Result<(), Failure> {
 
 fn info() -> String {
     let mut s = format!("lucent {}\nbackends: bvh", env!("CARGO_PKG_VERSION"));
-    #[cfg(lucent_embree)]
+    #[cfg(feature = "embree")]
     s.push_str(&format!(", embree (Embree {})", accel::embree::version()));
-    #[cfg(not(lucent_embree))]
+    #[cfg(not(feature = "embree"))]
     s.push_str(
-        "\nbuilt without Embree: install it with `apt-get install -y --no-install-recommends \
-         libembree-dev` and rebuild to enable --accel embree",
+        "\nbuilt without the `embree` feature (--no-default-features): --accel embree is \
+         not available; the default build has it (needs Embree 3, Debian 12: libembree-dev)",
     );
     s.push_str(&format!(
         "\ndefault backend: {}",

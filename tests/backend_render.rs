@@ -4,8 +4,8 @@
 //! point answers differ enough to send a path elsewhere: the per-channel
 //! image means must agree within Monte-Carlo noise, and nearly every pixel
 //! must agree to rounding.
-
-#![cfg(lucent_embree)]
+//!
+//! Built only with the `embree` feature (`required-features` in Cargo.toml).
 
 use std::path::Path;
 

@@ -261,8 +261,8 @@ fn scene_bench_replays_the_renders_queries() {
 
     let rows = parse_mix(&std::fs::read_to_string(out_dir.join("render-mix.csv")).unwrap());
     let backends = backends();
-    // build.rs sets cfg(lucent_embree) for the tests as for the binary.
-    assert_eq!(backends.contains("embree"), cfg!(lucent_embree));
+    // The tests are built with the binary's features.
+    assert_eq!(backends.contains("embree"), cfg!(feature = "embree"));
     let seen: BTreeSet<(String, String)> = rows
         .iter()
         .map(|r| (r["backend"].clone(), r["threads"].clone()))
@@ -344,8 +344,11 @@ fn scene_bench_bad_input_exits_with_2() {
         (vec!["--spp", "4"], "--scene"),
         (vec!["--scene", s, "--accel", "optix"], "optix"),
     ];
-    if !cfg!(lucent_embree) {
-        cases.push((vec!["--scene", s, "--accel", "embree"], "without Embree"));
+    if !cfg!(feature = "embree") {
+        cases.push((
+            vec!["--scene", s, "--accel", "embree"],
+            "without the `embree` feature",
+        ));
     }
     for (args, needle) in cases {
         let out = lucent()

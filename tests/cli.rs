@@ -157,11 +157,39 @@ fn info_lists_the_backends() {
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("backends: bvh"), "{text}");
-    if cfg!(lucent_embree) {
+    if cfg!(feature = "embree") {
         assert!(text.contains("embree (Embree 3."), "{text}");
         assert!(text.contains("default backend: embree"), "{text}");
     } else {
-        assert!(text.contains("built without Embree"), "{text}");
+        assert!(
+            text.contains("built without the `embree` feature"),
+            "{text}"
+        );
+        assert!(text.contains("default backend: bvh"), "{text}");
     }
     assert!(Path::new(env!("CARGO_BIN_EXE_lucent")).exists());
+}
+
+/// A BVH-only binary asked for Embree says it was built without the
+/// `embree` feature and how to get it, exits 2 and writes nothing.
+#[cfg(not(feature = "embree"))]
+#[test]
+fn accel_embree_without_the_feature_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("x.exr");
+    let out = lucent()
+        .arg("render")
+        .args([&scene("cornell.toml"), "-o", exr.to_str().unwrap()])
+        .args(["--spp", "1", "--accel", "embree"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("without the `embree` feature"), "{err}");
+    assert!(
+        err.contains("--accel bvh") && err.contains("libembree-dev"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }

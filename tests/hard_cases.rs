@@ -44,21 +44,20 @@ const MIS3_FACTOR: f64 = 6.928_203_230_275_509;
 
 // ---------------------------------------------------------------- helpers
 
-/// Every backend this build has. Embree is tried always and skipped only if
-/// building it fails; if lucent was compiled with Embree, a failure is an
-/// error, not a skip.
+/// Every backend this build has: our BVH, and Embree with the `embree`
+/// feature (then failing to build it is an error, never a skip).
 fn accels(meshes: &Arc<Vec<Mesh>>) -> Vec<(Backend, Box<dyn Accel>)> {
-    let mut v = vec![(Backend::Bvh, accel::build(meshes, Backend::Bvh).unwrap())];
-    match accel::build(meshes, Backend::Embree) {
-        Ok(a) => v.push((Backend::Embree, a)),
-        Err(e) => {
-            if cfg!(lucent_embree) {
-                panic!("lucent was built with Embree, yet: {e}");
-            }
-            eprintln!("(Embree not available, BVH only: {e})");
-        }
+    let mut backends = vec![Backend::Bvh];
+    if cfg!(feature = "embree") {
+        backends.push(Backend::Embree);
     }
-    v
+    backends
+        .into_iter()
+        .map(|b| {
+            let a = accel::build(meshes, b).unwrap_or_else(|e| panic!("{}: {e}", b.name()));
+            (b, a)
+        })
+        .collect()
 }
 
 /// Per-channel parameters with exactly these A and d (scene units).

@@ -184,9 +184,10 @@ pub enum Backend {
 }
 
 impl Backend {
-    /// The default: Embree when lucent was built with it, else our BVH.
+    /// The default: Embree when lucent was built with the `embree` feature,
+    /// else our BVH.
     pub fn default_available() -> Backend {
-        if cfg!(lucent_embree) {
+        if cfg!(feature = "embree") {
             Backend::Embree
         } else {
             Backend::Bvh
@@ -206,20 +207,23 @@ pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>
     match backend {
         Backend::Bvh => Ok(Box::new(bvh::Bvh::build(meshes))),
         Backend::Embree => {
-            #[cfg(lucent_embree)]
+            #[cfg(feature = "embree")]
             {
                 embree::EmbreeAccel::build(meshes).map(|a| Box::new(a) as Box<dyn Accel>)
             }
-            #[cfg(not(lucent_embree))]
+            #[cfg(not(feature = "embree"))]
             {
-                Err("this lucent was built without Embree; install it with \
-                     `apt-get install -y --no-install-recommends libembree-dev` and rebuild \
-                     (cargo build --release), or use --accel bvh"
-                    .into())
+                Err(
+                    "this lucent was built without the `embree` feature, so it has only \
+                     its own BVH: use --accel bvh, or rebuild with the default features \
+                     (`cargo build --release`, which needs Embree 3: on Debian 12 \
+                     `apt-get install -y --no-install-recommends libembree-dev`)"
+                        .into(),
+                )
             }
         }
     }
 }
 
-#[cfg(lucent_embree)]
+#[cfg(feature = "embree")]
 pub mod embree;

@@ -5,11 +5,11 @@
 use lucent::accel::Backend;
 use lucent::film::Film;
 
-/// The backends this build has: our BVH always, Embree when lucent was
-/// built with it (a build without it must not pretend to test it).
+/// The backends this build has: our BVH always, Embree with the `embree`
+/// feature (a build without it must not pretend to test it).
 pub fn backends() -> Vec<Backend> {
     let mut b = vec![Backend::Bvh];
-    if cfg!(lucent_embree) {
+    if cfg!(feature = "embree") {
         b.push(Backend::Embree);
     }
     b

@@ -79,7 +79,7 @@ pub(super) struct NodeW {
 
 /// Children per node.
 pub(super) const WIDTH: usize = 8;
-const _: () = assert!(std::mem::size_of::<NodeW>() % 64 == 0);
+const _: () = assert!(std::mem::size_of::<NodeW>().is_multiple_of(64));
 
 impl NodeW {
     const EMPTY: NodeW = NodeW {
@@ -333,7 +333,7 @@ fn best_split(bins: &Bins, count: usize, extent: Vec3A, block: u32) -> Option<(f
                 continue;
             }
             let cost = acc.half_area() * blocks(n, block) + right_cost[i];
-            if best.map_or(true, |b| cost < b.0) {
+            if best.is_none_or(|b| cost < b.0) {
                 best = Some((cost, a, i));
             }
         }

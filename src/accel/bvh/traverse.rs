@@ -100,7 +100,7 @@ impl RayBox {
     #[inline(always)]
     pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
         use std::arch::x86_64::*;
-        const _: () = assert!(WIDTH % 4 == 0);
+        const _: () = assert!(WIDTH.is_multiple_of(4));
         let mut out = [0f32; WIDTH];
         let mut mask = 0u32;
         for g in (0..WIDTH).step_by(4) {

@@ -193,7 +193,7 @@ impl Hits4 {
         while m != 0 {
             let k = m.trailing_zeros() as usize;
             m &= m - 1;
-            if best.map_or(true, |b| self.t[k] < self.t[b]) {
+            if best.is_none_or(|b| self.t[k] < self.t[b]) {
                 best = Some(k);
             }
         }
