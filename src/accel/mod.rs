@@ -14,6 +14,7 @@ pub mod bvh;
 
 use std::sync::Arc;
 
+use crate::error::Error;
 use crate::geometry::{Mesh, Ray};
 
 /// A ray-triangle hit. `geom` is the index of the mesh in the scene, `prim`
@@ -202,7 +203,7 @@ impl Backend {
 
 /// Builds the chosen backend over `meshes`. The meshes are shared (not
 /// copied) by backends that can read our buffers directly, hence the `Arc`.
-pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>, String> {
+pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>, Error> {
     match backend {
         Backend::Bvh => Ok(Box::new(bvh::Bvh::build(meshes))),
         Backend::Embree => {
@@ -212,10 +213,12 @@ pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>
             }
             #[cfg(not(lucent_embree))]
             {
-                Err("this lucent was built without Embree; install it with \
+                Err(Error::Unavailable(
+                    "this lucent was built without Embree; install it with \
                      `apt-get install -y --no-install-recommends libembree-dev` and rebuild \
                      (cargo build --release), or use --accel bvh"
-                    .into())
+                        .into(),
+                ))
             }
         }
     }
