@@ -4,8 +4,8 @@
 //! Every failure is an [`InputError`] that names the file, the line whenever
 //! the input has one, and the field (a dotted key path such as
 //! `shapes[2].material`). Nothing here panics on user input. The work is
-//! split by concept: [`super::checked`] reads spanned values with checks,
-//! [`super::material`] validates materials, [`super::objects`] builds shapes,
+//! split by concept: `checked.rs` reads spanned values with checks,
+//! `material.rs` validates materials, `objects.rs` builds shapes,
 //! [`super::obj`] checks and parses OBJ meshes, and [`super::key_path`]
 //! locates the errors `toml` itself reports.
 
