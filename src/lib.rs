@@ -6,6 +6,7 @@
 pub mod accel;
 pub mod bench;
 pub mod bssrdf;
+pub mod error;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
@@ -16,3 +17,5 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod study;
+
+pub use error::Error;

@@ -1,6 +1,6 @@
 //! The `lucent` command line: parses arguments, calls the library, and maps
-//! errors to exit codes (2: bad input — arguments, scene, meshes; 1: a
-//! failure while running or writing output).
+//! errors to exit codes in one place, [`exit_code`] (2: bad input —
+//! arguments, scene, meshes; 1: a failure while running or writing output).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -9,11 +9,13 @@ use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
 use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
+use lucent::error::{Param, ParamError};
 use lucent::film::{self, ToneMap};
 use lucent::integrator::IntegratorKind;
 use lucent::materials::SubsurfaceOverrides;
 use lucent::render::{self, RenderOptions};
 use lucent::scene;
+use lucent::Error;
 
 #[derive(Parser)]
 #[command(
@@ -137,7 +139,7 @@ enum ChannelArg {
     Mis,
 }
 
-fn parse_radius(s: &str) -> Result<RadiusSampler, String> {
+fn parse_radius(s: &str) -> Result<RadiusSampler, ParamError> {
     RadiusSampler::parse(s)
 }
 
@@ -159,11 +161,6 @@ impl SubsurfaceArgs {
             specular: self.specular,
         }
     }
-}
-
-enum Failure {
-    Input(String),
-    Runtime(String),
 }
 
 fn main() -> ExitCode {
@@ -216,14 +213,36 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::Input(m)) => {
-            eprintln!("error: {m}");
-            ExitCode::from(2)
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(exit_code(&e))
         }
-        Err(Failure::Runtime(m)) => {
-            eprintln!("error: {m}");
-            ExitCode::from(1)
-        }
+    }
+}
+
+/// The exit code of a failed command: 2 for bad input (arguments, scene,
+/// meshes, parameters, a backend this build lacks), 1 for a failure while
+/// running or writing output.
+fn exit_code(e: &Error) -> u8 {
+    if e.is_input() {
+        2
+    } else {
+        1
+    }
+}
+
+/// A subsurface override from the command line out of its domain, named by
+/// its option.
+fn option_error(e: ParamError) -> Error {
+    let (argument, problem) = match e.param {
+        Param::RmaxQuantile => ("--rmax-quantile", e.problem()),
+        Param::RadiusSampler => ("--radius", e.problem()),
+        Param::TableSize => ("--radius", format!("table size {}", e.problem())),
+        _ => ("subsurface option", e.to_string()),
+    };
+    Error::Argument {
+        argument: argument.into(),
+        problem,
     }
 }
 
@@ -237,43 +256,48 @@ fn run_render(
     tonemap: ToneMap,
     exposure: f32,
     quiet: bool,
-) -> Result<(), Failure> {
+) -> Result<(), Error> {
     if output
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         != Some("exr".into())
     {
-        return Err(Failure::Input(format!(
-            "output {}: expected a path ending in .exr",
-            output.display()
-        )));
+        return Err(Error::Argument {
+            argument: format!("output {}", output.display()),
+            problem: "expected a path ending in .exr".into(),
+        });
     }
     let dir = output
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     if !dir.is_dir() {
-        return Err(Failure::Input(format!(
-            "output directory {} does not exist",
-            dir.display()
-        )));
+        return Err(Error::Argument {
+            argument: format!("output directory {}", dir.display()),
+            problem: "does not exist".into(),
+        });
     }
     if opts.spp == Some(0) {
-        return Err(Failure::Input("--spp must be at least 1".into()));
+        return Err(Error::Argument {
+            argument: "--spp".into(),
+            problem: "must be at least 1".into(),
+        });
     }
     if opts.threads == Some(0) {
-        return Err(Failure::Input("--threads must be at least 1".into()));
+        return Err(Error::Argument {
+            argument: "--threads".into(),
+            problem: "must be at least 1".into(),
+        });
     }
-    let mut scene = scene::load(scene_path).map_err(|e| Failure::Input(e.to_string()))?;
+    let mut scene = scene::load(scene_path)?;
     overrides
         .apply_all(&mut scene.materials)
-        .map_err(|e| Failure::Input(format!("subsurface option: {e}")))?;
-    let accel = accel::build(&scene.meshes, backend).map_err(Failure::Input)?;
-    let (film, stats) = render::render(&scene, accel.as_ref(), opts).map_err(Failure::Runtime)?;
-    film.write_exr(output).map_err(Failure::Runtime)?;
-    film.write_png(&film::preview_path(output), tonemap, exposure)
-        .map_err(Failure::Runtime)?;
+        .map_err(option_error)?;
+    let accel = accel::build(&scene.meshes, backend)?;
+    let (film, stats) = render::render(&scene, accel.as_ref(), opts)?;
+    film.write_exr(output)?;
+    film.write_png(&film::preview_path(output), tonemap, exposure)?;
     if !quiet {
         eprintln!(
             "{}: {}x{} at {} spp, {} triangles: {}",
@@ -337,7 +361,7 @@ fn parse_study_axis(s: &str) -> Result<lucent::study::Axis, String> {
     lucent::study::Axis::parse(s).ok_or_else(|| format!("unknown axis \"{s}\""))
 }
 
-fn run_study(a: StudyArgs) -> Result<(), Failure> {
+fn run_study(a: StudyArgs) -> Result<(), Error> {
     use lucent::study::{self, StudyError};
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = a
@@ -358,8 +382,8 @@ fn run_study(a: StudyArgs) -> Result<(), Failure> {
     s.only = a.only;
     s.progress = !a.quiet;
     let o = study::run(&s).map_err(|e| match e {
-        StudyError::Input(m) => Failure::Input(m),
-        StudyError::Runtime(m) => Failure::Runtime(m),
+        StudyError::Input(m) => Error::Input(m),
+        StudyError::Runtime(m) => Error::Runtime(m),
     })?;
     if !a.quiet {
         eprintln!(
@@ -417,7 +441,7 @@ enum BenchAccelArg {
 }
 
 /// The backends `--accel` asks for; one this build lacks is bad input.
-fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Failure> {
+fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Error> {
     let want = match a {
         None | Some(BenchAccelArg::Both) => return Ok(lucent::bench::available_backends()),
         Some(BenchAccelArg::Bvh) => Backend::Bvh,
@@ -426,14 +450,14 @@ fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Failure> {
     if !lucent::bench::available_backends().contains(&want) {
         // accel::build says why and how to get it.
         let why = accel::build(&std::sync::Arc::new(Vec::new()), want).err();
-        return Err(Failure::Input(why.unwrap_or_else(|| {
-            format!("backend {} is not available", want.name())
-        })));
+        return Err(why.unwrap_or_else(|| {
+            Error::Unavailable(format!("backend {} is not available", want.name()))
+        }));
     }
     Ok(vec![want])
 }
 
-fn run_bench(a: BenchArgs) -> Result<(), Failure> {
+fn run_bench(a: BenchArgs) -> Result<(), Error> {
     use lucent::bench::{self, BenchError};
     let backends = bench_backends(a.accel)?;
     if let Some(scene) = &a.scene {
@@ -445,8 +469,8 @@ fn run_bench(a: BenchArgs) -> Result<(), Failure> {
         s.backends = backends;
         s.progress = !a.quiet;
         let o = bench::replay::run(&s).map_err(|e| match e {
-            BenchError::Input(m) => Failure::Input(m),
-            BenchError::Runtime(m) => Failure::Runtime(m),
+            BenchError::Input(m) => Error::Input(m),
+            BenchError::Runtime(m) => Error::Runtime(m),
         })?;
         print!("{}", o.report);
         if !a.quiet {
@@ -465,8 +489,8 @@ fn run_bench(a: BenchArgs) -> Result<(), Failure> {
     s.rays = a.rays.unwrap_or(s.rays);
     s.progress = !a.quiet;
     let o = bench::run(&s).map_err(|e| match e {
-        BenchError::Input(m) => Failure::Input(m),
-        BenchError::Runtime(m) => Failure::Runtime(m),
+        BenchError::Input(m) => Error::Input(m),
+        BenchError::Runtime(m) => Error::Runtime(m),
     })?;
     print!("{}", o.report);
     if !a.quiet {

@@ -11,6 +11,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::accel::Accel;
+use crate::error::Error;
 use crate::film::Film;
 use crate::geometry::Vec3;
 use crate::integrator::path::Scratch;
@@ -82,7 +83,7 @@ pub fn render(
     scene: &Scene,
     accel: &dyn Accel,
     opts: &RenderOptions,
-) -> Result<(Film, RenderStats), String> {
+) -> Result<(Film, RenderStats), Error> {
     let mut scene_settings = scene.settings;
     if let Some(s) = opts.spp {
         scene_settings.spp = s;
@@ -103,7 +104,7 @@ pub fn render(
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads.unwrap_or(0))
         .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+        .map_err(|e| Error::Runtime(format!("cannot start worker threads: {e}")))?;
     let threads = pool.current_num_threads();
     let ctx = Context::new(scene, accel);
     let (w, h) = (scene.camera.width, scene.camera.height);

@@ -335,7 +335,7 @@ fn cases() -> Vec<Case> {
         case(
             "subsurface table size not a number",
             format!("{CAM}{SSS}preset = \"skin1\"\nradius = \"table:many\"\n"),
-            "bad table size \"many\"",
+            "table size \"many\" must be in [2, 16777216]",
             Some("table:many"),
             Some("materials.skin.radius"),
         ),

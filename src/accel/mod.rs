@@ -14,6 +14,7 @@ pub mod bvh;
 
 use std::sync::Arc;
 
+use crate::error::Error;
 use crate::geometry::{Mesh, Ray};
 
 /// A ray-triangle hit. `geom` is the index of the mesh in the scene, `prim`
@@ -203,7 +204,7 @@ impl Backend {
 
 /// Builds the chosen backend over `meshes`. The meshes are shared (not
 /// copied) by backends that can read our buffers directly, hence the `Arc`.
-pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>, String> {
+pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>, Error> {
     match backend {
         Backend::Bvh => Ok(Box::new(bvh::Bvh::build(meshes))),
         Backend::Embree => {
@@ -213,13 +214,13 @@ pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>
             }
             #[cfg(not(feature = "embree"))]
             {
-                Err(
+                Err(Error::Unavailable(
                     "this lucent was built without the `embree` feature, so it has only \
                      its own BVH: use --accel bvh, or rebuild with the default features \
                      (`cargo build --release`, which needs Embree 3: on Debian 12 \
                      `apt-get install -y --no-install-recommends libembree-dev`)"
                         .into(),
-                )
+                ))
             }
         }
     }

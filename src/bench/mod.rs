@@ -402,7 +402,7 @@ pub fn run(s: &Settings) -> Result<Outcome, BenchError> {
             let t0 = Instant::now();
             let accel = build_pool
                 .install(|| accel::build(&bm.mesh, backend))
-                .map_err(BenchError::Runtime)?;
+                .map_err(|e| BenchError::Runtime(e.into()))?;
             let build_seconds = t0.elapsed().as_secs_f64();
             let rss1 = measure::rss_bytes();
             let build_mib = rss0

@@ -584,7 +584,9 @@ pub fn run(s: &Settings) -> Result<Outcome, BenchError> {
     let available = super::available_backends();
     if let Some(b) = s.backends.iter().find(|b| !available.contains(b)) {
         // The same message `lucent render --accel` gives.
-        let e = accel::build(&std::sync::Arc::new(Vec::new()), *b).err();
+        let e = accel::build(&std::sync::Arc::new(Vec::new()), *b)
+            .err()
+            .map(String::from);
         return Err(input(e.unwrap_or_else(|| {
             format!("backend {} is not available", b.name())
         })));

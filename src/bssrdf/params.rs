@@ -35,6 +35,7 @@
 //! length (σtr = 1/ℓd, or σt' = 1/ℓ for [`Fit::VolumeMfp`]), with g = 0.
 
 use super::profile::Fit;
+use crate::error::{Constraint, Param, ParamError};
 
 /// Lower bound on σa / σt' used for σa = 0 media; see the module docs.
 pub const MIN_ABSORPTION_FRACTION: f64 = 1e-6;
@@ -278,40 +279,37 @@ pub fn invert_dipole_reflectance(rd: f64, eta: f64) -> f64 {
     (0.5 * (lo + hi)).min(1.0 - MIN_ABSORPTION_FRACTION)
 }
 
-const CH: [&str; 3] = ["r", "g", "b"];
-
-fn check_finite_nonneg(field: &str, v: [f64; 3]) -> Result<(), String> {
+fn check_finite_nonneg(param: Param, v: [f64; 3]) -> Result<(), ParamError> {
     for (c, x) in v.iter().enumerate() {
         if !x.is_finite() || *x < 0.0 {
-            return Err(format!(
-                "{field}.{}: {x} must be finite and non-negative",
-                CH[c]
-            ));
+            return Err(ParamError::new(param, x, Constraint::FiniteNonNegative).channel(c));
         }
     }
     Ok(())
 }
 
-fn check_albedo(v: [f64; 3]) -> Result<(), String> {
+fn check_albedo(v: [f64; 3]) -> Result<(), ParamError> {
     for (c, x) in v.iter().enumerate() {
         if !(0.0..=1.0).contains(x) {
-            return Err(format!("albedo.{}: {x} must be in [0, 1]", CH[c]));
+            return Err(ParamError::new(Param::Albedo, x, Constraint::UnitInterval).channel(c));
         }
     }
     Ok(())
 }
 
-fn check_eta(eta: f32) -> Result<(), String> {
+fn check_eta(eta: f32) -> Result<(), ParamError> {
     if !(eta.is_finite() && eta > 0.0) {
-        return Err(format!("eta: {eta} must be finite and positive"));
+        return Err(ParamError::new(Param::Eta, eta, Constraint::FinitePositive));
     }
     Ok(())
 }
 
-fn check_units(units_per_mm: f64) -> Result<(), String> {
+fn check_units(units_per_mm: f64) -> Result<(), ParamError> {
     if !(units_per_mm.is_finite() && units_per_mm > 0.0) {
-        return Err(format!(
-            "units_per_mm: {units_per_mm} must be finite and positive"
+        return Err(ParamError::new(
+            Param::UnitsPerMm,
+            units_per_mm,
+            Constraint::FinitePositive,
         ));
     }
     Ok(())
@@ -329,12 +327,16 @@ pub fn diffuse_mfp(sigma_s_reduced: f64, sigma_a: f64) -> f64 {
 impl SubsurfaceParams {
     /// A named Jensen 2001 preset (case-insensitive), lengths converted with
     /// `units_per_mm`, d from the chosen fit.
-    pub fn from_preset(name: &str, units_per_mm: f64, fit: Fit) -> Result<Self, String> {
+    pub fn from_preset(name: &str, units_per_mm: f64, fit: Fit) -> Result<Self, ParamError> {
         let pr = preset(name).ok_or_else(|| {
             let names: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
-            format!(
-                "preset: unknown material \"{name}\" (known: {})",
-                names.join(", ")
+            ParamError::new(
+                Param::Preset,
+                format!("\"{name}\""),
+                Constraint::Named {
+                    what: "material",
+                    names: format!("known: {}", names.join(", ")),
+                },
             )
         })?;
         Self::from_measured(
@@ -352,31 +354,28 @@ impl SubsurfaceParams {
 
     /// Measured coefficients (mm⁻¹) → per-channel (A, d). The length fed to
     /// the fit is ℓd = 1/σtr, or 1/σt' for [`Fit::VolumeMfp`].
-    pub fn from_measured(m: &Measured, units_per_mm: f64, fit: Fit) -> Result<Self, String> {
-        check_finite_nonneg("sigma_s", m.sigma_s)?;
-        check_finite_nonneg("sigma_a", m.sigma_a)?;
+    pub fn from_measured(m: &Measured, units_per_mm: f64, fit: Fit) -> Result<Self, ParamError> {
+        check_finite_nonneg(Param::SigmaS, m.sigma_s)?;
+        check_finite_nonneg(Param::SigmaA, m.sigma_a)?;
         check_albedo(m.albedo)?;
         check_eta(m.eta)?;
         check_units(units_per_mm)?;
         if !(m.g.is_finite() && m.g > -1.0 && m.g < 1.0) {
-            return Err(format!("g: {} must be in (-1, 1)", m.g));
+            return Err(ParamError::new(Param::G, m.g, Constraint::Open(-1.0, 1.0)));
         }
         let mut d = [0.0; 3];
-        for c in 0..3 {
+        for (c, dc) in d.iter_mut().enumerate() {
             let ss = m.sigma_s[c] * (1.0 - m.g);
             let sa = m.sigma_a[c];
             if ss + sa <= 0.0 {
-                return Err(format!(
-                    "sigma_s.{0}, sigma_a.{0}: both zero, there is no medium",
-                    CH[c]
-                ));
+                return Err(ParamError::new(Param::SigmaS, 0, Constraint::SomeMedium).channel(c));
             }
             let len_mm = if fit.uses_volume_mfp() {
                 1.0 / (ss + sa)
             } else {
                 diffuse_mfp(ss, sa)
             };
-            d[c] = len_mm * units_per_mm / fit.s(m.albedo[c]);
+            *dc = len_mm * units_per_mm / fit.s(m.albedo[c]);
         }
         let medium = Medium {
             sigma_s: m.sigma_s.map(|s| s / units_per_mm),
@@ -394,16 +393,21 @@ impl SubsurfaceParams {
         mfp: [f64; 3],
         eta: f32,
         fit: Fit,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ParamError> {
         check_albedo(albedo)?;
-        check_finite_nonneg("mfp", mfp)?;
+        check_finite_nonneg(Param::Mfp, mfp)?;
         check_eta(eta)?;
         let d = std::array::from_fn(|c| mfp[c] / fit.s(albedo[c]));
         let medium = Medium::from_reflectance(albedo, mfp, eta, fit.uses_volume_mfp());
         Self::checked(albedo, d, eta, medium)
     }
 
-    fn checked(albedo: [f64; 3], d: [f64; 3], eta: f32, medium: Medium) -> Result<Self, String> {
+    fn checked(
+        albedo: [f64; 3],
+        d: [f64; 3],
+        eta: f32,
+        medium: Medium,
+    ) -> Result<Self, ParamError> {
         let p = SubsurfaceParams {
             albedo,
             d,
@@ -415,9 +419,9 @@ impl SubsurfaceParams {
     }
 
     /// Checks the invariants every consumer relies on.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ParamError> {
         check_albedo(self.albedo)?;
-        check_finite_nonneg("d", self.d)?;
+        check_finite_nonneg(Param::D, self.d)?;
         check_eta(self.eta)
     }
 
@@ -477,7 +481,11 @@ mod tests {
             }
         }
         let e = SubsurfaceParams::from_preset("jade", 1.0, Fit::Searchlight).unwrap_err();
-        assert!(e.starts_with("preset:") && e.contains("Marble"), "{e}");
+        assert_eq!(e.param, Param::Preset);
+        assert!(
+            e.to_string().starts_with("preset:") && e.to_string().contains("Marble"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -548,16 +556,21 @@ mod tests {
     fn validation_names_the_field() {
         let e = SubsurfaceParams::from_artist([0.5, 1.2, 0.5], [1.0; 3], 1.3, Fit::Searchlight)
             .unwrap_err();
-        assert!(e.starts_with("albedo.g"), "{e}");
+        assert_eq!(
+            (e.param, e.channel, e.found.as_str()),
+            (Param::Albedo, Some(1), "1.2")
+        );
+        assert!(e.to_string().starts_with("albedo.g"), "{e}");
         let e =
             SubsurfaceParams::from_artist([0.5; 3], [1.0, f64::NAN, 1.0], 1.3, Fit::Searchlight)
                 .unwrap_err();
-        assert!(e.starts_with("mfp.g"), "{e}");
+        assert_eq!((e.param, e.channel), (Param::Mfp, Some(1)));
+        assert!(e.to_string().starts_with("mfp.g"), "{e}");
         let e =
             SubsurfaceParams::from_artist([0.5; 3], [1.0; 3], 0.0, Fit::Searchlight).unwrap_err();
-        assert!(e.starts_with("eta"), "{e}");
+        assert_eq!(e.param, Param::Eta);
         let e = SubsurfaceParams::from_preset("apple", -1.0, Fit::Searchlight).unwrap_err();
-        assert!(e.starts_with("units_per_mm"), "{e}");
+        assert_eq!(e.param, Param::UnitsPerMm);
         let base = Measured {
             sigma_s: [1.0; 3],
             sigma_a: [0.1; 3],
@@ -574,11 +587,14 @@ mod tests {
             Fit::Searchlight,
         )
         .unwrap_err();
-        assert!(e.starts_with("sigma_a.g"), "{e}");
+        assert_eq!((e.param, e.channel), (Param::SigmaA, Some(1)));
         let e =
             SubsurfaceParams::from_measured(&Measured { g: 1.0, ..base }, 1.0, Fit::Searchlight)
                 .unwrap_err();
-        assert!(e.starts_with("g:"), "{e}");
+        assert_eq!(
+            (e.param, &e.constraint),
+            (Param::G, &Constraint::Open(-1.0, 1.0))
+        );
         let e = SubsurfaceParams::from_measured(
             &Measured {
                 sigma_s: [0.0; 3],
@@ -589,7 +605,8 @@ mod tests {
             Fit::Searchlight,
         )
         .unwrap_err();
-        assert!(e.contains("no medium"), "{e}");
+        assert_eq!((e.param, e.channel), (Param::SigmaS, Some(0)));
+        assert!(e.to_string().contains("no medium"), "{e}");
         // artist form: ℓ = 0 is allowed and makes the channel inactive
         let a = SubsurfaceParams::from_artist([0.5; 3], [1.0, 0.0, 2.0], 1.3, Fit::Searchlight)
             .unwrap();

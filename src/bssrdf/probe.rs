@@ -41,6 +41,7 @@ use super::params::SubsurfaceParams;
 use super::profile;
 use super::radius::{RadialDist, RadiusSampler};
 use crate::accel::{Accel, Hit, ProbeHits};
+use crate::error::{Constraint, Param, ParamError};
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::sampling::Draw;
 
@@ -101,11 +102,15 @@ impl ProbeOptions {
         }
     }
 
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ParamError> {
         self.radius.validate()?;
         let q = self.rmax_quantile;
         if !(q > 0.0 && q < 1.0) {
-            return Err(format!("rmax_quantile: {q} must be in (0, 1)"));
+            return Err(ParamError::new(
+                Param::RmaxQuantile,
+                q,
+                Constraint::Open(0.0, 1.0),
+            ));
         }
         Ok(())
     }
@@ -181,7 +186,7 @@ pub struct ProbeSampler {
 impl ProbeSampler {
     /// Prepares the sampler. A material with no active channel is valid: it
     /// samples nothing ([`sample`](Self::sample) returns None).
-    pub fn new(params: &SubsurfaceParams, opts: &ProbeOptions) -> Result<Self, String> {
+    pub fn new(params: &SubsurfaceParams, opts: &ProbeOptions) -> Result<Self, ParamError> {
         params.validate()?;
         opts.validate()?;
         let rmax = profile::quantile(opts.rmax_quantile) * params.max_active_d();
@@ -1245,7 +1250,7 @@ mod tests {
                 },
             )
             .unwrap_err();
-            assert!(e.starts_with("rmax_quantile"), "{e}");
+            assert_eq!(e.param, crate::error::Param::RmaxQuantile, "{e}");
         }
         let s = ProbeSampler::new(&p, &ProbeOptions::default()).unwrap();
         assert!((s.rmax() - profile::quantile(0.999)).abs() < 1e-12);

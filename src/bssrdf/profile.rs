@@ -14,6 +14,8 @@
 
 use std::f64::consts::PI;
 
+use crate::error::{Constraint, Param, ParamError};
+
 /// Smallest radius, in units of d, at which the profile is evaluated.
 ///
 /// R(r) ~ 1/(4πd r) is integrable but infinite at r = 0, and a sampler fed
@@ -193,13 +195,18 @@ impl Fit {
 
     /// Parses "searchlight", "diffuse-transmission", "volume-mfp"
     /// (case-insensitive; '_' accepted for '-').
-    pub fn parse(name: &str) -> Result<Fit, String> {
+    pub fn parse(name: &str) -> Result<Fit, ParamError> {
         match name.to_ascii_lowercase().replace('_', "-").as_str() {
             "searchlight" => Ok(Fit::Searchlight),
             "diffuse-transmission" | "dmfp" => Ok(Fit::DiffuseTransmission),
             "volume-mfp" | "mfp" => Ok(Fit::VolumeMfp),
-            other => Err(format!(
-                "fit: unknown fit \"{other}\" (expected searchlight, diffuse-transmission or volume-mfp)"
+            other => Err(ParamError::new(
+                Param::Fit,
+                format!("\"{other}\""),
+                Constraint::Named {
+                    what: "fit",
+                    names: "expected searchlight, diffuse-transmission or volume-mfp".into(),
+                },
             )),
         }
     }
@@ -340,6 +347,11 @@ mod tests {
             }
         }
         assert_eq!(Fit::parse("Volume_MFP"), Ok(Fit::VolumeMfp));
-        assert!(Fit::parse("nope").unwrap_err().starts_with("fit:"));
+        let e = Fit::parse("nope").unwrap_err();
+        assert_eq!((e.param, e.found.as_str()), (Param::Fit, "\"nope\""));
+        assert!(
+            e.to_string().starts_with("fit: unknown fit \"nope\""),
+            "{e}"
+        );
     }
 }

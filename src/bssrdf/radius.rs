@@ -29,6 +29,7 @@ use std::f64::consts::PI;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use super::profile::{self, RHO_MIN};
+use crate::error::{Constraint, Param, ParamError};
 
 /// Where the nodes of a tabulated inverse CDF sit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -65,12 +66,10 @@ impl RadiusSampler {
     }
 
     /// Checks parameters (table size in [2, 2²⁴]).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ParamError> {
         if let RadiusSampler::Table { size, .. } = *self {
-            if !(2..=1 << 24).contains(&size) {
-                return Err(format!(
-                    "radius_sampler.table_size: {size} must be in [2, 16777216]"
-                ));
+            if !(2..=MAX_TABLE_SIZE).contains(&size) {
+                return Err(table_size_error(size));
             }
         }
         Ok(())
@@ -78,43 +77,60 @@ impl RadiusSampler {
 
     /// Parses "uniform", "analytic", "mixture", "table", "table:N",
     /// "table-uniform:N" (case-insensitive).
-    pub fn parse(s: &str) -> Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self, ParamError> {
         let s = s.to_ascii_lowercase();
         let (name, arg) = match s.split_once(':') {
             Some((n, a)) => (n, Some(a)),
             None => (s.as_str(), None),
         };
-        let size = |a: Option<&str>| -> Result<usize, String> {
+        let size = |a: Option<&str>| -> Result<usize, ParamError> {
             match a {
                 None => Ok(256),
                 Some(a) => a
                     .trim()
                     .parse()
-                    .map_err(|_| format!("radius_sampler: bad table size \"{a}\"")),
+                    .map_err(|_| table_size_error(format!("\"{a}\""))),
             }
         };
-        let r = match name.trim() {
-            "uniform" if arg.is_none() => RadiusSampler::Uniform,
-            "analytic" if arg.is_none() => RadiusSampler::Analytic,
-            "mixture" if arg.is_none() => RadiusSampler::Mixture,
-            "table" => RadiusSampler::Table {
-                size: size(arg)?,
-                spacing: TableSpacing::Tail,
-            },
-            "table-uniform" => RadiusSampler::Table {
-                size: size(arg)?,
-                spacing: TableSpacing::Uniform,
-            },
-            _ => {
-                return Err(format!(
-                    "radius_sampler: unknown sampler \"{s}\" (expected uniform, table[:N], \
-                     table-uniform[:N], analytic or mixture)"
-                ))
-            }
-        };
+        let r =
+            match name.trim() {
+                "uniform" if arg.is_none() => RadiusSampler::Uniform,
+                "analytic" if arg.is_none() => RadiusSampler::Analytic,
+                "mixture" if arg.is_none() => RadiusSampler::Mixture,
+                "table" => RadiusSampler::Table {
+                    size: size(arg)?,
+                    spacing: TableSpacing::Tail,
+                },
+                "table-uniform" => RadiusSampler::Table {
+                    size: size(arg)?,
+                    spacing: TableSpacing::Uniform,
+                },
+                _ => return Err(ParamError::new(
+                    Param::RadiusSampler,
+                    format!("\"{s}\""),
+                    Constraint::Named {
+                        what: "sampler",
+                        names:
+                            "expected uniform, table[:N], table-uniform[:N], analytic or mixture"
+                                .into(),
+                    },
+                )),
+            };
         r.validate()?;
         Ok(r)
     }
+}
+
+/// The largest table a [`RadiusSampler::Table`] may have (2²⁴ cells).
+const MAX_TABLE_SIZE: usize = 1 << 24;
+
+/// A table size outside [2, [`MAX_TABLE_SIZE`]], or not a number.
+fn table_size_error(found: impl std::fmt::Display) -> ParamError {
+    ParamError::new(
+        Param::TableSize,
+        found,
+        Constraint::IntegerIn(2, MAX_TABLE_SIZE as u64),
+    )
 }
 
 /// 1 − ξ of the last table node: the table's support ends at the radius
@@ -277,13 +293,17 @@ pub struct RadialDist {
 impl RadialDist {
     /// Prepares `sampler` for profile parameter `d` truncated at `rmax`
     /// (both in scene units, finite and positive).
-    pub fn new(sampler: RadiusSampler, d: f64, rmax: f64) -> Result<Self, String> {
+    pub fn new(sampler: RadiusSampler, d: f64, rmax: f64) -> Result<Self, ParamError> {
         sampler.validate()?;
         if !(d.is_finite() && d > 0.0) {
-            return Err(format!("d: {d} must be finite and positive to sample it"));
+            return Err(ParamError::new(Param::D, d, Constraint::FinitePositive));
         }
         if !(rmax.is_finite() && rmax > 0.0) {
-            return Err(format!("rmax: {rmax} must be finite and positive"));
+            return Err(ParamError::new(
+                Param::Rmax,
+                rmax,
+                Constraint::FinitePositive,
+            ));
         }
         let rho_max = rmax / d;
         let kind = match sampler {

@@ -8,6 +8,7 @@ pub mod tonemap;
 use std::fs;
 use std::path::{Path, PathBuf};
 
+use crate::error::Error;
 use crate::geometry::Vec3;
 pub use tonemap::ToneMap;
 
@@ -39,7 +40,7 @@ impl Film {
     /// line order: the exr crate's parallel writer emits blocks in the order
     /// they finish, which would make the file's bytes (not its pixels)
     /// differ from run to run.
-    pub fn write_exr(&self, path: &Path) -> Result<(), String> {
+    pub fn write_exr(&self, path: &Path) -> Result<(), Error> {
         use exr::prelude::*;
         let w = self.width as usize;
         let channels = SpecificChannels::rgba(|pos: Vec2<usize>| {
@@ -52,7 +53,7 @@ impl Film {
             line_order: LineOrder::Increasing,
         };
         let image = Image::from_encoded_channels((w, self.height as usize), encoding, channels);
-        atomic_write(path, |tmp| {
+        write_atomically(path, |tmp| {
             image
                 .write()
                 .non_parallel()
@@ -63,7 +64,7 @@ impl Film {
 
     /// Reads an RGBA/RGB float OpenEXR written by [`write_exr`](Self::write_exr)
     /// (or any RGB EXR), for tests, merging and studies.
-    pub fn read_exr(path: &Path) -> Result<Film, String> {
+    pub fn read_exr(path: &Path) -> Result<Film, Error> {
         use exr::prelude::*;
         let image = read_first_rgba_layer_from_file(
             path,
@@ -72,13 +73,16 @@ impl Film {
                 film.set(pos.x() as u32, pos.y() as u32, Vec3::new(r, g, b))
             },
         )
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+        .map_err(|e| crate::error::Error::Read {
+            path: path.to_path_buf(),
+            problem: e.to_string(),
+        })?;
         Ok(image.layer_data.channel_data.pixels)
     }
 
     /// Writes an 8-bit sRGB PNG preview through `tonemap` after scaling by
     /// 2^exposure.
-    pub fn write_png(&self, path: &Path, tonemap: ToneMap, exposure: f32) -> Result<(), String> {
+    pub fn write_png(&self, path: &Path, tonemap: ToneMap, exposure: f32) -> Result<(), Error> {
         let scale = exposure.exp2();
         let mut buf = Vec::with_capacity(self.pixels.len() * 3);
         for p in &self.pixels {
@@ -87,8 +91,13 @@ impl Film {
                 buf.push((tonemap::srgb_encode(v) * 255.0 + 0.5).clamp(0.0, 255.0) as u8);
             }
         }
-        let img = image::RgbImage::from_raw(self.width, self.height, buf).ok_or("bad film size")?;
-        atomic_write(path, |tmp| {
+        let img = image::RgbImage::from_raw(self.width, self.height, buf).ok_or_else(|| {
+            Error::Write {
+                path: path.to_path_buf(),
+                problem: "bad film size".into(),
+            }
+        })?;
+        write_atomically(path, |tmp| {
             img.save_with_format(tmp, image::ImageFormat::Png)
                 .map_err(|e| e.to_string())
         })
@@ -97,17 +106,30 @@ impl Film {
 
 /// Runs `write` on a temporary path next to `path`, then renames it into
 /// place; on any failure the temporary file is removed and nothing appears
-/// under `path`.
-pub fn atomic_write(
+/// under `path`. `write` reports its failure as a message; the error names
+/// `path`.
+pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let tmp = temp_path(path);
     let result = write(&tmp).and_then(|()| fs::rename(&tmp, path).map_err(|e| e.to_string()));
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
     }
-    result.map_err(|e| format!("cannot write {}: {e}", path.display()))
+    result.map_err(|problem| Error::Write {
+        path: path.to_path_buf(),
+        problem,
+    })
+}
+
+/// [`write_atomically`] with the error as its message (`cannot write PATH:
+/// …`), for the tools (plots, study, bench) that still report strings.
+pub fn atomic_write(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), String> {
+    write_atomically(path, write).map_err(String::from)
 }
 
 fn temp_path(path: &Path) -> PathBuf {

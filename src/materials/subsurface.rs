@@ -14,6 +14,7 @@
 //! cosine lobe 1/π.
 
 use crate::bssrdf::{sw_normalization, ProbeOptions, ProbeSampler, SubsurfaceParams};
+use crate::error::ParamError;
 use crate::geometry::Vec3;
 
 #[derive(Clone, Debug)]
@@ -44,7 +45,7 @@ impl Subsurface {
         opts: &ProbeOptions,
         exit_sw: bool,
         specular: bool,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ParamError> {
         let probe = ProbeSampler::new(&params, opts)?;
         Ok(Subsurface {
             sw_c: sw_normalization(params.eta),
@@ -98,7 +99,7 @@ impl SubsurfaceOverrides {
     }
 
     /// The material with these choices applied (its parameters unchanged).
-    pub fn apply(&self, ss: &Subsurface) -> Result<Subsurface, String> {
+    pub fn apply(&self, ss: &Subsurface) -> Result<Subsurface, ParamError> {
         let mut opts = *ss.probe.options();
         opts.radius = self.radius.unwrap_or(opts.radius);
         opts.rmax_quantile = self.rmax_quantile.unwrap_or(opts.rmax_quantile);
@@ -114,7 +115,7 @@ impl SubsurfaceOverrides {
     }
 
     /// Applies the overrides to every subsurface material of `materials`.
-    pub fn apply_all(&self, materials: &mut [super::Material]) -> Result<(), String> {
+    pub fn apply_all(&self, materials: &mut [super::Material]) -> Result<(), ParamError> {
         for m in materials.iter_mut() {
             if let super::Material::Subsurface(ss) = m {
                 *ss = std::sync::Arc::new(self.apply(ss)?);

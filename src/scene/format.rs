@@ -4,7 +4,11 @@
 //! rejects unknown keys, and every value that [`super::load()`] validates
 //! afterwards is wrapped in [`Spanned`] so a rejected value can be reported
 //! with its line. Range checks, name resolution and conversion to a
-//! [`super::Scene`] live in `load.rs`.
+//! [`super::Scene`] live in the loader (`load.rs` and the files it uses).
+//!
+//! Keys the format requires are `Option`s here too: the loader reports a
+//! missing one at its table's span, as data, rather than reading the key
+//! back out of serde's "missing field" message.
 //!
 //! Materials and shapes are flat tables with a `type` key rather than serde
 //! internally-tagged enums: serde buffers internally-tagged content, which
@@ -30,27 +34,30 @@ pub type Triple = [f64; 3];
 pub struct SceneFile {
     /// Scene units per millimetre (subsurface parameters are in mm).
     pub units_per_mm: Option<Spanned<f64>>,
-    pub camera: Spanned<CameraDef>,
+    /// Required.
+    pub camera: Option<Spanned<CameraDef>>,
     #[serde(default)]
     pub render: RenderDef,
     #[serde(default)]
     pub materials: BTreeMap<String, Spanned<MaterialDef>>,
     #[serde(default)]
     pub shapes: Vec<Spanned<ShapeDef>>,
-    pub environment: Option<EnvironmentDef>,
+    pub environment: Option<Spanned<EnvironmentDef>>,
 }
 
 /// `[camera]`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDef {
-    pub look_from: Spanned<Triple>,
-    pub look_at: Spanned<Triple>,
+    /// Required.
+    pub look_from: Option<Spanned<Triple>>,
+    /// Required.
+    pub look_at: Option<Spanned<Triple>>,
     pub up: Option<Spanned<Triple>>,
     /// Vertical field of view in degrees.
     pub fov_y: Option<Spanned<f64>>,
-    /// `[width, height]` in pixels.
-    pub resolution: Spanned<[u32; 2]>,
+    /// `[width, height]` in pixels. Required.
+    pub resolution: Option<Spanned<[u32; 2]>>,
 }
 
 /// `[render]`; every key is optional.
@@ -66,7 +73,8 @@ pub struct RenderDef {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDef {
-    pub radiance: Spanned<Triple>,
+    /// Required.
+    pub radiance: Option<Spanned<Triple>>,
 }
 
 /// The `type` of a `[materials.NAME]` table.
@@ -93,8 +101,9 @@ impl MaterialKind {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDef {
+    /// Required.
     #[serde(rename = "type")]
-    pub kind: Spanned<MaterialKind>,
+    pub kind: Option<Spanned<MaterialKind>>,
     pub albedo: Option<Spanned<Triple>>,
     pub eta: Option<Spanned<f64>>,
     // subsurface: parameters (one of three forms)
@@ -175,8 +184,9 @@ impl ShapeKind {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShapeDef {
+    /// Required.
     #[serde(rename = "type")]
-    pub kind: Spanned<ShapeKind>,
+    pub kind: Option<Spanned<ShapeKind>>,
     pub name: Option<String>,
     /// `obj`: path of the OBJ file, relative to the scene file's directory.
     pub file: Option<Spanned<String>>,
@@ -185,7 +195,8 @@ pub struct ShapeDef {
     pub smooth: Option<Spanned<bool>>,
     /// `sphere`: icosphere subdivision level.
     pub subdivisions: Option<Spanned<u32>>,
-    pub material: Spanned<String>,
+    /// The material's name. Required.
+    pub material: Option<Spanned<String>>,
     pub emission: Option<Spanned<Triple>>,
     pub scale: Option<Spanned<Scale>>,
     pub rotate: Option<Vec<Spanned<Rotation>>>,

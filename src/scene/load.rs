@@ -1,157 +1,54 @@
-//! Scene loading and validation: TOML text → [`super::format::SceneFile`] →
-//! checked values → [`Scene`].
+//! Scene loading: TOML text → [`super::format::SceneFile`] → checked
+//! values → [`Scene`].
 //!
-//! Every failure is a [`SceneError`] that names the file, the line whenever
+//! Every failure is an [`InputError`] that names the file, the line whenever
 //! the input has one, and the field (a dotted key path such as
-//! `shapes[2].material`). Nothing here panics on user input: OBJ files are
-//! checked line by line before `tobj` sees them (it can index out of bounds
-//! or overflow on bad face indices), and the `tobj` call is additionally
-//! fenced with `catch_unwind`.
+//! `shapes[2].material`). Nothing here panics on user input. The work is
+//! split by concept: `checked.rs` reads spanned values with checks,
+//! `material.rs` validates materials, `objects.rs` builds shapes,
+//! [`super::obj`] checks and parses OBJ meshes, and [`super::key_path`]
+//! locates the errors `toml` itself reports.
 
 use std::collections::HashMap;
-use std::ops::Range;
 use std::path::Path;
 use std::sync::Arc;
 
-use super::format::{MaterialDef, MaterialKind, SceneFile, ShapeDef, ShapeKind, Spanned, Triple};
-use super::transform::Transform;
-use super::{shapes, Camera, Object, RenderSettings, Scene, SceneError};
-use crate::geometry::{Mesh, Vec3};
-use crate::materials::{Material, Subsurface};
+use super::checked::{Cx, Res};
+use super::format::{CameraDef, RenderDef, SceneFile, Spanned};
+use super::material::material;
+use super::objects::object;
+use super::{Camera, RenderSettings, Scene};
+use crate::error::InputError;
+use crate::geometry::Vec3;
 
-/// Highest accepted `subdivisions` for spheres: 20·4⁹ ≈ 5.2 M triangles.
-pub const MAX_SPHERE_SUBDIVISIONS: u32 = 9;
+/// OBJ loading, also used on its own (the benchmark's meshes).
+pub use super::obj::load_obj;
+
 /// Largest accepted image side, in pixels.
 pub const MAX_RESOLUTION: u32 = 16384;
 
 /// Reads and loads the scene file at `path`.
-pub fn load(path: &Path) -> Result<Scene, SceneError> {
+pub fn load(path: &Path) -> Result<Scene, InputError> {
     let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::new(path, format!("cannot read scene file: {e}")))?;
+        .map_err(|e| InputError::new(path, format!("cannot read scene file: {e}")))?;
     load_str(&text, path)
 }
 
 /// Loads a scene from `text`; `path` names it in errors and is where
 /// relative OBJ paths are resolved from (its directory).
-pub fn load_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
+pub fn load_str(text: &str, path: &Path) -> Result<Scene, InputError> {
     let cx = Cx { file: path, text };
     let def: SceneFile = toml::from_str(text).map_err(|e| cx.toml_error(&e))?;
     build(&cx, def)
 }
 
-/// The scene file being loaded, for locating errors.
-struct Cx<'a> {
-    file: &'a Path,
-    text: &'a str,
-}
-
-type Res<T> = Result<T, SceneError>;
-
-impl Cx<'_> {
-    fn line_of(&self, offset: usize) -> usize {
-        line_of(self.text, offset)
-    }
-
-    /// An error at `span` in the scene file, in `field`.
-    fn err(&self, span: Range<usize>, field: &str, msg: impl Into<String>) -> SceneError {
-        SceneError::new(self.file, msg)
-            .at_line(self.line_of(span.start))
-            .in_field(field)
-    }
-
-    /// Converts a `toml` syntax or type error. Its message has no key path
-    /// when the error carries a span, so the path is recovered from the
-    /// span's position in the text.
-    fn toml_error(&self, e: &toml::de::Error) -> SceneError {
-        // Syntax errors carry a multi-line message; keep it on one line.
-        let msg = e.message().trim_end().replace('\n', "; ");
-        let mut err = SceneError::new(self.file, msg);
-        let missing = missing_field(e.message());
-        match (e.span(), missing) {
-            // A required top-level key comes with the empty span 0..0: there
-            // is no line to point at. (A table's missing key has the table's
-            // span, which starts at its header.)
-            (Some(span), Some(key)) if span.is_empty() => err = err.in_field(key),
-            (None, Some(key)) => err = err.in_field(key),
-            (Some(span), missing) => {
-                err = err.at_line(self.line_of(span.start));
-                let path = key_path_at(self.text, span.start);
-                let field = match (path, missing) {
-                    (Some(p), Some(k)) => Some(format!("{p}.{k}")),
-                    (None, Some(k)) => Some(k),
-                    (p, None) => p,
-                };
-                if let Some(f) = field {
-                    err = err.in_field(f);
-                }
-            }
-            (None, None) => {}
-        }
-        err
-    }
-
-    /// A finite `Vec3` (finite also after narrowing to f32).
-    fn vec3(&self, v: &Spanned<Triple>, field: &str) -> Res<Vec3> {
-        let a = v.get_ref();
-        let out = Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
-        if !out.is_finite() {
-            return Err(self.err(
-                v.span(),
-                field,
-                format!(
-                    "expected finite numbers, found [{}, {}, {}]",
-                    a[0], a[1], a[2]
-                ),
-            ));
-        }
-        Ok(out)
-    }
-
-    fn scalar(&self, v: &Spanned<f64>, field: &str) -> Res<f32> {
-        let x = *v.get_ref() as f32;
-        if !x.is_finite() {
-            return Err(self.err(
-                v.span(),
-                field,
-                format!("expected a finite number, found {}", v.get_ref()),
-            ));
-        }
-        Ok(x)
-    }
-
-    fn positive(&self, v: &Spanned<f64>, field: &str) -> Res<f32> {
-        let x = self.scalar(v, field)?;
-        if x <= 0.0 {
-            return Err(self.err(v.span(), field, format!("expected a number > 0, found {x}")));
-        }
-        Ok(x)
-    }
-
-    /// RGB with every component ≥ 0 (and ≤ 1 if `unit`).
-    fn rgb(&self, v: &Spanned<Triple>, field: &str, unit: bool) -> Res<Vec3> {
-        let c = self.vec3(v, field)?;
-        let ok = c.min_element() >= 0.0 && (!unit || c.max_element() <= 1.0);
-        if !ok {
-            let range = if unit { "in [0, 1]" } else { ">= 0" };
-            return Err(self.err(
-                v.span(),
-                field,
-                format!(
-                    "expected RGB components {range}, found [{}, {}, {}]",
-                    c.x, c.y, c.z
-                ),
-            ));
-        }
-        Ok(c)
-    }
-}
-
+/// The checked scene of a deserialized file.
 fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
     let units_per_mm = match &def.units_per_mm {
         Some(u) => cx.positive(u, "units_per_mm")?,
         None => 1.0,
     };
-    let camera = camera(cx, &def.camera)?;
+    let camera = camera(cx, cx.required(&def.camera, None, "camera")?)?;
     let settings = settings(cx, &def.render)?;
 
     // Materials: indexed in name order (the map is sorted), so the same file
@@ -167,42 +64,16 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
     let mut meshes = Vec::with_capacity(def.shapes.len());
     let mut objects = Vec::with_capacity(def.shapes.len());
     for (i, s) in def.shapes.iter().enumerate() {
-        let field = format!("shapes[{i}]");
-        let sd = s.get_ref();
-        let m = sd.material.get_ref();
-        let Some(&mat) = material_index.get(m.as_str()) else {
-            let mut known: Vec<&str> = material_index.keys().copied().collect();
-            known.sort_unstable();
-            let known = if known.is_empty() {
-                "no materials are defined".to_string()
-            } else {
-                format!("defined: {}", known.join(", "))
-            };
-            return Err(cx.err(
-                sd.material.span(),
-                &format!("{field}.material"),
-                format!("unknown material \"{m}\" ({known})"),
-            ));
-        };
-        let emission = match &sd.emission {
-            Some(e) => {
-                Some(cx.rgb(e, &format!("{field}.emission"), false)?).filter(|e| *e != Vec3::ZERO)
-            }
-            None => None,
-        };
-        let mut mesh = shape_mesh(cx, scene_dir, &field, s)?;
-        transform(cx, &field, sd)?.apply(&mut mesh);
+        let (mesh, obj) = object(cx, scene_dir, i, s, &material_index)?;
         meshes.push(mesh);
-        objects.push(Object {
-            name: sd.name.clone().unwrap_or(field),
-            material: mat,
-            emission,
-        });
+        objects.push(obj);
     }
 
     let environment = match &def.environment {
         Some(env) => {
-            Some(cx.rgb(&env.radiance, "environment.radiance", false)?).filter(|r| *r != Vec3::ZERO)
+            let field = "environment.radiance";
+            let r = cx.required(&env.get_ref().radiance, Some(env.span()), field)?;
+            Some(cx.rgb(r, field, false)?).filter(|r| *r != Vec3::ZERO)
         }
         None => None,
     };
@@ -219,10 +90,16 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
     })
 }
 
-fn camera(cx: &Cx, c: &Spanned<super::format::CameraDef>) -> Res<Camera> {
+/// `[camera]`: the required keys present, values finite, the field of view
+/// in (0°, 180°), the resolution in range, and a well-defined view frame.
+fn camera(cx: &Cx, c: &Spanned<CameraDef>) -> Res<Camera> {
     let d = c.get_ref();
-    let from = cx.vec3(&d.look_from, "camera.look_from")?;
-    let at = cx.vec3(&d.look_at, "camera.look_at")?;
+    let required = |v, field| cx.required(v, Some(c.span()), field);
+    let look_from = required(&d.look_from, "camera.look_from")?;
+    let look_at = required(&d.look_at, "camera.look_at")?;
+    let resolution = cx.required(&d.resolution, Some(c.span()), "camera.resolution")?;
+    let from = cx.vec3(look_from, "camera.look_from")?;
+    let at = cx.vec3(look_at, "camera.look_at")?;
     let up = match &d.up {
         Some(u) => cx.vec3(u, "camera.up")?,
         None => Vec3::Y,
@@ -241,10 +118,10 @@ fn camera(cx: &Cx, c: &Spanned<super::format::CameraDef>) -> Res<Camera> {
         }
         None => 40.0,
     };
-    let [w, h] = *d.resolution.get_ref();
+    let [w, h] = *resolution.get_ref();
     if w == 0 || h == 0 || w > MAX_RESOLUTION || h > MAX_RESOLUTION {
         return Err(cx.err(
-            d.resolution.span(),
+            resolution.span(),
             "camera.resolution",
             format!("expected [width, height] each in 1..={MAX_RESOLUTION}, found [{w}, {h}]"),
         ));
@@ -253,7 +130,7 @@ fn camera(cx: &Cx, c: &Spanned<super::format::CameraDef>) -> Res<Camera> {
     let scale = from.abs().max(at.abs()).max_element().max(1.0);
     if view.length() <= 1e-6 * scale {
         return Err(cx.err(
-            d.look_at.span(),
+            look_at.span(),
             "camera.look_at",
             "look_at must differ from look_from",
         ));
@@ -275,7 +152,8 @@ fn camera(cx: &Cx, c: &Spanned<super::format::CameraDef>) -> Res<Camera> {
     Ok(Camera::new(from, at, up, fov, w, h))
 }
 
-fn settings(cx: &Cx, r: &super::format::RenderDef) -> Res<RenderSettings> {
+/// `[render]`: defaults for what it does not give.
+fn settings(cx: &Cx, r: &RenderDef) -> Res<RenderSettings> {
     let mut s = RenderSettings::default();
     if let Some(spp) = &r.spp {
         if *spp.get_ref() == 0 {
@@ -303,772 +181,12 @@ fn settings(cx: &Cx, r: &super::format::RenderDef) -> Res<RenderSettings> {
     Ok(s)
 }
 
-/// Rejects keys that belong to other types than `kind`.
-fn only_keys(
-    cx: &Cx,
-    field: &str,
-    kind: &str,
-    present: Vec<(&'static str, Range<usize>)>,
-    allowed: &[&str],
-) -> Res<()> {
-    for (key, span) in present {
-        if !allowed.contains(&key) {
-            let allowed = if allowed.is_empty() {
-                "none".to_string()
-            } else {
-                allowed.join(", ")
-            };
-            return Err(cx.err(
-                span,
-                &format!("{field}.{key}"),
-                format!("`{key}` does not apply to type \"{kind}\" (its keys: {allowed})"),
-            ));
-        }
-    }
-    Ok(())
-}
-
-fn material(cx: &Cx, name: &str, m: &Spanned<MaterialDef>, units_per_mm: f32) -> Res<Material> {
-    let field = format!("materials.{name}");
-    let d = m.get_ref();
-    let kind = *d.kind.get_ref();
-    let missing = |key: &str| {
-        cx.err(
-            m.span(),
-            &format!("{field}.{key}"),
-            format!(
-                "missing field `{key}` (required for type \"{}\")",
-                kind.name()
-            ),
-        )
-    };
-    match kind {
-        MaterialKind::Diffuse => {
-            only_keys(cx, &field, kind.name(), d.present_keys(), &["albedo"])?;
-            let a = d.albedo.as_ref().ok_or_else(|| missing("albedo"))?;
-            Ok(Material::Diffuse {
-                albedo: cx.rgb(a, &format!("{field}.albedo"), true)?,
-            })
-        }
-        MaterialKind::Dielectric => {
-            only_keys(cx, &field, kind.name(), d.present_keys(), &["eta"])?;
-            let e = d.eta.as_ref().ok_or_else(|| missing("eta"))?;
-            Ok(Material::Dielectric {
-                eta: cx.positive(e, &format!("{field}.eta"))?,
-            })
-        }
-        MaterialKind::Subsurface => {
-            only_keys(cx, &field, kind.name(), d.present_keys(), SUBSURFACE_KEYS)?;
-            subsurface(cx, &field, m, units_per_mm)
-        }
-    }
-}
-
-const SUBSURFACE_KEYS: &[&str] = &[
-    "preset",
-    "sigma_s_prime",
-    "sigma_a",
-    "g",
-    "albedo",
-    "dmfp",
-    "eta",
-    "fit",
-    "radius",
-    "rmax_quantile",
-    "axes",
-    "channel",
-    "renormalize",
-    "exit_sw",
-    "specular",
-];
-
-fn text(v: &Option<Spanned<String>>) -> Option<(&str, std::ops::Range<usize>)> {
-    v.as_ref().map(|s| (s.get_ref().as_str(), s.span()))
-}
-
-/// A `type = "subsurface"` material: one of three parameter forms (preset;
-/// measured σs', σa, A; artist A, dmfp), then the sampling options.
-fn subsurface(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units_per_mm: f32) -> Res<Material> {
-    use crate::bssrdf::{
-        ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler, SubsurfaceParams,
-    };
-    let d = m.get_ref();
-    let f = |k: &str| format!("{field}.{k}");
-    let units = units_per_mm as f64;
-    // Errors from the bssrdf module start with the offending key, named as
-    // there: `sigma_s` for the σs' given here, `mfp` for `dmfp`.
-    let param_err = |mut msg: String| {
-        for (from, to) in [("sigma_s.", "sigma_s_prime."), ("mfp.", "dmfp.")] {
-            if let Some(rest) = msg.strip_prefix(from) {
-                msg = format!("{to}{rest}");
-            }
-        }
-        let key = msg
-            .split([':', '.'])
-            .next()
-            .unwrap_or("")
-            .trim()
-            .to_string();
-        let span = d
-            .present_keys()
-            .into_iter()
-            .find(|(k, _)| *k == key)
-            .map(|(_, s)| s)
-            .unwrap_or(m.span());
-        cx.err(span, &f(&key), msg)
-    };
-    let fit = match text(&d.fit) {
-        Some((s, span)) => Fit::parse(s).map_err(|e| cx.err(span, &f("fit"), e))?,
-        None => Fit::Searchlight,
-    };
-    let eta = d
-        .eta
-        .as_ref()
-        .map(|e| cx.positive(e, &f("eta")))
-        .transpose()?;
-    let triple = |v: &Option<Spanned<[f64; 3]>>, k: &str| -> Res<Option<[f64; 3]>> {
-        v.as_ref()
-            .map(|t| {
-                // checked as f32, kept as written (no 1.2000000476837158)
-                cx.vec3(t, &f(k)).map(|_| *t.get_ref())
-            })
-            .transpose()
-    };
-    let albedo = triple(&d.albedo, "albedo")?;
-    let (sigma_s, sigma_a, dmfp) = (
-        triple(&d.sigma_s_prime, "sigma_s_prime")?,
-        triple(&d.sigma_a, "sigma_a")?,
-        triple(&d.dmfp, "dmfp")?,
-    );
-    let forms =
-        "give exactly one of: `preset`; `sigma_s_prime` + `sigma_a` + `albedo`; `albedo` + `dmfp`";
-    // Keys of two forms: name the first key of each, at the later one's line
-    // (`albedo` belongs to the measured and the artist form).
-    let present = d.present_keys();
-    let span_of = |k: &str| {
-        present
-            .iter()
-            .find(|(p, _)| *p == k)
-            .map(|(_, s)| s.clone())
-    };
-    let groups: [&[&str]; 3] = [
-        &["preset"],
-        &["sigma_s_prime", "sigma_a", "g"],
-        &["dmfp", "albedo"],
-    ];
-    let firsts: Vec<&str> = groups
-        .iter()
-        .filter_map(|g| g.iter().copied().find(|k| span_of(k).is_some()))
-        .collect();
-    if let [a, b, ..] = firsts[..] {
-        if a == "preset" || b == "dmfp" {
-            let msg = format!("`{a}` cannot be combined with `{b}`; {forms}");
-            return Err(cx.err(span_of(b).unwrap_or(m.span()), &f(b), msg));
-        }
-    }
-    let params = match (text(&d.preset), sigma_s.or(sigma_a), dmfp) {
-        (Some((name, span)), None, None) if albedo.is_none() && d.g.is_none() => {
-            let mut p = SubsurfaceParams::from_preset(name, units, fit)
-                .map_err(|e| cx.err(span, &f("preset"), e))?;
-            if let Some(eta) = eta {
-                p.eta = eta;
-            }
-            p
-        }
-        (None, Some(_), None) => {
-            let (Some(ss), Some(sa)) = (sigma_s, sigma_a) else {
-                let missing = if sigma_s.is_none() {
-                    "sigma_s_prime"
-                } else {
-                    "sigma_a"
-                };
-                return Err(cx.err(
-                    m.span(),
-                    &f(missing),
-                    format!("missing field `{missing}`: measured parameters need `sigma_s_prime`, `sigma_a` and `albedo`"),
-                ));
-            };
-            let Some(albedo) = albedo else {
-                return Err(cx.err(
-                    m.span(),
-                    &f("albedo"),
-                    format!("missing field `albedo` for measured parameters; {forms}"),
-                ));
-            };
-            // g is checked here, before σs = σs'/(1 − g) below (g = 1 would
-            // make that infinite), and so is σs' as written.
-            let g = match &d.g {
-                Some(gs) => {
-                    let g = *gs.get_ref();
-                    if !(g > -1.0 && g < 1.0) {
-                        return Err(cx.err(
-                            gs.span(),
-                            &f("g"),
-                            format!("g: {g} must be in (-1, 1)"),
-                        ));
-                    }
-                    g
-                }
-                None => 0.0,
-            };
-            if let Some((c, x)) = ss
-                .iter()
-                .enumerate()
-                .find(|(_, x)| !x.is_finite() || **x < 0.0)
-            {
-                let ch = ["r", "g", "b"][c];
-                return Err(param_err(format!(
-                    "sigma_s.{ch}: {x} must be finite and non-negative"
-                )));
-            }
-            // σs' is given: σs = σs' / (1 − g) so that the loader's σs(1 − g) is σs' again.
-            let sigma_s = ss.map(|x| x / (1.0 - g));
-            let measured = Measured {
-                sigma_s,
-                sigma_a: sa,
-                g,
-                albedo,
-                eta: eta.unwrap_or(1.3),
-            };
-            SubsurfaceParams::from_measured(&measured, units, fit).map_err(param_err)?
-        }
-        (None, None, Some(mfp)) if d.g.is_none() => {
-            let Some(albedo) = albedo else {
-                return Err(cx.err(
-                    m.span(),
-                    &f("albedo"),
-                    format!("missing field `albedo` for the artist form; {forms}"),
-                ));
-            };
-            SubsurfaceParams::from_artist(albedo, mfp.map(|x| x * units), eta.unwrap_or(1.3), fit)
-                .map_err(param_err)?
-        }
-        _ => return Err(cx.err(m.span(), field, format!("subsurface parameters: {forms}"))),
-    };
-
-    let mut opts = ProbeOptions::default();
-    if let Some((s, span)) = text(&d.radius) {
-        opts.radius = RadiusSampler::parse(s).map_err(|e| {
-            // the bssrdf module's name for this key is `radius_sampler`
-            let e = e
-                .replacen("radius_sampler.table_size: ", "table size ", 1)
-                .replacen("radius_sampler: ", "", 1);
-            cx.err(span, &f("radius"), e)
-        })?;
-    }
-    if let Some(q) = &d.rmax_quantile {
-        let v = cx.scalar(q, &f("rmax_quantile"))? as f64;
-        if !(v > 0.0 && v < 1.0) {
-            return Err(cx.err(
-                q.span(),
-                &f("rmax_quantile"),
-                format!("expected a number in (0, 1), found {v}"),
-            ));
-        }
-        opts.rmax_quantile = *q.get_ref();
-    }
-    if let Some((s, span)) = text(&d.axes) {
-        opts.axes = match s.to_ascii_lowercase().as_str() {
-            "normal" => ProbeAxes::Normal,
-            "mis3" => ProbeAxes::Mis3,
-            _ => {
-                return Err(cx.err(
-                    span,
-                    &f("axes"),
-                    format!("expected \"normal\" or \"mis3\", found \"{s}\""),
-                ))
-            }
-        };
-    }
-    if let Some((s, span)) = text(&d.channel) {
-        opts.channel = match s.to_ascii_lowercase().as_str() {
-            "single" => ChannelStrategy::Single,
-            "mis" => ChannelStrategy::Mis,
-            _ => {
-                return Err(cx.err(
-                    span,
-                    &f("channel"),
-                    format!("expected \"single\" or \"mis\", found \"{s}\""),
-                ))
-            }
-        };
-    }
-    if let Some(b) = &d.renormalize {
-        opts.renormalize = *b.get_ref();
-    }
-    let flag = |b: &Option<Spanned<bool>>| b.as_ref().map(|b| *b.get_ref()).unwrap_or(true);
-    let ss = Subsurface::new(params, &opts, flag(&d.exit_sw), flag(&d.specular))
-        .map_err(|e| cx.err(m.span(), field, e))?;
-    Ok(Material::Subsurface(Arc::new(ss)))
-}
-
-fn shape_mesh(cx: &Cx, dir: &Path, field: &str, s: &Spanned<ShapeDef>) -> Res<Mesh> {
-    let d = s.get_ref();
-    let kind = *d.kind.get_ref();
-    let allowed: &[&str] = match kind {
-        ShapeKind::Obj => &["file", "smooth"],
-        ShapeKind::Sphere => &["subdivisions"],
-        ShapeKind::Quad | ShapeKind::Box => &[],
-    };
-    only_keys(cx, field, kind.name(), d.present_type_keys(), allowed)?;
-    match kind {
-        ShapeKind::Obj => {
-            let Some(f) = &d.file else {
-                return Err(cx.err(
-                    s.span(),
-                    &format!("{field}.file"),
-                    "missing field `file` (required for type \"obj\")",
-                ));
-            };
-            let path = dir.join(f.get_ref());
-            let text = std::fs::read_to_string(&path).map_err(|e| {
-                cx.err(
-                    f.span(),
-                    &format!("{field}.file"),
-                    format!("cannot read OBJ file {}: {e}", path.display()),
-                )
-            })?;
-            let mut mesh = load_obj(&text, &path)?;
-            if d.smooth.as_ref().is_some_and(|b| *b.get_ref()) && mesh.normals.is_none() {
-                mesh.compute_smooth_normals();
-            }
-            Ok(mesh)
-        }
-        ShapeKind::Sphere => {
-            let level = match &d.subdivisions {
-                Some(l) if *l.get_ref() > MAX_SPHERE_SUBDIVISIONS => {
-                    return Err(cx.err(
-                        l.span(),
-                        &format!("{field}.subdivisions"),
-                        format!(
-                        "expected at most {MAX_SPHERE_SUBDIVISIONS} (20·4^n triangles), found {}",
-                        l.get_ref()
-                    ),
-                    ))
-                }
-                Some(l) => *l.get_ref(),
-                None => 4,
-            };
-            Ok(shapes::sphere(level))
-        }
-        ShapeKind::Quad => Ok(shapes::quad()),
-        ShapeKind::Box => Ok(shapes::cuboid()),
-    }
-}
-
-fn transform(cx: &Cx, field: &str, d: &ShapeDef) -> Res<Transform> {
-    let scale = match &d.scale {
-        Some(s) => {
-            let f = format!("{field}.scale");
-            let v = cx.vec3(&Spanned::new(s.span(), s.get_ref().0), &f)?;
-            if v.x == 0.0 || v.y == 0.0 || v.z == 0.0 {
-                return Err(cx.err(
-                    s.span(),
-                    &f,
-                    "scale components must be non-zero (negative mirrors)",
-                ));
-            }
-            v
-        }
-        None => Vec3::ONE,
-    };
-    let mut rotations = Vec::new();
-    for (k, r) in d.rotate.iter().flatten().enumerate() {
-        let f = format!("{field}.rotate[{k}]");
-        let rot = r.get_ref();
-        let angle = cx.scalar(&Spanned::new(r.span(), rot.angle_deg), &f)?;
-        let axis = cx.vec3(&Spanned::new(r.span(), rot.axis), &f)?;
-        if axis.length() == 0.0 || !axis.length().is_finite() {
-            return Err(cx.err(r.span(), &f, "rotation axis must be non-zero"));
-        }
-        rotations.push((angle, axis));
-    }
-    let translate = match &d.translate {
-        Some(t) => cx.vec3(t, &format!("{field}.translate"))?,
-        None => Vec3::ZERO,
-    };
-    Ok(Transform::from_srt(scale, &rotations, translate))
-}
-
-/// Loads an OBJ file's faces (all objects and groups) as one mesh. Shading
-/// normals are kept only if every vertex has one; materials (`mtllib`) are
-/// ignored — the scene file assigns the material.
-pub fn load_obj(text: &str, path: &Path) -> Res<Mesh> {
-    check_obj(text).map_err(|(line, msg)| SceneError::new(path, msg).at_line(line))?;
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let result = std::panic::catch_unwind(|| {
-        tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| {
-            Err(tobj::LoadError::GenericFailure)
-        })
-    });
-    let models = match result {
-        Ok(Ok((models, _materials))) => models,
-        Ok(Err(e)) => return Err(SceneError::new(path, format!("invalid OBJ data: {e}"))),
-        Err(_) => {
-            return Err(SceneError::new(
-                path,
-                "invalid OBJ data (the OBJ parser failed on this file)",
-            ))
-        }
-    };
-
-    let mut positions = Vec::new();
-    let mut normals = Vec::new();
-    let mut all_normals = true;
-    let mut indices = Vec::new();
-    for m in &models {
-        let m = &m.mesh;
-        let base = positions.len();
-        let nv = m.positions.len() / 3;
-        if m.positions.len() % 3 != 0 || m.indices.len() % 3 != 0 {
-            return Err(SceneError::new(
-                path,
-                "invalid OBJ data: malformed mesh arrays",
-            ));
-        }
-        for p in m.positions.chunks_exact(3) {
-            positions.push(Vec3::new(p[0], p[1], p[2]));
-        }
-        if m.normals.len() == m.positions.len() {
-            normals.extend(
-                m.normals
-                    .chunks_exact(3)
-                    .map(|n| Vec3::new(n[0], n[1], n[2])),
-            );
-        } else {
-            all_normals = false;
-        }
-        for t in m.indices.chunks_exact(3) {
-            if t.iter().any(|&i| i as usize >= nv) {
-                return Err(SceneError::new(
-                    path,
-                    "invalid OBJ data: face index out of range",
-                ));
-            }
-            let off = |i: u32| u32::try_from(base + i as usize);
-            match (off(t[0]), off(t[1]), off(t[2])) {
-                (Ok(a), Ok(b), Ok(c)) => indices.push([a, b, c]),
-                _ => return Err(SceneError::new(path, "OBJ file has too many vertices")),
-            }
-        }
-    }
-    if indices.is_empty() {
-        return Err(SceneError::new(
-            path,
-            "OBJ file contains no triangles (no `f` lines with 3 or more vertices)",
-        ));
-    }
-    if positions.iter().any(|p| !p.is_finite()) {
-        return Err(SceneError::new(
-            path,
-            "OBJ file has non-finite vertex positions",
-        ));
-    }
-    let normals = (all_normals && normals.iter().all(|n| n.is_finite() && n.length() > 0.0))
-        .then(|| normals.into_iter().map(Vec3::normalize).collect());
-    Ok(Mesh::new(positions, indices, normals))
-}
-
-/// Checks the OBJ statements `tobj` would trust: numbers in `v`/`vt`/`vn`
-/// lines must parse and be finite, and every face index must be non-zero
-/// and refer to an element defined before it. Returns (line, message).
-fn check_obj(text: &str) -> Result<(), (usize, String)> {
-    let (mut nv, mut nt, mut nn) = (0usize, 0usize, 0usize);
-    for (ln, line) in text.lines().enumerate() {
-        let ln = ln + 1;
-        let mut words = line.split_whitespace();
-        let Some(tag) = words.next() else { continue };
-        let numbers = |words: std::str::SplitWhitespace, need: usize, what: &str| {
-            let vals: Vec<&str> = words.collect();
-            if vals.len() < need {
-                return Err((
-                    ln,
-                    format!("`{what}` needs {need} numbers, found {}", vals.len()),
-                ));
-            }
-            let mut out = Vec::with_capacity(vals.len());
-            for w in vals {
-                match w.parse::<f32>() {
-                    Ok(x) if x.is_finite() => out.push(x),
-                    Ok(_) => return Err((ln, format!("`{what}` has a non-finite number `{w}`"))),
-                    Err(_) => return Err((ln, format!("`{what}` has `{w}`, expected a number"))),
-                }
-            }
-            Ok(out)
-        };
-        match tag {
-            "v" => {
-                // tobj reads `x y z`, `x y z w` (dividing by w) or
-                // `x y z r g b`, and rejects other counts.
-                let v = numbers(words, 3, "v")?;
-                match v.len() {
-                    3 | 6 => {}
-                    4 if v[3] != 0.0 && v[..3].iter().all(|x| (x / v[3]).is_finite()) => {}
-                    4 => {
-                        return Err((
-                            ln,
-                            format!("`v` has weight w = {} that makes it non-finite", v[3]),
-                        ))
-                    }
-                    n => {
-                        return Err((
-                            ln,
-                            format!("`v` has {n} numbers, expected x y z, x y z w or x y z r g b"),
-                        ))
-                    }
-                }
-                nv += 1;
-            }
-            "vt" => {
-                numbers(words, 2, "vt")?;
-                nt += 1;
-            }
-            "vn" => {
-                let n = numbers(words, 3, "vn")?;
-                if n[..3].iter().all(|&x| x == 0.0) {
-                    return Err((ln, "`vn` is a zero-length normal".into()));
-                }
-                nn += 1;
-            }
-            "f" | "l" | "p" => {
-                let refs: Vec<&str> = words.collect();
-                if tag == "f" && refs.len() < 3 {
-                    return Err((
-                        ln,
-                        format!("face has {} vertices, expected at least 3", refs.len()),
-                    ));
-                }
-                for r in refs {
-                    let parts: Vec<&str> = r.split('/').collect();
-                    if parts.len() > 3 || parts[0].is_empty() {
-                        return Err((
-                            ln,
-                            format!(
-                                "malformed face vertex `{r}` (expected v, v/vt, v//vn or v/vt/vn)"
-                            ),
-                        ));
-                    }
-                    for (k, (p, count, what)) in parts
-                        .iter()
-                        .zip([(nv, "vertex"), (nt, "texture coordinate"), (nn, "normal")])
-                        .map(|(p, (c, w))| (p, c, w))
-                        .enumerate()
-                    {
-                        if k > 0 && p.is_empty() {
-                            continue;
-                        }
-                        let i: i64 = p.parse().map_err(|_| {
-                            (
-                                ln,
-                                format!(
-                                    "malformed face vertex `{r}`: `{p}` is not an integer index"
-                                ),
-                            )
-                        })?;
-                        let ok = if i > 0 {
-                            (i as u64) <= count as u64
-                        } else {
-                            i != 0 && i.unsigned_abs() <= count as u64
-                        };
-                        if !ok {
-                            return Err((
-                                ln,
-                                format!(
-                                    "face {what} index {i} out of range: {count} defined before this line (indices start at 1; negative ones count back)"
-                                ),
-                            ));
-                        }
-                    }
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok(())
-}
-
-/// The 1-based line containing byte `offset` of `text`.
-pub(crate) fn line_of(text: &str, offset: usize) -> usize {
-    let end = offset.min(text.len());
-    text.as_bytes()[..end]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
-}
-
-/// The field named by serde's "missing field `x`" message, if that is what
-/// `msg` is.
-fn missing_field(msg: &str) -> Option<String> {
-    let rest = msg.strip_prefix("missing field `")?;
-    Some(rest[..rest.find('`')?].to_string())
-}
-
-/// The dotted key path (`materials.red.albedo`, `shapes[1].file`) of the
-/// TOML statement containing byte `offset`, from a lightweight scan that
-/// follows table headers, keys, strings, comments and bracket nesting.
-/// Array-of-tables entries are numbered from 0. Values nested in inline
-/// tables are attributed to the enclosing key.
-pub(crate) fn key_path_at(text: &str, offset: usize) -> Option<String> {
-    let b = text.as_bytes();
-    let mut header = String::new();
-    let mut aot: HashMap<String, usize> = HashMap::new();
-    let mut i = 0;
-    let join = |h: &str, k: &str| {
-        if h.is_empty() {
-            k.to_string()
-        } else {
-            format!("{h}.{k}")
-        }
-    };
-    while i < b.len() {
-        // Skip blank space and comments between statements.
-        match b[i] {
-            b' ' | b'\t' | b'\r' | b'\n' => {
-                i += 1;
-                continue;
-            }
-            b'#' => {
-                i = skip_line(b, i);
-                continue;
-            }
-            _ => {}
-        }
-        let start = i;
-        if b[i] == b'[' {
-            let double = b.get(i + 1) == Some(&b'[');
-            let name_start = i + if double { 2 } else { 1 };
-            let close = scan_key_until(b, name_start, b']');
-            let name = normalize_key(&text[name_start..close]);
-            let end = skip_line(b, close);
-            if double {
-                let n = aot.entry(name.clone()).or_insert(0);
-                header = format!("{name}[{n}]");
-                *n += 1;
-            } else {
-                header = name;
-            }
-            if (start..end).contains(&offset) {
-                return Some(header);
-            }
-            i = end;
-        } else {
-            let eq = scan_key_until(b, i, b'=');
-            if b.get(eq) != Some(&b'=') {
-                // Not a key-value pair (a syntax error): no field to name.
-                if (start..eq.max(start + 1)).contains(&offset) {
-                    return None;
-                }
-                i = eq.max(start + 1);
-                continue;
-            }
-            let key = normalize_key(&text[start..eq]);
-            let end = skip_value(b, (eq + 1).min(b.len()));
-            if (start..end.max(start + 1)).contains(&offset) {
-                return Some(join(&header, &key));
-            }
-            i = end.max(start + 1);
-        }
-    }
-    (!header.is_empty() && offset >= text.len()).then_some(header)
-}
-
-fn skip_line(b: &[u8], mut i: usize) -> usize {
-    while i < b.len() && b[i] != b'\n' {
-        i += 1;
-    }
-    i
-}
-
-/// Index of the first `stop` byte outside quotes at or after `i`, or the end
-/// of the line.
-fn scan_key_until(b: &[u8], mut i: usize, stop: u8) -> usize {
-    while i < b.len() && b[i] != b'\n' {
-        match b[i] {
-            c if c == stop => return i,
-            q @ (b'"' | b'\'') => {
-                i += 1;
-                while i < b.len() && b[i] != q && b[i] != b'\n' {
-                    i += if q == b'"' && b[i] == b'\\' { 2 } else { 1 };
-                }
-                i += 1;
-            }
-            _ => i += 1,
-        }
-    }
-    i.min(b.len())
-}
-
-/// End of the value starting at `i`: the first newline outside strings,
-/// comments and brackets.
-fn skip_value(b: &[u8], mut i: usize) -> usize {
-    let mut depth = 0usize;
-    while i < b.len() {
-        match b[i] {
-            b'\n' if depth == 0 => return i,
-            b'[' | b'{' => depth += 1,
-            b']' | b'}' => depth = depth.saturating_sub(1),
-            b'#' => {
-                i = skip_line(b, i);
-                continue;
-            }
-            q @ (b'"' | b'\'') => {
-                let triple = b.get(i + 1) == Some(&q) && b.get(i + 2) == Some(&q);
-                if triple {
-                    i += 3;
-                    while i < b.len()
-                        && !(b[i] == q && b.get(i + 1) == Some(&q) && b.get(i + 2) == Some(&q))
-                    {
-                        i += if q == b'"' && b[i] == b'\\' { 2 } else { 1 };
-                    }
-                    i += 3;
-                } else {
-                    i += 1;
-                    while i < b.len() && b[i] != q && b[i] != b'\n' {
-                        i += if q == b'"' && b[i] == b'\\' { 2 } else { 1 };
-                    }
-                    i += 1;
-                }
-                continue;
-            }
-            _ => {}
-        }
-        i += 1;
-    }
-    b.len()
-}
-
-/// `a . "b c"` → `a."b c"`; bare keys keep their spelling.
-fn normalize_key(k: &str) -> String {
-    let mut out = String::new();
-    let mut in_q: Option<char> = None;
-    for c in k.trim().chars() {
-        match in_q {
-            Some(q) => {
-                out.push(c);
-                if c == q {
-                    in_q = None;
-                }
-            }
-            None if c == '"' || c == '\'' => {
-                in_q = Some(c);
-                out.push(c);
-            }
-            None if c.is_whitespace() => {}
-            None => out.push(c),
-        }
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Mesh;
+    use crate::materials::Material;
+    use crate::scene::shapes;
 
     const CAMERA: &str =
         "[camera]\nlook_from = [0, 0, 5]\nlook_at = [0, 0, 0]\nresolution = [64, 32]\n";
@@ -1338,25 +456,5 @@ mod tests {
         assert_eq!(s.meshes[4].triangle_count(), 3674);
         assert_eq!(s.settings.seed, 1);
         assert!(s.environment.is_some());
-    }
-
-    #[test]
-    fn key_paths_follow_headers_arrays_and_strings() {
-        let t =
-            "a = 1\n[camera]\nlook_from = [\n  0, # ] comment\n  1,\n  2]\nname = \"x = [ #\"\n\
-                 [[shapes]]\ntype = 'quad'\n[[shapes]]\n  file = \"\"\"\nmulti = line\n\"\"\"\n\
-                 [ materials . \"my red\" ]\nalbedo = {r = 1}\n";
-        let at = |needle: &str| key_path_at(t, t.find(needle).unwrap());
-        assert_eq!(at("a = 1").as_deref(), Some("a"));
-        assert_eq!(at("[camera]").as_deref(), Some("camera"));
-        assert_eq!(at("1,").as_deref(), Some("camera.look_from"));
-        assert_eq!(at("2]").as_deref(), Some("camera.look_from"));
-        assert_eq!(at("\"x =").as_deref(), Some("camera.name"));
-        assert_eq!(at("'quad'").as_deref(), Some("shapes[0].type"));
-        assert_eq!(at("multi").as_deref(), Some("shapes[1].file"));
-        assert_eq!(at("r = 1").as_deref(), Some("materials.\"my red\".albedo"));
-        assert_eq!(line_of(t, t.find("2]").unwrap()), 6);
-        assert_eq!(line_of(t, 0), 1);
-        assert_eq!(line_of(t, usize::MAX), t.lines().count() + 1);
     }
 }

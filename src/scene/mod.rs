@@ -4,12 +4,16 @@
 //! only reads a finished `Scene`.
 
 pub mod camera;
+mod checked;
 pub mod format;
+pub mod key_path;
 pub mod load;
+mod material;
+pub mod obj;
+mod objects;
 pub mod shapes;
 pub mod transform;
 
-use std::fmt;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -69,47 +73,6 @@ impl Scene {
     }
 }
 
-/// A scene-loading error located in the user's input: file, and the line
-/// (1-based) and/or field where it was found.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SceneError {
-    pub file: PathBuf,
-    pub line: Option<usize>,
-    pub field: Option<String>,
-    pub message: String,
-}
-
-impl SceneError {
-    pub fn new(file: impl Into<PathBuf>, message: impl Into<String>) -> Self {
-        SceneError {
-            file: file.into(),
-            line: None,
-            field: None,
-            message: message.into(),
-        }
-    }
-    pub fn at_line(mut self, line: usize) -> Self {
-        self.line = Some(line);
-        self
-    }
-    pub fn in_field(mut self, field: impl Into<String>) -> Self {
-        self.field = Some(field.into());
-        self
-    }
-}
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.file.display())?;
-        if let Some(l) = self.line {
-            write!(f, ":{l}")?;
-        }
-        write!(f, ": ")?;
-        if let Some(field) = &self.field {
-            write!(f, "field `{field}`: ")?;
-        }
-        write!(f, "{}", self.message)
-    }
-}
-
-impl std::error::Error for SceneError {}
+/// The located input error scene loading fails with (the library-wide
+/// [`crate::error::InputError`], under the name scene code has used).
+pub type SceneError = crate::error::InputError;

@@ -430,7 +430,7 @@ pub fn run(s: &Settings) -> Result<Outcome, StudyError> {
     {
         accels.insert(
             b.name(),
-            accel::build(&scene.meshes, *b).map_err(StudyError::Input)?,
+            accel::build(&scene.meshes, *b).map_err(|e| StudyError::Input(e.into()))?,
         );
     }
     let (reference, ref_info) = reference(

@@ -19,6 +19,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use super::{Accel, Hit, ProbeHits};
+use crate::error::Error;
 use crate::geometry::{Mesh, Ray, Vec3};
 
 static LIVE_DEVICES: AtomicUsize = AtomicUsize::new(0);
@@ -115,7 +116,7 @@ impl Device {
     /// A device whose builds use at most `threads` threads (Embree's own
     /// TBB pool, which does not know about rayon); `None`: Embree's
     /// default, all hardware threads.
-    fn new(threads: Option<usize>) -> Result<Device, String> {
+    fn new(threads: Option<usize>) -> Result<Device, Error> {
         let config = match threads {
             Some(n) => format!("threads={}", n.max(1)),
             None => String::new(),
@@ -127,10 +128,10 @@ impl Device {
             // SAFETY: with a null device, rtcGetDeviceError returns the error
             // of the failed rtcNewDevice on this thread.
             let code = unsafe { ffi::rtcGetDeviceError(ptr::null_mut()) };
-            return Err(format!(
+            return Err(Error::Backend(format!(
                 "Embree: rtcNewDevice failed: {} ({code})",
                 error_name(code)
-            ));
+            )));
         }
         LIVE_DEVICES.fetch_add(1, Ordering::SeqCst);
         let dev = Device {
@@ -157,7 +158,7 @@ impl Device {
 
     /// Fails with the errors reported since the last check, if any; `what`
     /// names the step for the message.
-    fn check(&self, what: &str) -> Result<(), String> {
+    fn check(&self, what: &str) -> Result<(), Error> {
         // SAFETY: `self.raw` is a live device. Reading the code also clears it.
         let code = unsafe { ffi::rtcGetDeviceError(self.raw) };
         let mut msgs = std::mem::take(
@@ -173,7 +174,7 @@ impl Device {
         if msgs.is_empty() {
             Ok(())
         } else {
-            Err(format!("{what}: {}", msgs.join("; ")))
+            Err(Error::Backend(format!("{what}: {}", msgs.join("; "))))
         }
     }
 }
@@ -228,9 +229,12 @@ impl EmbreeAccel {
     /// Builds and commits an Embree scene over `meshes`, sharing their
     /// buffers; called inside a rayon pool, the build uses that many threads. Fails (without leaking) if Embree reports any error or if a
     /// mesh cannot be shared safely (index out of range, too many elements).
-    pub fn build(meshes: &Arc<Vec<Mesh>>) -> Result<EmbreeAccel, String> {
+    pub fn build(meshes: &Arc<Vec<Mesh>>) -> Result<EmbreeAccel, Error> {
         if meshes.len() >= ffi::RTC_INVALID_GEOMETRY_ID as usize {
-            return Err(format!("Embree: too many meshes ({})", meshes.len()));
+            return Err(Error::Backend(format!(
+                "Embree: too many meshes ({})",
+                meshes.len()
+            )));
         }
         // Embree reads the buffers without bounds checks, so an index out of
         // range would be an out-of-bounds read; `Mesh::new` checks only in
@@ -238,17 +242,19 @@ impl EmbreeAccel {
         for (i, m) in meshes.iter().enumerate() {
             let nv = m.vertex_count();
             if nv > u32::MAX as usize || m.triangle_count() > u32::MAX as usize {
-                return Err(format!("Embree: mesh {i} is too large"));
+                return Err(Error::Backend(format!("Embree: mesh {i} is too large")));
             }
             if let Some(bad) = m.indices.iter().flatten().find(|&&v| v as usize >= nv) {
-                return Err(format!(
+                return Err(Error::Backend(format!(
                     "Embree: mesh {i} has vertex index {bad} but only {nv} vertices"
-                ));
+                )));
             }
             // Embree's 16-byte vertex loads need the padding element
             // (`Mesh::default()` has none, but also no vertices to index).
             if m.triangle_count() > 0 && m.padded_positions().len() <= nv {
-                return Err(format!("Embree: mesh {i} lacks its padding vertex"));
+                return Err(Error::Backend(format!(
+                    "Embree: mesh {i} lacks its padding vertex"
+                )));
             }
         }
 
@@ -261,9 +267,9 @@ impl EmbreeAccel {
         if device.property(ffi::RTC_DEVICE_PROPERTY_TRIANGLE_GEOMETRY_SUPPORTED) == 0
             || device.property(ffi::RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0
         {
-            return Err(
+            return Err(Error::Backend(
                 "Embree: this library was built without triangle or filter-function support".into(),
-            );
+            ));
         }
         device.check("Embree device")?;
 
@@ -273,7 +279,7 @@ impl EmbreeAccel {
             return Err(device
                 .check("rtcNewScene")
                 .err()
-                .unwrap_or_else(|| "rtcNewScene returned null".into()));
+                .unwrap_or_else(|| Error::Backend("rtcNewScene returned null".into())));
         }
         LIVE_SCENES.fetch_add(1, Ordering::SeqCst);
         let scene = Scene { raw };
@@ -301,7 +307,7 @@ impl EmbreeAccel {
                 return Err(device
                     .check("rtcNewGeometry")
                     .err()
-                    .unwrap_or_else(|| "rtcNewGeometry returned null".into()));
+                    .unwrap_or_else(|| Error::Backend("rtcNewGeometry returned null".into())));
             }
             // SAFETY: `geom` is a live geometry. The vertex buffer is
             // `vertex_count` tightly packed 12-byte f32 triples followed by
@@ -358,7 +364,7 @@ impl EmbreeAccel {
 
     /// Errors Embree reported after the build (queries do not report
     /// errors, so this is only for diagnostics).
-    pub fn check_errors(&self) -> Result<(), String> {
+    pub fn check_errors(&self) -> Result<(), Error> {
         self.device.check("Embree")
     }
 }

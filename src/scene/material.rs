@@ -1,0 +1,325 @@
+//! `[materials.NAME]` tables → [`Material`]s: the keys each `type` accepts,
+//! the three parameter forms of a subsurface material (preset; measured
+//! σs', σa, A; artist A, dmfp) and its sampling options.
+//!
+//! Values are range-checked by the bssrdf module, which reports a
+//! [`ParamError`] naming the parameter and channel as data;
+//! [`locate_param`] turns that into an error at the scene key that holds
+//! the parameter (`sigma_s` is given as `sigma_s_prime`, `mfp` as `dmfp`,
+//! the radius sampler as `radius`).
+
+use std::sync::Arc;
+
+use super::checked::{Cx, Res};
+use super::format::{MaterialDef, MaterialKind, Spanned};
+use crate::bssrdf::{
+    ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler, SubsurfaceParams,
+};
+use crate::error::{Constraint, InputError, Param, ParamError};
+use crate::materials::{Material, Subsurface};
+
+/// The keys a `type = "subsurface"` material accepts.
+const SUBSURFACE_KEYS: &[&str] = &[
+    "preset",
+    "sigma_s_prime",
+    "sigma_a",
+    "g",
+    "albedo",
+    "dmfp",
+    "eta",
+    "fit",
+    "radius",
+    "rmax_quantile",
+    "axes",
+    "channel",
+    "renormalize",
+    "exit_sw",
+    "specular",
+];
+
+/// The parameter forms, for messages.
+const FORMS: &str =
+    "give exactly one of: `preset`; `sigma_s_prime` + `sigma_a` + `albedo`; `albedo` + `dmfp`";
+
+/// The material `name` (its table `m`), lengths in scene units given
+/// `units_per_mm`.
+pub(super) fn material(
+    cx: &Cx,
+    name: &str,
+    m: &Spanned<MaterialDef>,
+    units_per_mm: f32,
+) -> Res<Material> {
+    let field = format!("materials.{name}");
+    let d = m.get_ref();
+    let kind = *cx
+        .required(&d.kind, Some(m.span()), &format!("{field}.type"))?
+        .get_ref();
+    let missing = |key: &str| {
+        cx.err(
+            m.span(),
+            &format!("{field}.{key}"),
+            format!(
+                "missing field `{key}` (required for type \"{}\")",
+                kind.name()
+            ),
+        )
+    };
+    match kind {
+        MaterialKind::Diffuse => {
+            cx.only_keys(&field, kind.name(), d.present_keys(), &["albedo"])?;
+            let a = d.albedo.as_ref().ok_or_else(|| missing("albedo"))?;
+            Ok(Material::Diffuse {
+                albedo: cx.rgb(a, &format!("{field}.albedo"), true)?,
+            })
+        }
+        MaterialKind::Dielectric => {
+            cx.only_keys(&field, kind.name(), d.present_keys(), &["eta"])?;
+            let e = d.eta.as_ref().ok_or_else(|| missing("eta"))?;
+            Ok(Material::Dielectric {
+                eta: cx.positive(e, &format!("{field}.eta"))?,
+            })
+        }
+        MaterialKind::Subsurface => {
+            cx.only_keys(&field, kind.name(), d.present_keys(), SUBSURFACE_KEYS)?;
+            let ss = Subsurface::new(
+                parameters(cx, &field, m, units_per_mm as f64)?,
+                &sampling_options(cx, &field, m)?,
+                flag(&d.exit_sw),
+                flag(&d.specular),
+            )
+            .map_err(|e| locate_param(cx, &field, m, &e))?;
+            Ok(Material::Subsurface(Arc::new(ss)))
+        }
+    }
+}
+
+/// A boolean option, true when absent.
+fn flag(b: &Option<Spanned<bool>>) -> bool {
+    b.as_ref().map(|b| *b.get_ref()).unwrap_or(true)
+}
+
+fn text(v: &Option<Spanned<String>>) -> Option<(&str, std::ops::Range<usize>)> {
+    v.as_ref().map(|s| (s.get_ref().as_str(), s.span()))
+}
+
+/// The scene key of the material table `m` that holds bssrdf parameter
+/// `p`, with its span; None for derived values (d, rmax) and for
+/// `units_per_mm`, which is not a material key.
+fn key_of(p: Param, m: &Spanned<MaterialDef>) -> Option<(&'static str, std::ops::Range<usize>)> {
+    let key = match p {
+        Param::Albedo => "albedo",
+        Param::SigmaS => "sigma_s_prime",
+        Param::SigmaA => "sigma_a",
+        Param::G => "g",
+        Param::Mfp => "dmfp",
+        Param::Eta => "eta",
+        Param::Preset => "preset",
+        Param::Fit => "fit",
+        Param::RadiusSampler | Param::TableSize => "radius",
+        Param::RmaxQuantile => "rmax_quantile",
+        Param::D | Param::Rmax | Param::UnitsPerMm => return None,
+    };
+    let present = m.get_ref().present_keys();
+    let span = present.into_iter().find(|(k, _)| *k == key).map(|(_, s)| s);
+    Some((key, span.unwrap_or(m.span())))
+}
+
+/// `e` located at the key of material `field` (table `m`) that holds the
+/// parameter, and named as that key; at the table itself for derived
+/// values.
+fn locate_param(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, e: &ParamError) -> InputError {
+    match key_of(e.param, m) {
+        Some((key, span)) => {
+            let msg = match e.param {
+                Param::TableSize => format!("table size {}", e.problem()),
+                Param::RadiusSampler => e.problem(),
+                _ => e.describe(key),
+            };
+            cx.err(span, &format!("{field}.{key}"), msg)
+        }
+        None => cx.err(m.span(), field, e.to_string()),
+    }
+}
+
+/// Rejects keys of two parameter forms together: names the first key of
+/// each, at the later one's line (`albedo` belongs to the measured and the
+/// artist form).
+fn one_form(cx: &Cx, field: &str, m: &Spanned<MaterialDef>) -> Res<()> {
+    let present = m.get_ref().present_keys();
+    let span_of = |k: &str| {
+        present
+            .iter()
+            .find(|(p, _)| *p == k)
+            .map(|(_, s)| s.clone())
+    };
+    let groups: [&[&str]; 3] = [
+        &["preset"],
+        &["sigma_s_prime", "sigma_a", "g"],
+        &["dmfp", "albedo"],
+    ];
+    let firsts: Vec<&str> = groups
+        .iter()
+        .filter_map(|g| g.iter().copied().find(|k| span_of(k).is_some()))
+        .collect();
+    if let [a, b, ..] = firsts[..] {
+        if a == "preset" || b == "dmfp" {
+            let msg = format!("`{a}` cannot be combined with `{b}`; {FORMS}");
+            return Err(cx.err(span_of(b).unwrap_or(m.span()), &format!("{field}.{b}"), msg));
+        }
+    }
+    Ok(())
+}
+
+/// A triple checked as f32 and kept as written (no 1.2000000476837158).
+fn triple(cx: &Cx, field: &str, v: &Option<Spanned<[f64; 3]>>, k: &str) -> Res<Option<[f64; 3]>> {
+    v.as_ref()
+        .map(|t| cx.vec3(t, &format!("{field}.{k}")).map(|_| *t.get_ref()))
+        .transpose()
+}
+
+/// The medium parameters of a subsurface material, from whichever of the
+/// three forms its table uses.
+fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res<SubsurfaceParams> {
+    let d = m.get_ref();
+    let f = |k: &str| format!("{field}.{k}");
+    let located = |e: ParamError| locate_param(cx, field, m, &e);
+    let fit = match text(&d.fit) {
+        Some((s, _)) => Fit::parse(s).map_err(located)?,
+        None => Fit::Searchlight,
+    };
+    let eta = d
+        .eta
+        .as_ref()
+        .map(|e| cx.positive(e, &f("eta")))
+        .transpose()?;
+    let albedo = triple(cx, field, &d.albedo, "albedo")?;
+    let (sigma_s, sigma_a, dmfp) = (
+        triple(cx, field, &d.sigma_s_prime, "sigma_s_prime")?,
+        triple(cx, field, &d.sigma_a, "sigma_a")?,
+        triple(cx, field, &d.dmfp, "dmfp")?,
+    );
+    one_form(cx, field, m)?;
+    let missing_albedo = |form: &str| {
+        cx.err(
+            m.span(),
+            &f("albedo"),
+            format!("missing field `albedo` for {form}; {FORMS}"),
+        )
+    };
+    match (text(&d.preset), sigma_s.or(sigma_a), dmfp) {
+        (Some((name, _)), None, None) if albedo.is_none() && d.g.is_none() => {
+            let mut p = SubsurfaceParams::from_preset(name, units, fit).map_err(located)?;
+            if let Some(eta) = eta {
+                p.eta = eta;
+            }
+            Ok(p)
+        }
+        (None, Some(_), None) => {
+            let (Some(ss), Some(sa)) = (sigma_s, sigma_a) else {
+                let missing = if sigma_s.is_none() {
+                    "sigma_s_prime"
+                } else {
+                    "sigma_a"
+                };
+                return Err(cx.err(
+                    m.span(),
+                    &f(missing),
+                    format!("missing field `{missing}`: measured parameters need `sigma_s_prime`, `sigma_a` and `albedo`"),
+                ));
+            };
+            let albedo = albedo.ok_or_else(|| missing_albedo("measured parameters"))?;
+            let measured = measured(ss, sa, d.g.as_ref().map(|g| *g.get_ref()), albedo, eta);
+            measured
+                .and_then(|ms| SubsurfaceParams::from_measured(&ms, units, fit))
+                .map_err(located)
+        }
+        (None, None, Some(mfp)) if d.g.is_none() => {
+            let albedo = albedo.ok_or_else(|| missing_albedo("the artist form"))?;
+            SubsurfaceParams::from_artist(albedo, mfp.map(|x| x * units), eta.unwrap_or(1.3), fit)
+                .map_err(located)
+        }
+        _ => Err(cx.err(m.span(), field, format!("subsurface parameters: {FORMS}"))),
+    }
+}
+
+/// The measured form as given in a scene: σs' (reduced), σa, g, A, η.
+/// g and σs' as written are checked here, before σs = σs'/(1 − g) (g = 1
+/// would make that infinite), so that the loader's σs(1 − g) is σs' again.
+fn measured(
+    sigma_s_prime: [f64; 3],
+    sigma_a: [f64; 3],
+    g: Option<f64>,
+    albedo: [f64; 3],
+    eta: Option<f32>,
+) -> Result<Measured, ParamError> {
+    let g = g.unwrap_or(0.0);
+    if !(g > -1.0 && g < 1.0) {
+        return Err(ParamError::new(Param::G, g, Constraint::Open(-1.0, 1.0)));
+    }
+    if let Some((c, x)) = sigma_s_prime
+        .iter()
+        .enumerate()
+        .find(|(_, x)| !x.is_finite() || **x < 0.0)
+    {
+        return Err(ParamError::new(Param::SigmaS, x, Constraint::FiniteNonNegative).channel(c));
+    }
+    Ok(Measured {
+        sigma_s: sigma_s_prime.map(|x| x / (1.0 - g)),
+        sigma_a,
+        g,
+        albedo,
+        eta: eta.unwrap_or(1.3),
+    })
+}
+
+/// The sampling options of a subsurface material (defaults for the keys it
+/// does not give).
+fn sampling_options(cx: &Cx, field: &str, m: &Spanned<MaterialDef>) -> Res<ProbeOptions> {
+    let d = m.get_ref();
+    let f = |k: &str| format!("{field}.{k}");
+    let mut opts = ProbeOptions::default();
+    if let Some((s, _)) = text(&d.radius) {
+        opts.radius = RadiusSampler::parse(s).map_err(|e| locate_param(cx, field, m, &e))?;
+    }
+    if let Some(q) = &d.rmax_quantile {
+        let v = cx.scalar(q, &f("rmax_quantile"))? as f64;
+        if !(v > 0.0 && v < 1.0) {
+            return Err(cx.err(
+                q.span(),
+                &f("rmax_quantile"),
+                format!("expected a number in (0, 1), found {v}"),
+            ));
+        }
+        opts.rmax_quantile = *q.get_ref();
+    }
+    if let Some((s, span)) = text(&d.axes) {
+        opts.axes = match s.to_ascii_lowercase().as_str() {
+            "normal" => ProbeAxes::Normal,
+            "mis3" => ProbeAxes::Mis3,
+            _ => {
+                return Err(cx.err(
+                    span,
+                    &f("axes"),
+                    format!("expected \"normal\" or \"mis3\", found \"{s}\""),
+                ))
+            }
+        };
+    }
+    if let Some((s, span)) = text(&d.channel) {
+        opts.channel = match s.to_ascii_lowercase().as_str() {
+            "single" => ChannelStrategy::Single,
+            "mis" => ChannelStrategy::Mis,
+            _ => {
+                return Err(cx.err(
+                    span,
+                    &f("channel"),
+                    format!("expected \"single\" or \"mis\", found \"{s}\""),
+                ))
+            }
+        };
+    }
+    if let Some(b) = &d.renormalize {
+        opts.renormalize = *b.get_ref();
+    }
+    Ok(opts)
+}

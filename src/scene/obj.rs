@@ -1,0 +1,207 @@
+//! OBJ meshes: a line-by-line check of the statements the OBJ parser
+//! (`tobj`) would trust, then the parse into one [`Mesh`].
+//!
+//! `tobj` can index out of bounds or overflow on bad face indices, so every
+//! number and index is checked first (errors name the OBJ file and line),
+//! and the `tobj` call is additionally fenced with `catch_unwind`.
+
+use std::path::Path;
+
+use crate::error::InputError;
+use crate::geometry::{Mesh, Vec3};
+
+/// Loads an OBJ file's faces (all objects and groups) as one mesh. Shading
+/// normals are kept only if every vertex has one; materials (`mtllib`) are
+/// ignored — the scene file assigns the material.
+pub fn load_obj(text: &str, path: &Path) -> Result<Mesh, InputError> {
+    check_obj(text).map_err(|(line, msg)| InputError::new(path, msg).at_line(line))?;
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let result = std::panic::catch_unwind(|| {
+        tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| {
+            Err(tobj::LoadError::GenericFailure)
+        })
+    });
+    let models = match result {
+        Ok(Ok((models, _materials))) => models,
+        Ok(Err(e)) => return Err(InputError::new(path, format!("invalid OBJ data: {e}"))),
+        Err(_) => {
+            return Err(InputError::new(
+                path,
+                "invalid OBJ data (the OBJ parser failed on this file)",
+            ))
+        }
+    };
+
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    let mut all_normals = true;
+    let mut indices = Vec::new();
+    for m in &models {
+        let m = &m.mesh;
+        let base = positions.len();
+        let nv = m.positions.len() / 3;
+        if m.positions.len() % 3 != 0 || m.indices.len() % 3 != 0 {
+            return Err(InputError::new(
+                path,
+                "invalid OBJ data: malformed mesh arrays",
+            ));
+        }
+        for p in m.positions.chunks_exact(3) {
+            positions.push(Vec3::new(p[0], p[1], p[2]));
+        }
+        if m.normals.len() == m.positions.len() {
+            normals.extend(
+                m.normals
+                    .chunks_exact(3)
+                    .map(|n| Vec3::new(n[0], n[1], n[2])),
+            );
+        } else {
+            all_normals = false;
+        }
+        for t in m.indices.chunks_exact(3) {
+            if t.iter().any(|&i| i as usize >= nv) {
+                return Err(InputError::new(
+                    path,
+                    "invalid OBJ data: face index out of range",
+                ));
+            }
+            let off = |i: u32| u32::try_from(base + i as usize);
+            match (off(t[0]), off(t[1]), off(t[2])) {
+                (Ok(a), Ok(b), Ok(c)) => indices.push([a, b, c]),
+                _ => return Err(InputError::new(path, "OBJ file has too many vertices")),
+            }
+        }
+    }
+    if indices.is_empty() {
+        return Err(InputError::new(
+            path,
+            "OBJ file contains no triangles (no `f` lines with 3 or more vertices)",
+        ));
+    }
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(InputError::new(
+            path,
+            "OBJ file has non-finite vertex positions",
+        ));
+    }
+    let normals = (all_normals && normals.iter().all(|n| n.is_finite() && n.length() > 0.0))
+        .then(|| normals.into_iter().map(Vec3::normalize).collect());
+    Ok(Mesh::new(positions, indices, normals))
+}
+
+/// Checks the OBJ statements `tobj` would trust: numbers in `v`/`vt`/`vn`
+/// lines must parse and be finite, and every face index must be non-zero
+/// and refer to an element defined before it. Returns (line, message).
+fn check_obj(text: &str) -> Result<(), (usize, String)> {
+    let (mut nv, mut nt, mut nn) = (0usize, 0usize, 0usize);
+    for (ln, line) in text.lines().enumerate() {
+        let ln = ln + 1;
+        let mut words = line.split_whitespace();
+        let Some(tag) = words.next() else { continue };
+        let numbers = |words: std::str::SplitWhitespace, need: usize, what: &str| {
+            let vals: Vec<&str> = words.collect();
+            if vals.len() < need {
+                return Err((
+                    ln,
+                    format!("`{what}` needs {need} numbers, found {}", vals.len()),
+                ));
+            }
+            let mut out = Vec::with_capacity(vals.len());
+            for w in vals {
+                match w.parse::<f32>() {
+                    Ok(x) if x.is_finite() => out.push(x),
+                    Ok(_) => return Err((ln, format!("`{what}` has a non-finite number `{w}`"))),
+                    Err(_) => return Err((ln, format!("`{what}` has `{w}`, expected a number"))),
+                }
+            }
+            Ok(out)
+        };
+        match tag {
+            "v" => {
+                // tobj reads `x y z`, `x y z w` (dividing by w) or
+                // `x y z r g b`, and rejects other counts.
+                let v = numbers(words, 3, "v")?;
+                match v.len() {
+                    3 | 6 => {}
+                    4 if v[3] != 0.0 && v[..3].iter().all(|x| (x / v[3]).is_finite()) => {}
+                    4 => {
+                        return Err((
+                            ln,
+                            format!("`v` has weight w = {} that makes it non-finite", v[3]),
+                        ))
+                    }
+                    n => {
+                        return Err((
+                            ln,
+                            format!("`v` has {n} numbers, expected x y z, x y z w or x y z r g b"),
+                        ))
+                    }
+                }
+                nv += 1;
+            }
+            "vt" => {
+                numbers(words, 2, "vt")?;
+                nt += 1;
+            }
+            "vn" => {
+                let n = numbers(words, 3, "vn")?;
+                if n[..3].iter().all(|&x| x == 0.0) {
+                    return Err((ln, "`vn` is a zero-length normal".into()));
+                }
+                nn += 1;
+            }
+            "f" | "l" | "p" => {
+                let refs: Vec<&str> = words.collect();
+                if tag == "f" && refs.len() < 3 {
+                    return Err((
+                        ln,
+                        format!("face has {} vertices, expected at least 3", refs.len()),
+                    ));
+                }
+                for r in refs {
+                    check_vertex_ref(r, [nv, nt, nn]).map_err(|m| (ln, m))?;
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Checks one face/line/point vertex reference `v`, `v/vt`, `v//vn` or
+/// `v/vt/vn` against the `[vertices, texture coordinates, normals]` defined
+/// so far: each index non-zero and in range (negative ones count back).
+fn check_vertex_ref(r: &str, counts: [usize; 3]) -> Result<(), String> {
+    let parts: Vec<&str> = r.split('/').collect();
+    if parts.len() > 3 || parts[0].is_empty() {
+        return Err(format!(
+            "malformed face vertex `{r}` (expected v, v/vt, v//vn or v/vt/vn)"
+        ));
+    }
+    let what = ["vertex", "texture coordinate", "normal"];
+    for (k, p) in parts.iter().enumerate() {
+        if k > 0 && p.is_empty() {
+            continue;
+        }
+        let (count, what) = (counts[k], what[k]);
+        let i: i64 = p
+            .parse()
+            .map_err(|_| format!("malformed face vertex `{r}`: `{p}` is not an integer index"))?;
+        let ok = if i > 0 {
+            (i as u64) <= count as u64
+        } else {
+            i != 0 && i.unsigned_abs() <= count as u64
+        };
+        if !ok {
+            return Err(format!(
+                "face {what} index {i} out of range: {count} defined before this line (indices start at 1; negative ones count back)"
+            ));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,152 @@
+//! `[[shapes]]` entries → meshes and [`Object`]s: the shape's mesh (a
+//! generated sphere, quad or box, or an OBJ file), its transform (scale,
+//! then rotations in order, then translation), its material by name and its
+//! emission.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use super::checked::{Cx, Res};
+use super::format::{ShapeDef, ShapeKind, Spanned};
+use super::obj::load_obj;
+use super::transform::Transform;
+use super::{shapes, Object};
+use crate::geometry::{Mesh, Vec3};
+
+/// Highest accepted `subdivisions` for spheres: 20·4⁹ ≈ 5.2 M triangles.
+pub const MAX_SPHERE_SUBDIVISIONS: u32 = 9;
+
+/// Shape `i` (entry `s`): its transformed mesh and its object. `materials`
+/// maps material names to indices; OBJ paths are relative to `dir`.
+pub(super) fn object(
+    cx: &Cx,
+    dir: &Path,
+    i: usize,
+    s: &Spanned<ShapeDef>,
+    materials: &HashMap<&str, usize>,
+) -> Res<(Mesh, Object)> {
+    let field = format!("shapes[{i}]");
+    let sd = s.get_ref();
+    let m = cx.required(&sd.material, Some(s.span()), &format!("{field}.material"))?;
+    let Some(&mat) = materials.get(m.get_ref().as_str()) else {
+        let mut known: Vec<&str> = materials.keys().copied().collect();
+        known.sort_unstable();
+        let known = if known.is_empty() {
+            "no materials are defined".to_string()
+        } else {
+            format!("defined: {}", known.join(", "))
+        };
+        return Err(cx.err(
+            m.span(),
+            &format!("{field}.material"),
+            format!("unknown material \"{}\" ({known})", m.get_ref()),
+        ));
+    };
+    let emission = match &sd.emission {
+        Some(e) => {
+            Some(cx.rgb(e, &format!("{field}.emission"), false)?).filter(|e| *e != Vec3::ZERO)
+        }
+        None => None,
+    };
+    let mut mesh = shape_mesh(cx, dir, &field, s)?;
+    transform(cx, &field, sd)?.apply(&mut mesh);
+    let object = Object {
+        name: sd.name.clone().unwrap_or(field),
+        material: mat,
+        emission,
+    };
+    Ok((mesh, object))
+}
+
+/// The mesh of shape `field` (entry `s`) before its transform; OBJ paths
+/// are relative to `dir`.
+fn shape_mesh(cx: &Cx, dir: &Path, field: &str, s: &Spanned<ShapeDef>) -> Res<Mesh> {
+    let d = s.get_ref();
+    let kind = *cx
+        .required(&d.kind, Some(s.span()), &format!("{field}.type"))?
+        .get_ref();
+    let allowed: &[&str] = match kind {
+        ShapeKind::Obj => &["file", "smooth"],
+        ShapeKind::Sphere => &["subdivisions"],
+        ShapeKind::Quad | ShapeKind::Box => &[],
+    };
+    cx.only_keys(field, kind.name(), d.present_type_keys(), allowed)?;
+    match kind {
+        ShapeKind::Obj => {
+            let Some(f) = &d.file else {
+                return Err(cx.err(
+                    s.span(),
+                    &format!("{field}.file"),
+                    "missing field `file` (required for type \"obj\")",
+                ));
+            };
+            let path = dir.join(f.get_ref());
+            let text = std::fs::read_to_string(&path).map_err(|e| {
+                cx.err(
+                    f.span(),
+                    &format!("{field}.file"),
+                    format!("cannot read OBJ file {}: {e}", path.display()),
+                )
+            })?;
+            let mut mesh = load_obj(&text, &path)?;
+            if d.smooth.as_ref().is_some_and(|b| *b.get_ref()) && mesh.normals.is_none() {
+                mesh.compute_smooth_normals();
+            }
+            Ok(mesh)
+        }
+        ShapeKind::Sphere => {
+            let level = match &d.subdivisions {
+                Some(l) if *l.get_ref() > MAX_SPHERE_SUBDIVISIONS => {
+                    return Err(cx.err(
+                        l.span(),
+                        &format!("{field}.subdivisions"),
+                        format!(
+                        "expected at most {MAX_SPHERE_SUBDIVISIONS} (20·4^n triangles), found {}",
+                        l.get_ref()
+                    ),
+                    ))
+                }
+                Some(l) => *l.get_ref(),
+                None => 4,
+            };
+            Ok(shapes::sphere(level))
+        }
+        ShapeKind::Quad => Ok(shapes::quad()),
+        ShapeKind::Box => Ok(shapes::cuboid()),
+    }
+}
+
+/// The shape's scale, rotations and translation.
+fn transform(cx: &Cx, field: &str, d: &ShapeDef) -> Res<Transform> {
+    let scale = match &d.scale {
+        Some(s) => {
+            let f = format!("{field}.scale");
+            let v = cx.vec3(&Spanned::new(s.span(), s.get_ref().0), &f)?;
+            if v.x == 0.0 || v.y == 0.0 || v.z == 0.0 {
+                return Err(cx.err(
+                    s.span(),
+                    &f,
+                    "scale components must be non-zero (negative mirrors)",
+                ));
+            }
+            v
+        }
+        None => Vec3::ONE,
+    };
+    let mut rotations = Vec::new();
+    for (k, r) in d.rotate.iter().flatten().enumerate() {
+        let f = format!("{field}.rotate[{k}]");
+        let rot = r.get_ref();
+        let angle = cx.scalar(&Spanned::new(r.span(), rot.angle_deg), &f)?;
+        let axis = cx.vec3(&Spanned::new(r.span(), rot.axis), &f)?;
+        if axis.length() == 0.0 || !axis.length().is_finite() {
+            return Err(cx.err(r.span(), &f, "rotation axis must be non-zero"));
+        }
+        rotations.push((angle, axis));
+    }
+    let translate = match &d.translate {
+        Some(t) => cx.vec3(t, &format!("{field}.translate"))?,
+        None => Vec3::ZERO,
+    };
+    Ok(Transform::from_srt(scale, &rotations, translate))
+}
