@@ -142,7 +142,7 @@ pub fn write(
     .unwrap();
     writeln!(
         r,
-        "- Metrics (see `src/study/metrics.rs`): RMSE; relMSE with ε = 0.01; bias = Σ(I − R)/ΣR with its standard error; \
+        "- Metrics (see `src/tools/study/metrics.rs`): RMSE; relMSE with ε = 0.01; bias = Σ(I − R)/ΣR with its standard error; \
          fireflies = pixels above {}× the reference luminance.",
         s.firefly_k
     )

@@ -1016,7 +1016,7 @@ mod tests {
     use std::sync::Arc;
 
     /// A marble sphere on a floor under an area light: every query kind.
-    const SCENE: &str = include_str!("../../tests/fixtures/marble-ball.toml");
+    const SCENE: &str = include_str!("../../../tests/fixtures/marble-ball.toml");
 
     fn scene() -> Scene {
         crate::scene::load::load_str(SCENE, Path::new("test.toml")).unwrap()
@@ -1041,7 +1041,7 @@ mod tests {
     #[test]
     fn recording_counts_every_ray_and_replay_reproduces_the_answers() {
         let scene = scene();
-        for backend in crate::bench::available_backends() {
+        for backend in crate::tools::bench::available_backends() {
             let accel = accel::build(&scene.meshes, backend).unwrap();
             let accel = accel.as_ref();
             for threads in [1, 2] {
