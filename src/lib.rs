@@ -2,9 +2,11 @@
 //!
 //! Data flows one way: [`scene::load()`] → [`accel::build`] →
 //! [`integrator`] (rendered in tiles by [`render`]) → [`film`] output.
+//!
+//! The measuring tools — `lucent bench`, `lucent study` and their plots —
+//! live apart in [`tools`]; the renderer modules never use them.
 
 pub mod accel;
-pub mod bench;
 pub mod bssrdf;
 pub mod error;
 pub mod film;
@@ -12,10 +14,9 @@ pub mod geometry;
 pub mod integrator;
 pub mod lights;
 pub mod materials;
-pub mod plot;
 pub mod render;
 pub mod sampling;
 pub mod scene;
-pub mod study;
+pub mod tools;
 
 pub use error::Error;

@@ -96,7 +96,7 @@ enum Command {
     Info,
     /// Measure error against time for every sampling choice of the
     /// subsurface estimator: results.csv, plots and report.md in the output
-    /// directory (resumes from results.csv; see src/study/mod.rs).
+    /// directory (resumes from results.csv; see src/tools/study/mod.rs).
     Study(StudyArgs),
 }
 
@@ -346,23 +346,23 @@ struct StudyArgs {
     /// Only these axes (comma separated: radius, rmax, axes, channel,
     /// renormalize, exit_sw, specular, backend, integrator); the baseline always runs.
     #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
-    only: Vec<lucent::study::Axis>,
+    only: Vec<lucent::tools::study::Axis>,
     /// No progress bars.
     #[arg(short, long)]
     quiet: bool,
 }
 
 fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, String> {
-    lucent::study::config::parse_integrator(s)
+    lucent::tools::study::config::parse_integrator(s)
         .ok_or_else(|| format!("expected diffusion or randomwalk, found \"{s}\""))
 }
 
-fn parse_study_axis(s: &str) -> Result<lucent::study::Axis, String> {
-    lucent::study::Axis::parse(s).ok_or_else(|| format!("unknown axis \"{s}\""))
+fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, String> {
+    lucent::tools::study::Axis::parse(s).ok_or_else(|| format!("unknown axis \"{s}\""))
 }
 
 fn run_study(a: StudyArgs) -> Result<(), Error> {
-    use lucent::study::{self, StudyError};
+    use lucent::tools::study;
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = a
             .scene
@@ -381,10 +381,7 @@ fn run_study(a: StudyArgs) -> Result<(), Error> {
     s.firefly_k = a.firefly_k;
     s.only = a.only;
     s.progress = !a.quiet;
-    let o = study::run(&s).map_err(|e| match e {
-        StudyError::Input(m) => Error::Input(m),
-        StudyError::Runtime(m) => Error::Runtime(m),
-    })?;
+    let o = study::run(&s)?;
     if !a.quiet {
         eprintln!(
             "{}: {} configurations, {} rows ({} rendered now), reference {} at {} spp",
@@ -409,13 +406,13 @@ struct BenchArgs {
     quick: bool,
     /// Triangle counts, comma separated (1k, 16k, 1.3M; each becomes the
     /// displaced sphere of 20·4^level triangles nearest to it).
-    #[arg(long, value_delimiter = ',', value_parser = lucent::bench::parse_size)]
+    #[arg(long, value_delimiter = ',', value_parser = lucent::tools::bench::parse_size)]
     sizes: Vec<usize>,
     /// Thread counts, comma separated (default: 1 and all cores).
-    #[arg(long, value_delimiter = ',', value_parser = lucent::bench::parse_threads)]
+    #[arg(long, value_delimiter = ',', value_parser = lucent::tools::bench::parse_threads)]
     threads: Vec<usize>,
     /// Rays per query set (default 500000, quick 16384).
-    #[arg(long, value_parser = lucent::bench::parse_rays)]
+    #[arg(long, value_parser = lucent::tools::bench::parse_rays)]
     rays: Option<usize>,
     /// Backends to measure: bvh | embree | both (default: every backend of
     /// this build).
@@ -443,11 +440,11 @@ enum BenchAccelArg {
 /// The backends `--accel` asks for; one this build lacks is bad input.
 fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Error> {
     let want = match a {
-        None | Some(BenchAccelArg::Both) => return Ok(lucent::bench::available_backends()),
+        None | Some(BenchAccelArg::Both) => return Ok(lucent::tools::bench::available_backends()),
         Some(BenchAccelArg::Bvh) => Backend::Bvh,
         Some(BenchAccelArg::Embree) => Backend::Embree,
     };
-    if !lucent::bench::available_backends().contains(&want) {
+    if !lucent::tools::bench::available_backends().contains(&want) {
         // accel::build says why and how to get it.
         let why = accel::build(&std::sync::Arc::new(Vec::new()), want).err();
         return Err(why.unwrap_or_else(|| {
@@ -458,7 +455,7 @@ fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Error> {
 }
 
 fn run_bench(a: BenchArgs) -> Result<(), Error> {
-    use lucent::bench::{self, BenchError};
+    use lucent::tools::bench;
     let backends = bench_backends(a.accel)?;
     if let Some(scene) = &a.scene {
         let mut s = bench::replay::Settings::new(scene, &a.output);
@@ -468,10 +465,7 @@ fn run_bench(a: BenchArgs) -> Result<(), Error> {
         }
         s.backends = backends;
         s.progress = !a.quiet;
-        let o = bench::replay::run(&s).map_err(|e| match e {
-            BenchError::Input(m) => Error::Input(m),
-            BenchError::Runtime(m) => Error::Runtime(m),
-        })?;
+        let o = bench::replay::run(&s)?;
         print!("{}", o.report);
         if !a.quiet {
             eprintln!("{} rows in {}", o.rows.len(), o.csv.display());
@@ -488,10 +482,7 @@ fn run_bench(a: BenchArgs) -> Result<(), Error> {
     }
     s.rays = a.rays.unwrap_or(s.rays);
     s.progress = !a.quiet;
-    let o = bench::run(&s).map_err(|e| match e {
-        BenchError::Input(m) => Error::Input(m),
-        BenchError::Runtime(m) => Error::Runtime(m),
-    })?;
+    let o = bench::run(&s)?;
     print!("{}", o.report);
     if !a.quiet {
         eprintln!(

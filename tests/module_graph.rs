@@ -295,7 +295,10 @@ fn the_scanner_reads_paths_groups_and_skips_comments_and_strings() {
     let mut g = BTreeMap::new();
     g.insert("a".to_string(), BTreeSet::from(["b".to_string()]));
     g.insert("b".to_string(), BTreeSet::from(["a".to_string()]));
-    assert_eq!(find_cycle(&g), Some(vec!["a".into(), "b".into(), "a".into()]));
+    assert_eq!(
+        find_cycle(&g),
+        Some(vec!["a".into(), "b".into(), "a".into()])
+    );
     g.remove("b");
     assert_eq!(find_cycle(&g), None);
 }
@@ -308,9 +311,19 @@ fn top_level_modules_form_a_dag() {
     if let Some(cycle) = find_cycle(&g) {
         let edges: Vec<String> = cycle
             .windows(2)
-            .map(|w| format!("{} → {} ({})", w[0], w[1], s.files_naming(&w[0], &w[1]).join(", ")))
+            .map(|w| {
+                format!(
+                    "{} → {} ({})",
+                    w[0],
+                    w[1],
+                    s.files_naming(&w[0], &w[1]).join(", ")
+                )
+            })
             .collect();
-        panic!("import cycle among modules of src/:\n  {}", edges.join("\n  "));
+        panic!(
+            "import cycle among modules of src/:\n  {}",
+            edges.join("\n  ")
+        );
     }
 }
 

@@ -10,8 +10,8 @@ use std::time::Instant;
 
 use lucent::film::Film;
 use lucent::materials::Material;
-use lucent::study::results::Row;
-use lucent::study::{self, config, Axis, Settings};
+use lucent::tools::study::results::Row;
+use lucent::tools::study::{self, config, Axis, Settings};
 
 use common::mean_se;
 
@@ -259,7 +259,7 @@ fn resume_renders_only_missing_rows_and_extends_the_ladder() {
     let mut other = s.clone();
     other.seed = Some(12345);
     match study::run(&other) {
-        Err(study::StudyError::Input(m)) => assert!(m.contains("other settings"), "{m}"),
+        Err(lucent::Error::Input(m)) => assert!(m.contains("other settings"), "{m}"),
         r => panic!("expected a settings mismatch, got {r:?}"),
     }
     // The same 32-spp images from scratch: identical errors.

@@ -171,36 +171,44 @@ fn scene_fresnel(scene: &Scene) -> Option<(bool, bool)> {
     })
 }
 
-/// The configurations of a study of `scene`. `quick` keeps a few values per
-/// axis (enough for the ordering facts the tests check). `backends[0]` is
-/// the baseline's backend; each further one gets a backend row.
-pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Config>, String> {
-    let (exit_sw, specular) =
-        scene_fresnel(scene).ok_or("the scene has no subsurface material: nothing to study")?;
-    let base_probe = baseline_probe();
-    let base_backend = backends[0];
-    let mut base_ov = full_probe(base_probe);
-    base_ov.exit_sw = Some(exit_sw);
-    base_ov.specular = Some(specular);
-    let mut out = vec![Config {
-        name: "baseline".into(),
-        axis: Axis::Baseline,
-        value: String::new(),
-        overrides: base_ov,
-        backend: base_backend,
-        integrator: IntegratorKind::Path,
-    }];
-    let mut add =
-        |axis: Axis, value: String, ov: Overrides, backend: Backend, integrator: IntegratorKind| {
-            out.push(Config {
-                name: format!("{}={value}", axis.name()),
-                axis,
-                value,
-                overrides: ov,
-                backend,
-                integrator,
-            });
-        };
+/// The configurations being built: the baseline first, then one per value
+/// of each axis in the order they are added.
+struct Matrix {
+    out: Vec<Config>,
+    /// The baseline's overrides, which every variation starts from.
+    base: Overrides,
+    base_backend: Backend,
+}
+
+impl Matrix {
+    fn add(
+        &mut self,
+        axis: Axis,
+        value: String,
+        ov: Overrides,
+        backend: Backend,
+        integrator: IntegratorKind,
+    ) {
+        self.out.push(Config {
+            name: format!("{}={value}", axis.name()),
+            axis,
+            value,
+            overrides: ov,
+            backend,
+            integrator,
+        });
+    }
+
+    /// A variation of the estimator: other overrides, the baseline's
+    /// backend, the path tracer.
+    fn vary(&mut self, axis: Axis, value: String, ov: Overrides) {
+        let backend = self.base_backend;
+        self.add(axis, value, ov, backend, IntegratorKind::Path);
+    }
+}
+
+/// The radius samplers of the radius axis.
+fn radius_values(quick: bool) -> Vec<RadiusSampler> {
     let tu = |size| RadiusSampler::Table {
         size,
         spacing: TableSpacing::Uniform,
@@ -209,7 +217,7 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
         size,
         spacing: TableSpacing::Tail,
     };
-    let radii: Vec<RadiusSampler> = if quick {
+    if quick {
         vec![
             RadiusSampler::Uniform,
             tu(16),
@@ -228,17 +236,40 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
             tt(1024),
             RadiusSampler::Mixture,
         ]
+    }
+}
+
+/// The configurations of a study of `scene`. `quick` keeps a few values per
+/// axis (enough for the ordering facts the tests check). `backends[0]` is
+/// the baseline's backend; each further one gets a backend row.
+pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Config>, String> {
+    let (exit_sw, specular) =
+        scene_fresnel(scene).ok_or("the scene has no subsurface material: nothing to study")?;
+    let base_probe = baseline_probe();
+    let base_backend = backends[0];
+    let mut base_ov = full_probe(base_probe);
+    base_ov.exit_sw = Some(exit_sw);
+    base_ov.specular = Some(specular);
+    let mut m = Matrix {
+        out: vec![Config {
+            name: "baseline".into(),
+            axis: Axis::Baseline,
+            value: String::new(),
+            overrides: base_ov,
+            backend: base_backend,
+            integrator: IntegratorKind::Path,
+        }],
+        base: base_ov,
+        base_backend,
     };
-    for r in radii {
-        add(
+    for r in radius_values(quick) {
+        m.vary(
             Axis::Radius,
             radius_name(r),
             Overrides {
                 radius: Some(r),
-                ..base_ov
+                ..m.base
             },
-            base_backend,
-            IntegratorKind::Path,
         );
     }
     let quantiles: &[f64] = if quick {
@@ -247,82 +278,70 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
         &[0.9, 0.99, 0.997, 0.9999]
     };
     for &q in quantiles {
-        add(
+        m.vary(
             Axis::RmaxQuantile,
             format!("{q}"),
             Overrides {
                 rmax_quantile: Some(q),
-                ..base_ov
+                ..m.base
             },
-            base_backend,
-            IntegratorKind::Path,
         );
     }
     let other_axes = match base_probe.axes {
         ProbeAxes::Normal => ProbeAxes::Mis3,
         ProbeAxes::Mis3 => ProbeAxes::Normal,
     };
-    add(
+    m.vary(
         Axis::Axes,
         axes_name(other_axes).into(),
         Overrides {
             axes: Some(other_axes),
-            ..base_ov
+            ..m.base
         },
-        base_backend,
-        IntegratorKind::Path,
     );
     let other_channel = match base_probe.channel {
         ChannelStrategy::Single => ChannelStrategy::Mis,
         ChannelStrategy::Mis => ChannelStrategy::Single,
     };
-    add(
+    m.vary(
         Axis::Channel,
         channel_name(other_channel).into(),
         Overrides {
             channel: Some(other_channel),
-            ..base_ov
+            ..m.base
         },
-        base_backend,
-        IntegratorKind::Path,
     );
     if !quick {
         let r = !base_probe.renormalize;
-        add(
+        m.vary(
             Axis::Renormalize,
             r.to_string(),
             Overrides {
                 renormalize: Some(r),
-                ..base_ov
+                ..m.base
             },
-            base_backend,
-            IntegratorKind::Path,
         );
     }
-    add(
+    m.vary(
         Axis::ExitSw,
         (!exit_sw).to_string(),
         Overrides {
             exit_sw: Some(!exit_sw),
-            ..base_ov
+            ..m.base
         },
-        base_backend,
-        IntegratorKind::Path,
     );
     if !quick {
-        add(
+        m.vary(
             Axis::Specular,
             (!specular).to_string(),
             Overrides {
                 specular: Some(!specular),
-                ..base_ov
+                ..m.base
             },
-            base_backend,
-            IntegratorKind::Path,
         );
     }
     for &b in &backends[1..] {
-        add(
+        m.add(
             Axis::Backend,
             b.name().into(),
             base_ov,
@@ -330,14 +349,14 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
             IntegratorKind::Path,
         );
     }
-    add(
+    m.add(
         Axis::Integrator,
         integrator_name(IntegratorKind::RandomWalk).into(),
         base_ov,
         base_backend,
         IntegratorKind::RandomWalk,
     );
-    Ok(out)
+    Ok(m.out)
 }
 
 /// `scene` with every subsurface material rebuilt with `ov` applied to its

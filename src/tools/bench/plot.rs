@@ -1,14 +1,14 @@
 //! The bench's plots: per query, time per ray against triangle count on the
 //! displaced spheres, log-log, one line per (backend, threads); and build
 //! time against triangle count per backend. Canvas, PNG writing, palette,
-//! axis ranges and font are the shared ones of [`crate::plot`].
+//! axis ranges and font are the shared ones of [`crate::tools::plot`].
 
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
 use super::{QueryKind, Row};
-use crate::plot::{color, ensure_font, log_range, png, FONT};
+use crate::tools::plot::{color, ensure_font, log_range, png, FONT};
 
 type Series = (String, Vec<(f64, f64)>);
 

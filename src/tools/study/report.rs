@@ -87,6 +87,35 @@ pub fn write(
     let mut r = String::new();
     writeln!(r, "# Accuracy vs time: {name}\n").unwrap();
     writeln!(r, "Reproduce with:\n\n    {}\n", command_line(s)).unwrap();
+    setup_section(&mut r, s, scene, configs, reference, run_seconds);
+    let pixels = (w as f64) * (h as f64);
+    results_table(&mut r, configs, rows, pixels);
+    writeln!(r, "## Headlines\n").unwrap();
+    for h in headlines(configs, rows, pixels) {
+        writeln!(r, "- {h}").unwrap();
+    }
+    writeln!(r).unwrap();
+    writeln!(r, "## Plots\n").unwrap();
+    for p in plots {
+        let f = p.file_name().unwrap_or_default().to_string_lossy();
+        writeln!(r, "![{f}]({f})\n").unwrap();
+    }
+    writeln!(r, "Raw rows: `results.csv`; final images: `images/`.").unwrap();
+    atomic_write(&path, |tmp| fs::write(tmp, &r).map_err(|e| e.to_string()))?;
+    Ok(path)
+}
+
+/// The "Setup" section: image, ladder, reference, baseline, metrics, and
+/// how long this run took.
+fn setup_section(
+    r: &mut String,
+    s: &Settings,
+    scene: &Scene,
+    configs: &[Config],
+    reference: &ReferenceInfo,
+    run_seconds: f64,
+) {
+    let (w, h) = (scene.camera.width, scene.camera.height);
     writeln!(r, "## Setup\n").unwrap();
     writeln!(
         r,
@@ -142,7 +171,7 @@ pub fn write(
     .unwrap();
     writeln!(
         r,
-        "- Metrics (see `src/study/metrics.rs`): RMSE; relMSE with ε = 0.01; bias = Σ(I − R)/ΣR with its standard error; \
+        "- Metrics (see `src/tools/study/metrics.rs`): RMSE; relMSE with ε = 0.01; bias = Σ(I − R)/ΣR with its standard error; \
          fireflies = pixels above {}× the reference luminance.",
         s.firefly_k
     )
@@ -152,7 +181,11 @@ pub fn write(
         "- This run took {run_seconds:.0} s (rows already in results.csv were not re-rendered).\n"
     )
     .unwrap();
+}
 
+/// Every configuration at its largest sample count against the baseline:
+/// the table of results and its note.
+fn results_table(r: &mut String, configs: &[Config], rows: &[Row], pixels: f64) {
     let base_rows = configs
         .first()
         .map(|b| ladder_of(rows, &b.name))
@@ -165,7 +198,6 @@ pub fn write(
     )
     .unwrap();
     writeln!(r, "|---|---|---|---|---|---|---|---|---|---|---|---|").unwrap();
-    let pixels = (w as f64) * (h as f64);
     for c in configs {
         let ladder = ladder_of(rows, &c.name);
         let Some(last) = ladder.last() else { continue };
@@ -198,19 +230,6 @@ pub fn write(
         "\n\"—\" in *time to baseline RMSE*: the ladder never got that low (noise or bias).\n"
     )
     .unwrap();
-    writeln!(r, "## Headlines\n").unwrap();
-    for h in headlines(configs, rows, pixels) {
-        writeln!(r, "- {h}").unwrap();
-    }
-    writeln!(r).unwrap();
-    writeln!(r, "## Plots\n").unwrap();
-    for p in plots {
-        let f = p.file_name().unwrap_or_default().to_string_lossy();
-        writeln!(r, "![{f}]({f})\n").unwrap();
-    }
-    writeln!(r, "Raw rows: `results.csv`; final images: `images/`.").unwrap();
-    atomic_write(&path, |tmp| fs::write(tmp, &r).map_err(|e| e.to_string()))?;
-    Ok(path)
 }
 
 /// How much less time `a` needs than `b` to reach `b`'s final RMSE.

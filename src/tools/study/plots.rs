@@ -9,7 +9,7 @@
 //!   radius sampler, one series per node spacing, with the exact sampler's
 //!   bias as a horizontal line.
 //!
-//! The canvas, font and palette are [`crate::plot`]'s, shared with
+//! The canvas, font and palette are [`crate::tools::plot`]'s, shared with
 //! `lucent bench`.
 
 use std::path::{Path, PathBuf};
@@ -18,7 +18,7 @@ use plotters::prelude::*;
 
 use super::config::{Axis, Config};
 use super::results::Row;
-use crate::plot::{color, ensure_font, log_range, png, FONT};
+use crate::tools::plot::{color, ensure_font, log_range, png, FONT};
 
 /// (x, bias %, 2σ %) points of one labelled series.
 type BiasSeries = (String, Vec<(f64, f64, f64)>);

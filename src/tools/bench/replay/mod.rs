@@ -1,0 +1,118 @@
+//! `lucent bench --scene`: how fast the renderer runs against how fast its
+//! backend answers the very queries the render issued.
+//!
+//! The synthetic ray sets of `lucent bench` only approximate a render's
+//! queries. Here the render itself is the workload:
+//!
+//! 1. the scene is rendered normally (the code path of `lucent render`),
+//!    timed: the end-to-end rate is the render's ray count over its wall
+//!    time;
+//! 2. it is rendered once more through a [`Recorder`], an [`Accel`](crate::accel::Accel) that
+//!    forwards every query to the real backend and appends it (kind, ray,
+//!    interval, geometry, seed) to the log of the rayon worker that issued
+//!    it, in issue order, with a digest of every answer;
+//! 3. each worker's log is replayed on its own thread of a pool of the same
+//!    size, through the bare backend as `&dyn Accel` (the dispatch the
+//!    integrator uses): the raw rate is the number of queries over the
+//!    replay's wall time, and replaying one kind at a time gives per-kind
+//!    rates. The first replay recomputes the digest; an answer that differs
+//!    from what the render saw is an error.
+//!
+//! The ratio of the two rates is the share of the render's wall time spent
+//! inside ray queries; the rest is shading, sampling and bookkeeping.
+//! Memory: a record is [`RECORD_BYTES`] bytes, and a run stops with an
+//! error beyond [`Settings::max_records`] queries per (backend, threads).
+//!
+//! The files: `record` (a logged query), `recorder` (the logging
+//! `Accel`), `digest` (answers summarized), `playback` (the replays),
+//! `timing` (best of repeated runs), `measure` (one backend and thread
+//! count), `rows` (the figures), `csv` and `report` (the output),
+//! `settings`; `tests` records and replays the marble-ball fixture.
+
+mod csv;
+mod digest;
+mod measure;
+mod playback;
+mod record;
+mod recorder;
+mod report;
+mod rows;
+mod settings;
+mod timing;
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use crate::accel;
+use crate::Error;
+pub use csv::csv_header;
+pub use digest::{Digest, Digests};
+pub use playback::{replay_digest, replay_hits};
+pub use record::{Kind, Record, RECORD_BYTES};
+pub use recorder::Recorder;
+pub use report::report;
+pub use rows::{KindRow, MixRow, TARGET_RATIO};
+pub use settings::{Settings, DEFAULT_MAX_RECORDS, DEFAULT_SPP};
+
+/// What [`run`] produced.
+pub struct Outcome {
+    pub rows: Vec<MixRow>,
+    pub csv: PathBuf,
+    /// The text printed on stdout (also `render-mix.txt`).
+    pub report: String,
+    /// Differences between the render's ray counter and the record count,
+    /// explained (also in the report).
+    pub notes: Vec<String>,
+}
+
+fn input(m: impl Into<String>) -> Error {
+    Error::Input(m.into())
+}
+
+fn runtime(m: impl Into<String>) -> Error {
+    Error::Runtime(m.into())
+}
+
+fn status(s: &Settings, m: String) {
+    if s.progress {
+        eprintln!("{m}");
+    }
+}
+
+/// Runs the measurement for every backend and thread count and writes
+/// `render-mix.csv` and `render-mix.txt` into `s.out`.
+pub fn run(s: &Settings) -> Result<Outcome, Error> {
+    settings::validate(s)?;
+    let scene = crate::scene::load(&s.scene).map_err(|e| input(e.to_string()))?;
+    std::fs::create_dir_all(&s.out).map_err(|e| input(format!("{}: {e}", s.out.display())))?;
+    let mut threads = s.threads.clone();
+    threads.sort_unstable();
+    threads.dedup();
+    let started = Instant::now();
+    let mut rows = Vec::new();
+    let mut notes = Vec::new();
+    for &backend in &s.backends {
+        let accel = accel::build(&scene.meshes, backend).map_err(input)?;
+        for &t in &threads {
+            let row = measure::measure(s, &scene, accel.as_ref(), t, &mut notes)?;
+            rows.push(row);
+        }
+    }
+    let csv = csv::write_csv(&s.out, &rows, &s.scene, &scene, s.spp)?;
+    let mut rep = report(&rows, s, &scene, started.elapsed());
+    for n in &notes {
+        let _ = writeln!(rep, "note: {n}");
+    }
+    let txt = s.out.join("render-mix.txt");
+    std::fs::write(&txt, &rep).map_err(|e| runtime(format!("{}: {e}", txt.display())))?;
+    Ok(Outcome {
+        rows,
+        csv,
+        report: rep,
+        notes,
+    })
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,193 @@
+//! `lucent study SCENE`: what accuracy costs in time.
+//!
+//! Renders a matrix of sampling configurations of the subsurface estimator
+//! ([`config`]: a baseline and one-axis-at-a-time variations) at a ladder
+//! of sample counts 1, 2, 4, …, times each render and measures its error
+//! against a long reference render ([`metrics`]). Writes `results.csv`
+//! ([`results`], resumable), plots ([`plots`]) and `report.md` ([`report`])
+//! into the output directory.
+//!
+//! The ladder is progressive: rung j adds a chunk of samples with seed
+//! `seed + j` to the running mean, so the image at 2^j spp costs 2^j spp of
+//! render time in total (not 2^(j+1) − 1) and its time is the sum of the
+//! chunks' wall times. Rungs are rendered round-robin (every
+//! configuration's rung j before any rung j + 1), so load drift on a shared
+//! machine spreads over all configurations. Every configuration uses the
+//! same seeds, and the reference uses seeds no configuration uses
+//! ([`REFERENCE_SEED_OFFSET`]), so reference noise is independent of the
+//! images it judges. The running
+//! mean after each rung is kept in `DIR/state/`, so an interrupted study
+//! resumes where it stopped without re-rendering anything, and a rerun with
+//! a larger `max_spp` extends the ladder. The final image of each
+//! configuration is written to `DIR/images/<config>.exr` (and `.png`).
+//!
+//! The reference is cached as `DIR/reference-<hash>.exr`, where the hash is
+//! 64-bit FNV-1a ([`Fnv1a`], written here so it is stable across Rust
+//! versions, unlike `DefaultHasher`) over the scene file's bytes, every
+//! mesh's transformed vertex positions (so edits of an OBJ invalidate it
+//! too), and the reference settings (integrator, spp, seed, resolution,
+//! path depth, probe options).
+//!
+//! The files: `settings` (what it is told), [`config`] (the matrix),
+//! `reference` (the cached reference), `resume` (what is already done),
+//! `ladder` (the renders), [`metrics`], [`results`] (the CSV), [`plots`]
+//! and [`report`].
+
+pub mod config;
+mod ladder;
+pub mod metrics;
+pub mod plots;
+mod reference;
+pub mod report;
+pub mod results;
+mod resume;
+mod settings;
+
+use std::collections::HashMap;
+use std::fs;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use crate::accel::{self, Accel, Backend};
+use crate::integrator::IntegratorKind;
+use crate::render::RenderOptions;
+use crate::scene::{self, Camera, Scene};
+pub use config::{Axis, Config, Overrides};
+pub use ladder::ladder;
+use ladder::Ladder;
+pub use reference::{Fnv1a, ReferenceInfo, REFERENCE_SEED_OFFSET};
+use results::{Results, Row};
+pub use resume::slug;
+pub use settings::Settings;
+
+use crate::Error;
+
+/// What a finished study produced.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    pub configs: Vec<Config>,
+    pub rows: Vec<Row>,
+    /// Rows rendered by this run (the others were already in the CSV).
+    pub rendered_rows: usize,
+    pub reference: ReferenceInfo,
+    pub report: PathBuf,
+    pub plots: Vec<PathBuf>,
+}
+
+/// The scene at the study's resolution (the scene's aspect, `width` wide).
+fn resized(mut scene: Scene, width: u32) -> Scene {
+    let c = &scene.camera;
+    let w = width.min(c.width);
+    let h = ((c.height as f64 * w as f64 / c.width as f64).round() as u32).max(1);
+    scene.camera = Camera::new(c.look_from, c.look_at, c.up, c.fov_y, w, h);
+    scene
+}
+
+fn render_opts(
+    s: &Settings,
+    spp: u32,
+    seed: u64,
+    integrator: IntegratorKind,
+    progress: bool,
+) -> RenderOptions {
+    RenderOptions {
+        spp: Some(spp),
+        seed: Some(seed),
+        threads: s.threads,
+        progress,
+        integrator,
+    }
+}
+
+fn runtime<E: std::fmt::Display>(e: E) -> Error {
+    Error::Runtime(e.to_string())
+}
+
+/// Every backend the matrix uses (and the first, which renders the
+/// reference), built once and shared by its configurations (a
+/// configuration rebuilds materials, never meshes).
+fn build_accels(
+    scene: &Scene,
+    backends: &[Backend],
+    configs: &[Config],
+) -> Result<HashMap<&'static str, Box<dyn Accel>>, Error> {
+    let mut accels: HashMap<&'static str, Box<dyn Accel>> = HashMap::new();
+    for b in backends
+        .iter()
+        .filter(|b| configs.iter().any(|c| c.backend == **b) || **b == backends[0])
+    {
+        accels.insert(b.name(), accel::build(&scene.meshes, *b)?);
+    }
+    Ok(accels)
+}
+
+/// Runs (or resumes) a study; see the module docs.
+pub fn run(s: &Settings) -> Result<Outcome, Error> {
+    settings::validate(s)?;
+    let scene_text =
+        fs::read(&s.scene).map_err(|e| Error::Input(format!("{}: {e}", s.scene.display())))?;
+    let scene = scene::load(&s.scene).map_err(|e| Error::Input(e.to_string()))?;
+    let scene = resized(scene, s.width);
+    let seed = s.seed.unwrap_or(scene.settings.seed);
+    let mut backends = vec![Backend::default_available()];
+    if backends[0] == Backend::Embree {
+        backends.push(Backend::Bvh);
+    }
+    let configs: Vec<Config> = config::matrix(&scene, s.quick, &backends)
+        .map_err(Error::Input)?
+        .into_iter()
+        .filter(|c| c.axis == Axis::Baseline || s.only.is_empty() || s.only.contains(&c.axis))
+        .collect();
+    fs::create_dir_all(s.out_dir.join("state"))
+        .map_err(|e| Error::Runtime(format!("cannot create {}: {e}", s.out_dir.display())))?;
+    let accels = build_accels(&scene, &backends, &configs)?;
+    let (reference, ref_info) = reference::reference(
+        s,
+        &scene,
+        &scene_text,
+        accels[backends[0].name()].as_ref(),
+        seed,
+    )?;
+
+    resume::check_results_key(s, &ref_info, seed, &scene)?;
+    let mut results = Results::open(&s.out_dir.join("results.csv")).map_err(runtime)?;
+    let spps = ladder(s.max_spp);
+    let bar = ladder::progress_bar(s, &configs, &spps, &results);
+    let started = Instant::now();
+    let mut jobs = resume::jobs(s, &scene, &configs, &spps, &results)?;
+    let rungs = Ladder {
+        settings: s,
+        spps: &spps,
+        accels: &accels,
+        reference: &reference,
+        seed,
+    };
+    let rendered_rows = rungs.render(&mut jobs, &mut results, &bar)?;
+    ladder::write_final_images(s, &jobs)?;
+    bar.finish_and_clear();
+    let rows: Vec<Row> = results
+        .rows()
+        .iter()
+        .filter(|r| configs.iter().any(|c| c.name == r.config) && spps.contains(&r.spp))
+        .cloned()
+        .collect();
+    let plots = plots::write_all(&s.out_dir, &rows, &configs).map_err(runtime)?;
+    let report = report::write(
+        s,
+        &scene,
+        &configs,
+        &rows,
+        &ref_info,
+        &plots,
+        started.elapsed().as_secs_f64(),
+    )
+    .map_err(runtime)?;
+    Ok(Outcome {
+        configs,
+        rows,
+        rendered_rows,
+        reference: ref_info,
+        report,
+        plots,
+    })
+}
