@@ -7,6 +7,7 @@ pub mod accel;
 pub mod bench;
 pub mod bssrdf;
 pub mod film;
+pub mod fresnel;
 pub mod geometry;
 pub mod integrator;
 pub mod lights;

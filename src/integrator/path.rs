@@ -20,7 +20,8 @@ use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
 use crate::bssrdf::ProbeRandoms;
 use crate::geometry::{Frame, Ray, Vec3};
-use crate::materials::{dielectric, diffuse, fresnel, Material, Subsurface};
+use crate::fresnel;
+use crate::materials::{dielectric, diffuse, Material, Subsurface};
 use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Draw, SampleRng};
 use glam::Vec3A;
 
