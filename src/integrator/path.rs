@@ -16,6 +16,7 @@
 //! small (pbrt-v4 §13.1.1).
 
 use super::interaction::offset_along;
+use super::probe::{sample_entry, ProbeTarget};
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
 use crate::bssrdf::ProbeRandoms;
@@ -292,15 +293,13 @@ fn subsurface_probe<'s>(
     let frame_o = si.shading_frame_facing(wo);
     let u = ProbeRandoms::from_rng(rng);
     counters.rays += 1;
-    let Some(ps) = ss.probe.sample(
-        si.p,
-        &frame_o,
-        &u,
-        ctx.accel,
-        si.geom,
-        &ctx.face_normals[si.geom as usize],
-        &mut scratch.probe_hits,
-    ) else {
+    let target = ProbeTarget {
+        accel: ctx.accel,
+        geom: si.geom,
+        mesh: &ctx.scene.meshes[si.geom as usize],
+    };
+    let Some(ps) = sample_entry(&ss.probe, si.p, &frame_o, &u, &target, &mut scratch.probe_hits)
+    else {
         return Scatter::Absorbed;
     };
     *beta *= ps.weight;
