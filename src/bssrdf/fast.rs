@@ -180,10 +180,8 @@ impl FastProbe {
         let p = match single {
             Some(ch) => pdf[ch],
             None => pdf[0] + pdf[1] + pdf[2],
-        } / n_active as u32 as f32;
-        // = !(p > 0 && p.is_finite()) (NaN fails both comparisons) in two
-        // compares instead of a float classification
-        if !(p > 0.0 && p < f32::INFINITY) {
+        } / n_active as f32;
+        if !(p > 0.0 && p.is_finite()) {
             return None;
         }
         let inv = 1.0 / p;

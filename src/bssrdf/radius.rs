@@ -358,16 +358,8 @@ impl RadialDist {
                 }
             }
         };
-        // = r.max(RHO_MIN * d).min(self.rmax) (a NaN r gives the lower
-        // bound, as f64::max does; the bounds are never NaN), as one maxsd
-        // and one minsd instead of f64::max's and min's NaN blends
-        let lo = RHO_MIN * d;
-        let r = if r > lo { r } else { lo };
-        if r < self.rmax {
-            r
-        } else {
-            self.rmax
-        }
+        // a NaN r gives the lower bound
+        r.max(RHO_MIN * d).min(self.rmax)
     }
 
     /// The disk pdf (per unit area) of radius r; 0 beyond Rmax.
