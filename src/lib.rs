@@ -10,6 +10,7 @@ pub mod film;
 pub mod fresnel;
 pub mod geometry;
 pub mod integrator;
+pub mod kernels;
 pub mod lights;
 pub mod materials;
 pub mod plot;

@@ -9,7 +9,7 @@
 //! - [`radius`]: the four radius samplers with their disk pdfs;
 //! - [`probe`]: the probe-ray estimator: samples probe segments and weighs
 //!   the hits the integrator finds on them;
-//! - [`fast`]: its per-hit density and weight in f32, for the exact samplers;
+//! - [`density`]: the density p(xi) and Rd of an entry point, per channel;
 //! - [`fresnel_moment`]: Ft and the normalized exit lobe Sw.
 //!
 //! The separable BSSRDF is S = C·Ft(xi, wi)·Rd(|xo − xi|)·Ft(xo, wo) with
@@ -35,7 +35,7 @@
 //! This module imports nothing from the accel, the integrator or the
 //! materials: the integrator's `probe` module runs the query.
 
-pub mod fast;
+pub mod density;
 pub mod fresnel_moment;
 pub mod params;
 pub mod probe;
