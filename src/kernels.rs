@@ -13,17 +13,28 @@
 //!   probe density ([`crate::bssrdf::density`]) evaluates the profile at four
 //!   radii per channel with one call, where the f64 evaluation made 12 libm
 //!   `exp` calls per probe hit: with the f64 density instead the tile loop
-//!   costs 769.0M instead of 718.8M instructions (+7.0 %, BVH; measured at
-//!   the commit that made this module).
+//!   costs 769.0M instead of 718.5M instructions (+7.0 %; BVH build, as
+//!   every figure here unless noted).
 //!
-//! Tricks measured and removed (below 0.5 % of the tile loop each, under the
+//! - Code placement in the bounce loop of [`crate::integrator::path`]:
+//!   `#[inline(never)]` on `dielectric_bounce`, `emission_weight` and
+//!   `subsurface_probe`. Inlined, their locals join the values the loop
+//!   keeps live across every ray-query call (which preserves no xmm
+//!   register) and the loop spills more: without the attributes the tile
+//!   loop costs 718.5M instead of 711.2M instructions (+1.0 %).
+//! - `#[inline(always)]` on `Context::interaction` and `Interaction::new`:
+//!   LLVM kept them out of line despite `#[inline]`, returning the 48-byte
+//!   Interaction through memory; 3.2M instructions (0.6 %) when measured
+//!   (Embree build, commit a4c453a).
+//!
+//! Tricks measured and removed (each below 0.5 % of the tile loop, under the
 //! wall-time noise of a render): Vec3A radiance and throughput in
-//! `path::trace`, a u64 bounce range, `#[inline(never)]` on the dielectric
-//! bounce, the emission weight and the probe step, a packed finiteness test
-//! in `render_tile`, an SSE truncation in `sin_cos_turns`, integer-width
-//! detours in float conversions, compare-select clamps, and
+//! `path::trace`, a u64 bounce range instead of `0..=max_depth`, a packed
+//! finiteness test in `render_tile`, an SSE truncation in `sin_cos_turns`,
+//! integer-width detours in float conversions, compare-select clamps, and
 //! `#[inline(always)]` on the analytic inverse CDF. Together they saved
-//! 2.1 % of the tile loop's instructions (704.0M with them, 718.8M without).
+//! 1.0 % of the tile loop's instructions (704.0M with them and the
+//! placement above, 711.2M with the placement alone).
 
 use glam::Vec4;
 

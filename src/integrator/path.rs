@@ -218,6 +218,9 @@ pub(crate) fn trace<'s>(
 }
 
 /// A specular bounce off or through a dielectric.
+// Out of line, as are the probe step and the emission weight: a measured
+// gain, see `crate::kernels`.
+#[inline(never)]
 fn dielectric_bounce(
     ctx: &Context,
     eta: f32,
@@ -236,6 +239,7 @@ fn dielectric_bounce(
 /// xo, then one probe ray for the entry point xi, where the path continues
 /// with the entry lobe.
 #[allow(clippy::too_many_arguments)]
+#[inline(never)]
 fn subsurface_probe<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
@@ -314,6 +318,7 @@ fn roulette(depth: u32, beta: &mut Vec3, rng: &mut SampleRng) -> bool {
 }
 
 /// The MIS weight of emission found by lobe sampling from `prev`.
+#[inline(never)]
 fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3, f32)>) -> f32 {
     match prev {
         None => 1.0,
