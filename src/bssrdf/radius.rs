@@ -814,34 +814,6 @@ mod tests {
         }
     }
 
-    /// Cost per sample (sample + its pdf), and per pdf evaluation. Run with
-    /// `cargo test --release --lib bench_radius -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn bench_radius_samplers() {
-        use std::hint::black_box;
-        use std::time::Instant;
-        let n = 20_000_000;
-        for s in all_samplers() {
-            let dist = RadialDist::new(s, 1.0, profile::quantile(0.999)).unwrap();
-            let mut rng = Rng::from_key(1);
-            let t0 = Instant::now();
-            let mut acc = 0.0;
-            for _ in 0..n {
-                let (r, p) = dist.sample(rng.uniform_f64());
-                acc += r + p;
-            }
-            let ns_sample = t0.elapsed().as_nanos() as f64 / n as f64;
-            let t0 = Instant::now();
-            for i in 0..n {
-                acc += dist.pdf(black_box(i as f64 * 1e-6));
-            }
-            let ns_pdf = t0.elapsed().as_nanos() as f64 / n as f64;
-            black_box(acc);
-            println!("{s:?}: {ns_sample:.1} ns/sample (incl. rng + pdf), {ns_pdf:.1} ns/pdf");
-        }
-    }
-
     #[test]
     fn parse_and_validate() {
         assert_eq!(
