@@ -67,7 +67,9 @@ pub struct Interaction {
 }
 
 impl Interaction {
-    /// `shading` is the [`MeshShading`] of the mesh hit.
+    /// `shading` is the [`MeshShading`] of the mesh hit. Forced inline with
+    /// [`Context::interaction`](super::Context::interaction) (see
+    /// [`crate::kernels`]).
     #[inline(always)]
     pub fn new(shading: &MeshShading, ray: &Ray, hit: &Hit) -> Self {
         let t = &shading.tris[hit.prim as usize];

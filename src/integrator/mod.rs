@@ -58,9 +58,10 @@ impl<'a> Context<'a> {
         }
     }
 
-    /// The surface geometry at `hit` on the ray `ray`. Forced inline: the
-    /// bounce loop is large enough that LLVM kept this out of line, and the
-    /// call returned the 48-byte Interaction through memory.
+    /// The surface geometry at `hit` on the ray `ray`. Forced inline (a
+    /// measured gain, see [`crate::kernels`]): the bounce loop is large
+    /// enough that LLVM kept this out of line, and the call returned the
+    /// 48-byte Interaction through memory.
     #[inline(always)]
     pub fn interaction(&self, ray: &crate::geometry::Ray, hit: &crate::accel::Hit) -> Interaction {
         Interaction::new(&self.shading[hit.geom as usize], ray, hit)
