@@ -35,6 +35,10 @@
 //! `#[inline(always)]` on the analytic inverse CDF. Together they saved
 //! 1.0 % of the tile loop's instructions (704.0M with them and the
 //! placement above, 711.2M with the placement alone).
+//!
+//! Measured and not taken: `#[inline]` on `ProbeSampler::sample_probe` and
+//! `ProbeSampler::weigh`, the two calls the probe split put between the
+//! integrator and the BSSRDF (711.2M → 709.5M, −0.25 %).
 
 use glam::Vec4;
 
