@@ -289,6 +289,8 @@ impl ProbeSampler {
         if self.n_active == 0 {
             return None;
         }
+        // docs/bssrdf.md §5 step 1: a channel c, a radius r ~ p_c, an axis
+        // V with probability p_axis(V), an angle φ.
         let channel = self.active[uniform_index(u.channel, self.n_active)];
         let dist = self.dists[channel].as_ref()?;
         let r = dist.sample_radius(u.radius);
@@ -313,6 +315,7 @@ impl ProbeSampler {
         // The angle in f32: its rounding moves p0 by ~1e-7·r, below the f32
         // rounding of p0 itself.
         let (sin, cos) = crate::sampling::sin_cos_turns(u.angle as f32);
+        // Step 2: p0 = xo + r (cos φ T' + sin φ B') + h V, segment p0 → p0 − 2h V.
         let h = (self.rmax * self.rmax - r * r).max(0.0).sqrt();
         let p0 = xo.as_dvec3() + (t1 * cos as f64 + t2 * sin as f64) * r + v * h;
         Some(ProbeSegment {
@@ -326,7 +329,8 @@ impl ProbeSampler {
 
     /// Weighs the hit at distance `t` along `seg` on a triangle with unit
     /// normal `n_hit`, picked with [`pick_hit`] among `total` hits on the
-    /// segment (pbrt-v4 `ProbeIntersectionToSample`):
+    /// segment (pbrt-v4 `ProbeIntersectionToSample`; `docs/bssrdf.md` §5
+    /// step 4, where `total` is k):
     ///
     ///   weight = Rd(|xo − xi|) / p(xi) × total,
     ///

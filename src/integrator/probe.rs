@@ -47,6 +47,8 @@ pub fn sample_entry(
     target: &ProbeTarget,
     hits: &mut ProbeHits,
 ) -> Option<ProbeSample> {
+    // docs/bssrdf.md §5: steps 1–2 in the BSSRDF, step 3 here (every hit
+    // on the object, one picked uniformly), step 4 in the BSSRDF.
     let seg = sampler.sample_probe(xo, frame, u)?;
     target
         .accel
