@@ -37,7 +37,7 @@ for b in $backends; do
         "$ty as lucent::accel::Accel>::intersect"
         "$ty as lucent::accel::Accel>::occluded"
         "$ty as lucent::accel::Accel>::hits_on_segment"
-        "ProbeSampler::sample")
+        "lucent::integrator::probe::sample_entry")
   mapfile -t v < <(python3 scripts/cg_inclusive.py "$OUT/$b.cg" "${pats[@]}" | cut -f1)
   # A function the compiler inlined has no cost of its own in the profile;
   # its share would silently land in "the rest".

@@ -1,6 +1,8 @@
 //! Rays, orthonormal frames and triangle meshes: the geometric vocabulary
 //! shared by the scene loader, both ray-query backends and the integrators.
 
+use std::sync::OnceLock;
+
 pub use glam::Vec3;
 
 /// A ray `o + t d`. `d` need not be normalized for the accel queries (t is in
@@ -54,12 +56,20 @@ impl Frame {
 /// because Embree reads vertices with 16-byte loads and requires the buffer
 /// to be readable 4 bytes past the last vertex; keeping it here lets Embree
 /// share our buffer instead of copying it.
+///
+/// The unit face normals are computed on first use ([`Mesh::face_normal`])
+/// and kept: the shading records and the probe estimator both read them, and
+/// meshes that are only traced (benchmarks) never pay for them.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     positions: Vec<Vec3>,
+    /// Triangles as vertex index triples. Edit them before the face normals
+    /// are first read (or through [`Mesh::flip_winding`]), or the cached
+    /// normals go stale.
     pub indices: Vec<[u32; 3]>,
     /// Optional per-vertex shading normals (unit length), same count as vertices.
     pub normals: Option<Vec<Vec3>>,
+    face_normals: OnceLock<Vec<Vec3>>,
 }
 
 impl Mesh {
@@ -77,6 +87,7 @@ impl Mesh {
             positions: p,
             indices,
             normals,
+            face_normals: OnceLock::new(),
         }
     }
     /// Vertex positions (without the padding element).
@@ -104,6 +115,7 @@ impl Mesh {
     }
     /// Applies `f` to every vertex position (and `g` to every normal).
     pub fn transform(&mut self, f: impl Fn(Vec3) -> Vec3, g: impl Fn(Vec3) -> Vec3) {
+        self.face_normals = OnceLock::new();
         let n = self.vertex_count();
         for p in &mut self.positions[..n] {
             *p = f(*p);
@@ -117,6 +129,7 @@ impl Mesh {
     /// Flips the winding of every triangle (and normals), used when a
     /// transform has negative determinant.
     pub fn flip_winding(&mut self) {
+        self.face_normals = OnceLock::new();
         for t in &mut self.indices {
             t.swap(1, 2);
         }
@@ -141,6 +154,28 @@ impl Mesh {
                 .map(|v| v.try_normalize().unwrap_or(Vec3::Z))
                 .collect(),
         );
+    }
+
+    /// The unit geometric normal of triangle `prim`, front face by
+    /// counter-clockwise winding (outward for a consistently wound closed
+    /// mesh); zero for a degenerate triangle.
+    #[inline]
+    pub fn face_normal(&self, prim: u32) -> Vec3 {
+        self.face_normals()[prim as usize]
+    }
+
+    /// [`face_normal`](Self::face_normal) of every triangle, in order;
+    /// computed once, on the first call.
+    pub fn face_normals(&self) -> &[Vec3] {
+        self.face_normals.get_or_init(|| {
+            self.indices
+                .iter()
+                .map(|&idx| {
+                    let [a, b, c] = self.vertices(idx);
+                    (b - a).cross(c - a).normalize_or_zero()
+                })
+                .collect()
+        })
     }
 
     pub fn area(&self, prim: u32) -> f32 {
@@ -180,6 +215,22 @@ mod tests {
         assert_eq!(m.vertex_count(), 3);
         assert_eq!(m.padded_positions().len(), 4);
         assert!((m.area(0) - 0.5).abs() < 1e-7);
+    }
+
+    #[test]
+    fn face_normals_follow_winding_and_edits() {
+        let mut m = Mesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(2.0, 0.0, 0.0)],
+            vec![[0, 1, 2], [0, 1, 3]],
+            None,
+        );
+        assert_eq!(m.face_normal(0), Vec3::Z);
+        // collinear vertices: a degenerate triangle has no normal
+        assert_eq!(m.face_normal(1), Vec3::ZERO);
+        m.flip_winding();
+        assert_eq!(m.face_normal(0), -Vec3::Z);
+        m.transform(|p| Vec3::new(p.x, p.z, p.y), |n| n);
+        assert_eq!(m.face_normals(), &[Vec3::Y, Vec3::ZERO]);
     }
 
     #[test]

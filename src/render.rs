@@ -18,7 +18,6 @@ use crate::integrator::path::Scratch;
 use crate::integrator::{Context, Counters, IntegratorKind};
 use crate::sampling::{Draw, Rng, SampleRng};
 use crate::scene::Scene;
-use glam::Vec3A;
 
 pub const TILE: u32 = 16;
 
@@ -187,13 +186,7 @@ fn render_tile(
                 let [jx, jy] = rng.uniform2_packed();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 let l = integrator.radiance(ctx, ray, &mut rng, &mut scratch, &mut counters);
-                // = l.is_finite(): x − x is 0 exactly for finite x and NaN
-                // for ±∞ and NaN, one packed compare for the three lanes
-                // instead of a classification per lane
-                let a = Vec3A::from(l);
-                #[allow(clippy::eq_op)]
-                let finite = (a - a).cmpeq(Vec3A::ZERO).all();
-                if finite {
+                if l.is_finite() {
                     sum[0] += l.x as f64;
                     sum[1] += l.y as f64;
                     sum[2] += l.z as f64;

@@ -32,7 +32,7 @@ use lucent::bssrdf::{
 };
 use lucent::film::Film;
 use lucent::geometry::{Frame, Mesh, Ray, Vec3};
-use lucent::integrator::interaction::face_normals;
+use lucent::integrator::probe::{sample_entry, ProbeTarget};
 use lucent::materials::{Material, Subsurface};
 use lucent::render::{render, RenderOptions, RenderStats};
 use lucent::sampling::Rng;
@@ -111,6 +111,15 @@ fn scene(
 }
 
 /// The cube [-1, 1]³ scaled by `half` and moved by `at`.
+/// Mesh 0 of `accel`, which is `mesh`: where a probe searches.
+fn target<'a>(accel: &'a dyn Accel, mesh: &'a Mesh) -> ProbeTarget<'a> {
+    ProbeTarget {
+        accel,
+        geom: 0,
+        mesh,
+    }
+}
+
 fn cuboid(half: Vec3, at: Vec3) -> Mesh {
     let mut m = shapes::cuboid();
     m.transform(|p| p * half + at, |n| n);
@@ -268,7 +277,7 @@ fn zero_albedo_channel_ketchup_blue_is_exactly_zero() {
     assert_eq!(p.albedo[2], 0.0);
     for opts in [
         ProbeOptions::default(),
-        ProbeOptions::seed(RadiusSampler::table(256)),
+        ProbeOptions::seed_document(RadiusSampler::table(256)),
     ] {
         let m = material(p, opts, true, false);
         let rmax = subsurface_of(&m).probe.rmax() as f32;
@@ -315,7 +324,7 @@ fn tiny_d_looks_like_a_diffuse_surface_of_albedo_a() {
     let slab = cuboid(Vec3::new(1.0, 0.5, 1.0), Vec3::new(0.0, -0.5, 0.0));
     for opts in [
         ProbeOptions::default(),
-        ProbeOptions::seed(RadiusSampler::Analytic),
+        ProbeOptions::seed_document(RadiusSampler::Analytic),
     ] {
         let sc = scene(
             vec![slab.clone()],
@@ -422,7 +431,6 @@ fn grazing_probe_hits_on_a_thin_wedge() {
     let p = params([0.8, 0.8, 0.8], [0.025, 0.02, 0.015], 1.0);
     let per_hit_bound = MIS3_FACTOR * 3.0 * 0.8;
     let mesh = thin_wedge(alpha);
-    let normals = face_normals(&mesh);
     let meshes = Arc::new(vec![mesh.clone()]);
     for (backend, acc) in accels(&meshes) {
         let mut max_w = [0.0f64; 2];
@@ -447,9 +455,14 @@ fn grazing_probe_hits_on_a_thin_wedge() {
                     let frame = Frame::from_normal(ns);
                     for _ in 0..3000 {
                         let u = ProbeRandoms::from_rng(&mut rng);
-                        if let Some(ps) =
-                            s.sample(xo, &frame, &u, acc.as_ref(), 0, &normals, &mut hits)
-                        {
+                        if let Some(ps) = sample_entry(
+                            &s,
+                            xo,
+                            &frame,
+                            &u,
+                            &target(acc.as_ref(), &mesh),
+                            &mut hits,
+                        ) {
                             found += 1;
                             let total = hits.total() as f64;
                             assert!((1.0..=4.0).contains(&total), "{total}");
@@ -541,7 +554,6 @@ fn probes_that_find_nothing_on_geometry_thinner_than_d() {
     let albedo = [0.8, 0.6, 0.4];
     let p = params(albedo, [1.0, 0.8, 0.6], 1.0);
     let thin = cuboid(Vec3::new(1.0, 0.005, 1.0), Vec3::ZERO);
-    let normals = face_normals(&thin);
     let sc = scene(
         vec![thin.clone()],
         vec![plain(p, ProbeOptions::default())],
@@ -558,13 +570,12 @@ fn probes_that_find_nothing_on_geometry_thinner_than_d() {
         for _ in 0..n {
             let u = ProbeRandoms::from_rng(&mut rng);
             let xo = Vec3::new(0.1, 0.005, -0.2);
-            match s.sample(
+            match sample_entry(
+                &s,
                 xo,
                 &Frame::from_normal(Vec3::Y),
                 &u,
-                acc.as_ref(),
-                0,
-                &normals,
+                &target(acc.as_ref(), &thin),
                 &mut hits,
             ) {
                 None => none += 1,
@@ -679,7 +690,6 @@ fn extreme_random_numbers_through_the_probe_sampler() {
     let top = 1.0 - f64::EPSILON / 2.0;
     assert!(top < 1.0 && top == 1.0 - 2f64.powi(-53));
     let mesh = shapes::sphere(3);
-    let normals = face_normals(&mesh);
     let p = params([0.8, 0.5, 0.3], [0.1, 0.05, 0.02], 1.3);
     let meshes = Arc::new(vec![mesh.clone()]);
     for (backend, acc) in accels(&meshes) {
@@ -700,7 +710,8 @@ fn extreme_random_numbers_through_the_probe_sampler() {
                         hit: x(4),
                         seed: if bits >> 5 & 1 == 1 { u32::MAX } else { 0 },
                     };
-                    if let Some(ps) = s.sample(xo, &frame, &u, acc.as_ref(), 0, &normals, &mut hits)
+                    if let Some(ps) =
+                        sample_entry(&s, xo, &frame, &u, &target(acc.as_ref(), &mesh), &mut hits)
                     {
                         found += 1;
                         assert!(
@@ -854,7 +865,6 @@ fn degenerate_triangles_are_harmless() {
         }
     }
     let dirty = Mesh::new(pos, idx, Some(nrm));
-    let normals = face_normals(&dirty);
     assert!(
         (0..dirty.triangle_count() as u32)
             .filter(|&t| dirty.area(t) == 0.0)
@@ -901,7 +911,7 @@ fn degenerate_triangles_are_harmless() {
         let mut rng = Rng::from_key(9);
         for opts in [
             ProbeOptions::default(),
-            ProbeOptions::seed(RadiusSampler::Uniform),
+            ProbeOptions::seed_document(RadiusSampler::Uniform),
         ] {
             let s = ProbeSampler::new(&p, &opts).unwrap();
             let mut found = 0;
@@ -910,7 +920,8 @@ fn degenerate_triangles_are_harmless() {
                 let frame = Frame::from_normal(dirty.normals.as_ref().unwrap()[v]);
                 for _ in 0..50 {
                     let u = ProbeRandoms::from_rng(&mut rng);
-                    if let Some(ps) = s.sample(xo, &frame, &u, acc.as_ref(), 0, &normals, &mut hits)
+                    if let Some(ps) =
+                        sample_entry(&s, xo, &frame, &u, &target(acc.as_ref(), &dirty), &mut hits)
                     {
                         found += 1;
                         assert!(

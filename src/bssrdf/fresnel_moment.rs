@@ -7,7 +7,7 @@
 //! energy: with it, a flat slab still reflects exactly A. The seed drops the
 //! exit Fresnel altogether (`docs/bssrdf.md` §6); the integrator chooses.
 
-use crate::materials::fresnel;
+use crate::fresnel;
 
 /// First Fresnel moment FM1(η) = ∫_0^1 Fr(μ, η) μ dμ, polynomial fits
 /// (pbrt-v3 `FresnelMoment1`).

@@ -7,8 +7,9 @@
 //! - [`profile`]: R(r), its CDF and closed-form inverse, the s(A) fits;
 //! - [`params`]: presets, measured and artist parameters → per-channel (A, d);
 //! - [`radius`]: the four radius samplers with their disk pdfs;
-//! - [`probe`]: the probe-ray estimator the integrator calls;
-//! - [`fast`]: its per-hit density and weight in f32, for the exact samplers;
+//! - [`probe`]: the probe-ray estimator: samples probe segments and weighs
+//!   the hits the integrator finds on them;
+//! - [`density`]: the density p(xi) and Rd of an entry point, per channel;
 //! - [`fresnel_moment`]: Ft and the normalized exit lobe Sw.
 //!
 //! The separable BSSRDF is S = C·Ft(xi, wi)·Rd(|xo − xi|)·Ft(xo, wo) with
@@ -22,14 +23,19 @@
 //! let c = sw_normalization(params.eta);                                    // once
 //! // at exit point xo with shading frame `frame` on mesh `geom`:
 //! let u = ProbeRandoms::from_rng(rng);
-//! if let Some(ps) = sampler.sample(xo, &frame, &u, accel, geom, &mesh, &mut probe_hits) {
-//!     // ps.weight = Rd / pdf × hit count (RGB); light arriving at ps.point
-//!     // (normal ps.normal) through the lobe sw(cos, eta, c) contributes
-//!     // Ft(xo, wo) · ps.weight · ∫ Li sw cos dω.
-//! }
+//! let seg = sampler.sample_probe(xo, &frame, &u)?;
+//! accel.hits_on_segment(&seg.ray, seg.t_max, geom, u.seed, &mut probe_hits); // the integrator's query
+//! let hit = probe_hits.hits()[pick_hit(&u, probe_hits.hits().len())];
+//! let e = sampler.weigh(&seg, hit.t, mesh.face_normal(hit.prim), probe_hits.total())?;
+//! // e.weight = Rd / pdf × hit count (RGB); light arriving at e.point
+//! // through the lobe sw(cos, eta, c) contributes
+//! // Ft(xo, wo) · e.weight · ∫ Li sw cos dω.
 //! ```
+//!
+//! This module imports nothing from the accel, the integrator or the
+//! materials: the integrator's `probe` module runs the query.
 
-pub mod fast;
+pub mod density;
 pub mod fresnel_moment;
 pub mod params;
 pub mod probe;
@@ -39,7 +45,8 @@ pub mod radius;
 pub use fresnel_moment::{sw, sw_normalization, transmittance};
 pub use params::{Measured, Preset, SubsurfaceParams, PRESETS};
 pub use probe::{
-    ChannelStrategy, ProbeAxes, ProbeOptions, ProbeRandoms, ProbeSample, ProbeSampler,
+    pick_hit, ChannelStrategy, ProbeAxes, ProbeEntry, ProbeOptions, ProbeRandoms, ProbeSampler,
+    ProbeSegment,
 };
 pub use profile::Fit;
 pub use radius::{RadialDist, RadiusSampler, TableSpacing};

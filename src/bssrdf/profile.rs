@@ -88,9 +88,7 @@ pub fn cdf(r: f64, d: f64) -> f64 {
 /// Passing 1 − ξ separately lets callers that know it exactly (a truncated
 /// sampler computes it as (1 − u)·c + (1 − c)) keep the tail precise.
 /// Returns +∞ for ξ = 1 (u = 0).
-// Always inlined: as a call it cost ~9 instructions per sampled radius in
-// frame set-up and register moves (callgrind, marble bunny).
-#[inline(always)]
+#[inline]
 pub fn inverse_cdf_unit_pair(xi: f64, one_minus_xi: f64) -> f64 {
     if xi <= 0.0 {
         return 0.0;

@@ -378,16 +378,8 @@ impl RadialDist {
                 }
             }
         };
-        // = r.max(RHO_MIN * d).min(self.rmax) (a NaN r gives the lower
-        // bound, as f64::max does; the bounds are never NaN), as one maxsd
-        // and one minsd instead of f64::max's and min's NaN blends
-        let lo = RHO_MIN * d;
-        let r = if r > lo { r } else { lo };
-        if r < self.rmax {
-            r
-        } else {
-            self.rmax
-        }
+        // a NaN r gives the lower bound
+        r.max(RHO_MIN * d).min(self.rmax)
     }
 
     /// The disk pdf (per unit area) of radius r; 0 beyond Rmax.
@@ -839,34 +831,6 @@ mod tests {
             if n == 16 {
                 assert!(rel[0].abs() > 1e-3, "{rel:?}");
             }
-        }
-    }
-
-    /// Cost per sample (sample + its pdf), and per pdf evaluation. Run with
-    /// `cargo test --release --lib bench_radius -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn bench_radius_samplers() {
-        use std::hint::black_box;
-        use std::time::Instant;
-        let n = 20_000_000;
-        for s in all_samplers() {
-            let dist = RadialDist::new(s, 1.0, profile::quantile(0.999)).unwrap();
-            let mut rng = Rng::from_key(1);
-            let t0 = Instant::now();
-            let mut acc = 0.0;
-            for _ in 0..n {
-                let (r, p) = dist.sample(rng.uniform_f64());
-                acc += r + p;
-            }
-            let ns_sample = t0.elapsed().as_nanos() as f64 / n as f64;
-            let t0 = Instant::now();
-            for i in 0..n {
-                acc += dist.pdf(black_box(i as f64 * 1e-6));
-            }
-            let ns_pdf = t0.elapsed().as_nanos() as f64 / n as f64;
-            black_box(acc);
-            println!("{s:?}: {ns_sample:.1} ns/sample (incl. rng + pdf), {ns_pdf:.1} ns/pdf");
         }
     }
 

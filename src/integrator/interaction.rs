@@ -26,14 +26,12 @@ struct TriGeometry {
 }
 
 impl MeshShading {
-    /// `face_normals` is [`face_normals`] of `mesh` (computed once per
-    /// scene and shared with the probe sampler).
-    pub fn new(mesh: &Mesh, face_normals: &[Vec3]) -> Self {
-        debug_assert_eq!(face_normals.len(), mesh.indices.len());
+    /// The record of `mesh`, with its [`Mesh::face_normals`].
+    pub fn new(mesh: &Mesh) -> Self {
         let tris = mesh
             .indices
             .iter()
-            .zip(face_normals)
+            .zip(mesh.face_normals())
             .map(|(&idx, &ng)| {
                 let [a, b, c] = mesh.vertices(idx);
                 TriGeometry {
@@ -69,7 +67,9 @@ pub struct Interaction {
 }
 
 impl Interaction {
-    /// `shading` is the [`MeshShading`] of the mesh hit.
+    /// `shading` is the [`MeshShading`] of the mesh hit. Forced inline with
+    /// [`Context::interaction`](super::Context::interaction) (see
+    /// [`crate::kernels`]).
     #[inline(always)]
     pub fn new(shading: &MeshShading, ray: &Ray, hit: &Hit) -> Self {
         let t = &shading.tris[hit.prim as usize];
@@ -132,18 +132,6 @@ impl Interaction {
     pub fn spawn(&self, dir: Vec3, eps: f32) -> Ray {
         Ray::new(offset_origin(self.p, self.ng, dir, eps), dir)
     }
-}
-
-/// The unit geometric normal of each triangle of `mesh` (front face by
-/// counter-clockwise winding), zero for degenerate triangles.
-pub fn face_normals(mesh: &Mesh) -> Vec<Vec3> {
-    mesh.indices
-        .iter()
-        .map(|&idx| {
-            let [a, b, c] = mesh.vertices(idx);
-            (b - a).cross(c - a).normalize_or_zero()
-        })
-        .collect()
 }
 
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3, eps: f32) -> Vec3 {

@@ -4,12 +4,15 @@
 //! and multiple importance sampling. [`plan`] decides once per scene which
 //! effects exist, so a scene pays only for what it uses. [`interaction`]
 //! turns an accel hit into the local surface geometry shading needs.
+//! [`probe`] runs the BSSRDF's probe query: the BSSRDF samples the segment
+//! and weighs the hit, the integrator queries the accel.
 //! [`randomwalk`] is the brute-force volumetric reference for subsurface
 //! materials, selected with [`IntegratorKind`].
 
 pub mod interaction;
 pub mod path;
 pub mod plan;
+pub mod probe;
 pub mod randomwalk;
 
 use crate::accel::Accel;
@@ -27,8 +30,6 @@ pub struct Context<'a> {
     pub plan: Plan,
     /// Minimum offset for spawned rays, from the scene's size.
     pub ray_epsilon: f32,
-    /// Per mesh, [`interaction::face_normals`].
-    pub face_normals: Vec<Vec<glam::Vec3>>,
     /// Per mesh, what [`Interaction::new`] reads.
     pub shading: Vec<interaction::MeshShading>,
 }
@@ -42,12 +43,10 @@ impl<'a> Context<'a> {
         } else {
             1.0
         };
-        let face_normals: Vec<_> = scene.meshes.iter().map(interaction::face_normals).collect();
         let shading = scene
             .meshes
             .iter()
-            .zip(&face_normals)
-            .map(|(mesh, ng)| interaction::MeshShading::new(mesh, ng))
+            .map(interaction::MeshShading::new)
             .collect();
         Context {
             scene,
@@ -55,14 +54,14 @@ impl<'a> Context<'a> {
             lights: LightSet::new(scene),
             plan: Plan::new(scene),
             ray_epsilon: extent * 1e-6,
-            face_normals,
             shading,
         }
     }
 
-    /// The surface geometry at `hit` on the ray `ray`. Forced inline: the
-    /// bounce loop is large enough that LLVM kept this out of line, and the
-    /// call returned the 48-byte Interaction through memory.
+    /// The surface geometry at `hit` on the ray `ray`. Forced inline (a
+    /// measured gain, see [`crate::kernels`]): the bounce loop is large
+    /// enough that LLVM kept this out of line, and the call returned the
+    /// 48-byte Interaction through memory.
     #[inline(always)]
     pub fn interaction(&self, ray: &crate::geometry::Ray, hit: &crate::accel::Hit) -> Interaction {
         Interaction::new(&self.shading[hit.geom as usize], ray, hit)

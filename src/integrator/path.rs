@@ -16,13 +16,14 @@
 //! small (pbrt-v4 §13.1.1).
 
 use super::interaction::offset_along;
+use super::probe::{sample_entry, ProbeTarget};
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
 use crate::bssrdf::ProbeRandoms;
+use crate::fresnel;
 use crate::geometry::{Frame, Ray, Vec3};
-use crate::materials::{dielectric, diffuse, fresnel, Material, Subsurface};
+use crate::materials::{dielectric, diffuse, Material, Subsurface};
 use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Draw, SampleRng};
-use glam::Vec3A;
 
 /// Bounces after which Russian roulette may end a path.
 const RR_START: u32 = 3;
@@ -129,12 +130,10 @@ pub(crate) fn trace<'s>(
     ) -> Scatter<'s>,
 ) -> Vec3 {
     let scene = ctx.scene;
-    // Radiance and throughput live across the ray-query calls, which clobber
-    // every xmm register: as 16-byte Vec3A each spill and reload is one move
-    // instead of a pair, and the lane-wise products round exactly as Vec3's.
-    let mut l = Vec3A::ZERO;
+    // The estimate of L, summed over the path's vertices.
+    let mut l = Vec3::ZERO;
     // Path throughput: the product of f |cos| / pdf (and BSSRDF weights).
-    let mut beta = Vec3A::ONE;
+    let mut beta = Vec3::ONE;
     let mut ray = camera_ray;
     // The last non-specular vertex and the solid-angle pdf with which its
     // lobe sampled the current ray; None after the camera or a specular
@@ -142,14 +141,11 @@ pub(crate) fn trace<'s>(
     let mut prev: Option<(Vec3, f32)> = None;
 
     let max_depth = scene.settings.max_depth;
-    // A half-open u64 range rather than 0..=max_depth: RangeInclusive keeps
-    // an exhausted flag whose test costs a dozen instructions per bounce.
-    for depth in 0..u64::from(max_depth) + 1 {
-        let depth = depth as u32;
+    for depth in 0..=max_depth {
         counters.rays += 1;
         let Some(hit) = ctx.accel.intersect(&ray, 0.0, f32::INFINITY) else {
             if ctx.plan.environment {
-                l += beta * Vec3A::from(scene.environment.unwrap_or(Vec3::ZERO));
+                l += beta * scene.environment.unwrap_or(Vec3::ZERO);
             }
             break;
         };
@@ -159,7 +155,7 @@ pub(crate) fn trace<'s>(
 
         // Le, MIS-weighted against next-event estimation.
         if let (Some(le), true) = (object.emission, si.front) {
-            l += beta * Vec3A::from(le) * emission_weight(ctx, &si, wo, prev);
+            l += beta * le * emission_weight(ctx, &si, wo, prev);
         }
         if depth == max_depth {
             break;
@@ -178,17 +174,9 @@ pub(crate) fn trace<'s>(
                 })
             }
             Material::Dielectric { eta } => {
-                let mut b = Vec3::from(beta);
-                let next = dielectric_bounce(ctx, *eta, &si, wo, &mut b, rng);
-                beta = b.into();
-                Scatter::Continue(next)
+                Scatter::Continue(dielectric_bounce(ctx, *eta, &si, wo, &mut beta, rng))
             }
-            Material::Subsurface(ss) => {
-                let mut b = Vec3::from(beta);
-                let scatter = subsurface(ss, &si, wo, &mut b, rng, counters);
-                beta = b.into();
-                scatter
-            }
+            Material::Subsurface(ss) => subsurface(ss, &si, wo, &mut beta, rng, counters),
         };
         // Borrowed, not moved out: the vertex stays where it was built.
         let vertex = match &scatter {
@@ -206,7 +194,7 @@ pub(crate) fn trace<'s>(
 
         // Next-event estimation, then continue by sampling the lobe.
         if ctx.plan.area_lights {
-            l += beta * Vec3A::from(direct_lighting(ctx, vertex, rng, counters));
+            l += beta * direct_lighting(ctx, vertex, rng, counters);
         }
         let Some((wi_local, weight, pdf)) =
             vertex.lobe.sample(vertex.wo_local, rng.uniform2_packed())
@@ -219,19 +207,19 @@ pub(crate) fn trace<'s>(
         if wi.dot(vertex.ng) <= 0.0 {
             break;
         }
-        beta *= Vec3A::from(weight);
+        beta *= weight;
         prev = Some((vertex.p, pdf));
         ray = Ray::new(offset_along(vertex.p, vertex.ng, ctx.ray_epsilon), wi);
         if !roulette(depth, &mut beta, rng) {
             break;
         }
     }
-    l.into()
+    l
 }
 
-/// A specular bounce off or through a dielectric. Out of line for the same
-/// reason as [`emission_weight`]: rarely taken, and inlined it costs the
-/// bounce loop registers on every bounce.
+/// A specular bounce off or through a dielectric.
+// Out of line, as are the probe step and the emission weight: a measured
+// gain, see `crate::kernels`.
 #[inline(never)]
 fn dielectric_bounce(
     ctx: &Context,
@@ -249,9 +237,7 @@ fn dielectric_bounce(
 
 /// A subsurface hit at xo under the diffusion model: the Fresnel split at
 /// xo, then one probe ray for the entry point xi, where the path continues
-/// with the entry lobe. Out of line: it makes a ray query of its own, so
-/// the call is cheap next to it, and inlined into the bounce loop its
-/// locals made the loop spill more around the loop's other queries.
+/// with the entry lobe.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn subsurface_probe<'s>(
@@ -291,13 +277,17 @@ fn subsurface_probe<'s>(
     let frame_o = si.shading_frame_facing(wo);
     let u = ProbeRandoms::from_rng(rng);
     counters.rays += 1;
-    let Some(ps) = ss.probe.sample(
+    let target = ProbeTarget {
+        accel: ctx.accel,
+        geom: si.geom,
+        mesh: &ctx.scene.meshes[si.geom as usize],
+    };
+    let Some(ps) = sample_entry(
+        &ss.probe,
         si.p,
         &frame_o,
         &u,
-        ctx.accel,
-        si.geom,
-        &ctx.face_normals[si.geom as usize],
+        &target,
         &mut scratch.probe_hits,
     ) else {
         return Scatter::Absorbed;
@@ -315,7 +305,7 @@ fn subsurface_probe<'s>(
 
 /// Russian roulette after `RR_START` bounces: survive with probability
 /// min(1, max β) and reweight; false ends the path.
-fn roulette(depth: u32, beta: &mut Vec3A, rng: &mut SampleRng) -> bool {
+fn roulette(depth: u32, beta: &mut Vec3, rng: &mut SampleRng) -> bool {
     if depth < RR_START {
         return true;
     }
@@ -327,9 +317,7 @@ fn roulette(depth: u32, beta: &mut Vec3A, rng: &mut SampleRng) -> bool {
     true
 }
 
-/// The MIS weight of emission found by lobe sampling from `prev`. Out of
-/// line: only paths that hit a light need it, and inlined into the bounce
-/// loop it adds to the values the loop spills around every ray query.
+/// The MIS weight of emission found by lobe sampling from `prev`.
 #[inline(never)]
 fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3, f32)>) -> f32 {
     match prev {

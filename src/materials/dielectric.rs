@@ -2,7 +2,7 @@
 //! refraction with probability 1 − Fr (pbrt-v4 §9.3). Directions are local
 //! (z = geometric normal pointing outside); η = inside / outside.
 
-use super::fresnel;
+use crate::fresnel;
 use crate::geometry::Vec3;
 
 /// A sampled specular direction and its path-throughput weight.

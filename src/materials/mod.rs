@@ -1,9 +1,10 @@
-//! Surface materials. The enum grows as lucent does (a subsurface variant
-//! joins it with the BSSRDF); each variant's scattering lives in its own file.
+//! Surface materials: Lambertian, smooth dielectric and subsurface (a
+//! dielectric boundary over the Burley BSSRDF); each variant's scattering
+//! lives in its own file. Fresnel reflectance is [`crate::fresnel`], shared
+//! with the BSSRDF.
 
 pub mod dielectric;
 pub mod diffuse;
-pub mod fresnel;
 pub mod subsurface;
 
 use std::sync::Arc;

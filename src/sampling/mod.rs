@@ -60,31 +60,13 @@ pub fn sin_cos_quarter(x: f32) -> (f32, f32) {
 pub fn sin_cos_turns(u: f32) -> (f32, f32) {
     let q = 4.0 * u;
     // u ≥ 0, so truncating q + ½ rounds to the nearest quarter turn.
-    let k = trunc_i32(q + 0.5);
+    let k = (q + 0.5) as i32;
     let (s, c) = sin_cos_quarter((q - k as f32) * (PI / 2.0));
     match k & 3 {
         0 => (s, c),
         1 => (c, -s),
         2 => (-s, -c),
         _ => (-c, s),
-    }
-}
-
-/// `x as i32` for x in i32's range: one cvttss2si on x86-64, without the
-/// compares and selects of Rust's saturating conversion (out of range and
-/// NaN give i32::MIN there instead of saturating; [`sin_cos_turns`] only
-/// passes values in [½, 4½)).
-#[inline(always)]
-fn trunc_i32(x: f32) -> i32 {
-    #[cfg(all(target_arch = "x86_64", target_feature = "sse"))]
-    {
-        use std::arch::x86_64::*;
-        // SAFETY: SSE is enabled (cfg above); a pure register operation.
-        unsafe { _mm_cvttss_si32(_mm_set_ss(x)) }
-    }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse")))]
-    {
-        x as i32
     }
 }
 

@@ -1,4 +1,6 @@
-//! Dielectric Fresnel reflectance (pbrt-v4 §9.3.6).
+//! Dielectric Fresnel reflectance (pbrt-v4 §9.3.6): the optics both the
+//! surface materials and the BSSRDF's directional terms build on, so it sits
+//! below [`crate::materials`] and [`crate::bssrdf`] and imports neither.
 
 /// Unpolarized Fresnel reflectance for light arriving with cosine `cos_i`
 /// (measured on the side it comes from, positive when it arrives from the
