@@ -26,7 +26,7 @@
 //!
 //! Every constructor also records the volumetric [`Medium`] (σs, σa, g in
 //! scene units) that the brute-force random walk
-//! ([`crate::integrator::randomwalk`]) simulates. The preset and measured
+//! (`integrator::randomwalk`, which builds on this module) simulates. The preset and measured
 //! forms carry it directly (unfloored: the walk handles σa = 0 exactly).
 //! The artist form has none, so one is derived by inverting the classical
 //! dipole's total diffuse reflectance (Jensen et al. 2001, eq. 5; the same
