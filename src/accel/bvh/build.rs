@@ -82,7 +82,7 @@ pub(super) const WIDTH: usize = 8;
 const _: () = assert!(std::mem::size_of::<NodeW>() % 64 == 0);
 
 impl NodeW {
-    const EMPTY: NodeW = NodeW {
+    pub(super) const EMPTY: NodeW = NodeW {
         b: [
             [f32::INFINITY; WIDTH],
             [f32::NEG_INFINITY; WIDTH],
