@@ -401,25 +401,11 @@ mod tests {
     /// A box test that accepts every box, or children visited farthest
     /// first, leave every answer right and only cost time; the number of
     /// nodes a nearest-hit query visits on fixed scenes makes them visible.
-    /// The bounds are generous (about twice what the traversal visits).
+    /// The bounds are about twice what the traversal visits (measured:
+    /// 2.00 / 2.00 on the layers, 4.69 / 2.62 on the sphere).
     #[test]
     fn nearest_hit_queries_visit_few_nodes() {
         let mut rng = crate::sampling::Rng::from_key(5);
-        // A tessellated sphere, rays from outside aimed near it.
-        let bvh = Bvh::build(&[shapes::sphere(4)]);
-        let rays: Vec<Ray> = (0..2000)
-            .map(|_| {
-                let o = Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, 1.0).normalize() * 4.0;
-                let t = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE;
-                Ray::new(o, t - o)
-            })
-            .collect();
-        let (nodes, leaves) = visits(&bvh, &rays);
-        eprintln!("sphere: {nodes:.2} nodes, {leaves:.2} leaves per ray");
-        assert!(
-            nodes < 9.0 && leaves < 5.0,
-            "sphere: {nodes} nodes, {leaves} leaves per ray"
-        );
         // 64 stacked layers, rays down through all of them: nearest first,
         // the layers below the first hit are skipped.
         let layer = shapes::quad();
@@ -440,23 +426,43 @@ mod tests {
             })
             .collect();
         let (nodes, leaves) = visits(&bvh, &rays);
-        eprintln!("layers: {nodes:.2} nodes, {leaves:.2} leaves per ray");
         assert!(
             nodes < 4.0 && leaves < 4.0,
             "layers: {nodes} nodes, {leaves} leaves per ray"
         );
-        // A one-leaf mesh: rays that miss its box visit no leaf.
+        // A tessellated sphere, rays from outside aimed near it.
+        let bvh = Bvh::build(&[shapes::sphere(4)]);
+        let rays: Vec<Ray> = (0..2000)
+            .map(|_| {
+                let o = Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, 1.0).normalize() * 4.0;
+                let t = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE;
+                Ray::new(o, t - o)
+            })
+            .collect();
+        let (nodes, leaves) = visits(&bvh, &rays);
+        assert!(
+            nodes < 9.0 && leaves < 5.0,
+            "sphere: {nodes} nodes, {leaves} leaves per ray"
+        );
+        // A one-leaf mesh (the quad [-1, 1]² at z = 0): rays that miss its
+        // box visit no leaf — beside it, past its corner (each slab is
+        // crossed, but not at the same time), and pointing away from it.
         let bvh = Bvh::build(&[shapes::quad()]);
-        let miss = Ray::new(Vec3::new(1.5, 0.0, 1.0), -Vec3::Z);
-        assert!(bvh.intersect(&miss, 0.0, f32::INFINITY).is_none());
         let hit = Ray::new(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z);
         assert!(bvh.intersect(&hit, 0.0, f32::INFINITY).is_some());
-        traverse::stats::take();
-        bvh.intersect(&miss, 0.0, f32::INFINITY);
-        assert_eq!(
-            traverse::stats::take().1,
-            0,
-            "a missed one-leaf mesh was visited"
-        );
+        for miss in [
+            Ray::new(Vec3::new(1.5, 0.0, 1.0), -Vec3::Z),
+            Ray::new(Vec3::new(3.0, 0.0, 1.0), Vec3::new(-1.0, 0.0, -1.0)),
+            Ray::new(Vec3::new(0.5, 0.0, 1.0), Vec3::Z),
+        ] {
+            assert!(bvh.intersect(&miss, 0.0, f32::INFINITY).is_none());
+            traverse::stats::take();
+            bvh.intersect(&miss, 0.0, f32::INFINITY);
+            assert_eq!(
+                traverse::stats::take().1,
+                0,
+                "{miss:?}: a missed one-leaf mesh was visited"
+            );
+        }
     }
 }
