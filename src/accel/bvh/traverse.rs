@@ -75,7 +75,7 @@ impl RayBox {
         self.hit_w_sse(n, tmin, tmax)
     }
 
-    /// See the SSE variant above.
+    /// The same, on the portable box test (see above).
     #[cfg(any(not(target_arch = "x86_64"), feature = "bvh-portable"))]
     #[inline(always)]
     pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
