@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The whole test suite, from a fresh Debian 12 machine: installs what is
 # missing, checks formatting, lints and rust-version, runs every test with
-# the default features (Embree and our BVH, compared), then lints and tests
-# the BVH-only build (`--no-default-features`) too.
+# the default features (Embree and our BVH, compared), then the BVH tests on
+# its portable (non-SSE) path, and lints and tests the BVH-only build
+# (`--no-default-features`) too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,6 +18,11 @@ cargo clippy --no-default-features --all-targets -- -D warnings
 # Broken intra-doc links are bugs in the docs the module headers promise.
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 cargo test --all-targets
+
+# The BVH's portable box and triangle tests, which other architectures
+# run, forced on x86_64 (only lucent is rebuilt).
+echo "--- BVH portable path (--features bvh-portable) ---"
+cargo test --lib --test bvh_brute_force --features bvh-portable
 
 # Same target dir: only lucent itself is rebuilt, the dependencies are
 # reused. The library's own tests, and the command-line tests whose

@@ -431,3 +431,114 @@ fn probe_segment_through_200_quads_overflows_like_brute_force() {
     assert_eq!(out.total(), 51);
     assert_eq!(out.hits().len(), 51);
 }
+
+/// A mesh of `n` random triangles with vertices on the grid of quarters in
+/// [−1, 1]³ (all in the plane z = 1/4 when `flat`): every vertex, edge
+/// midpoint and box corner is exact, and so is the direction of a ray
+/// from a grid point to it.
+fn tiny_mesh(n: u32, flat: bool, rng: &mut Rng) -> Mesh {
+    let mut q = || ((rng.uniform() * 9.0).floor() - 4.0) * 0.25;
+    let mut p = Vec::new();
+    for _ in 0..3 * n {
+        let v = Vec3::new(q(), q(), q());
+        p.push(if flat { Vec3::new(v.x, v.y, 0.25) } else { v });
+    }
+    let idx = (0..n).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    Mesh::new(p, idx, None)
+}
+
+/// Rays aimed exactly at the vertices, edge midpoints and bounding-box
+/// corners, edge midpoints and face centres of meshes of one to a few
+/// triangles (one-leaf trees, where the traversal tests the whole box
+/// before the leaf), from outside and from points on the box's faces, with
+/// intervals that end exactly at the target. Such rays graze the boxes:
+/// the slab test's entry and exit distances coincide at a corner or edge,
+/// so any box test stricter than the triangle test loses a hit.
+#[test]
+fn rays_at_vertices_edges_and_box_corners_of_tiny_meshes() {
+    let mut rng = Rng::from_key(21);
+    let (mut rays, mut hits) = (0usize, 0usize);
+    for n in [1u32, 1, 2, 3, 5, 8, 9, 17] {
+        for flat in [false, true] {
+            let mesh = tiny_mesh(n, flat, &mut rng);
+            let meshes = [mesh];
+            let bvh = Bvh::build(&meshes);
+            let brute = Brute::new(&meshes);
+            let mesh = &meshes[0];
+            let Some((lo, hi)) = (0..mesh.triangle_count() as u32)
+                .map(|i| mesh.triangle(i))
+                .filter(|&p| can_hit(p))
+                .map(|p| (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2])))
+                .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+            else {
+                continue;
+            };
+            let mut targets = Vec::new();
+            for i in 0..mesh.triangle_count() as u32 {
+                let p = mesh.triangle(i);
+                for k in 0..3 {
+                    targets.push(p[k]);
+                    targets.push((p[k] + p[(k + 1) % 3]) * 0.5);
+                }
+            }
+            // box corners (0, 2), edge midpoints and face centres (1) and centre
+            for c in 0..27u32 {
+                let pick = |a: u32, axis: usize| match a {
+                    0 => lo[axis],
+                    1 => 0.5 * (lo[axis] + hi[axis]),
+                    _ => hi[axis],
+                };
+                targets.push(Vec3::new(
+                    pick(c % 3, 0),
+                    pick(c / 3 % 3, 1),
+                    pick(c / 9, 2),
+                ));
+            }
+            let origins = [
+                Vec3::new(3.0, 2.5, 1.75),
+                Vec3::new(-2.25, 3.0, -2.5),
+                Vec3::new(0.5, -3.0, 2.0),
+                Vec3::new(-3.0, -1.5, -0.75),
+                Vec3::new(0.0, 0.0, 3.0),
+            ];
+            for &t in &targets {
+                // from outside, and from the box's faces along them
+                let mut from = origins.to_vec();
+                for axis in 0..3 {
+                    for plane in [lo[axis], hi[axis]] {
+                        let mut o = t + Vec3::splat(2.0);
+                        o[axis] = plane;
+                        from.push(o);
+                        let mut o = t - Vec3::new(1.5, 2.0, 2.5);
+                        o[axis] = plane;
+                        from.push(o);
+                    }
+                }
+                for o in from {
+                    let d = t - o;
+                    if d == Vec3::ZERO {
+                        continue;
+                    }
+                    let ray = Ray::new(o, d);
+                    // An origin on a triangle is a hit at t = ±0, whose
+                    // sign depends on the triangle: not what this is about.
+                    if !brute.all(&ray, 0.0, 0.0).is_empty() {
+                        continue;
+                    }
+                    for (tmin, tmax) in [
+                        (0.0, f32::INFINITY),
+                        (0.0, 1.0),
+                        (1.0, f32::INFINITY),
+                        (0.5, 1.0),
+                    ] {
+                        compare(&bvh, &brute, &ray, tmin, tmax, rays as u32);
+                    }
+                    hits += brute.nearest(&ray, 0.0, 1.0).is_some() as usize;
+                    rays += 1;
+                }
+            }
+        }
+    }
+    // The targets on triangles are hit at t = 1 exactly (inclusive edges).
+    assert!(rays > 5000 && hits > rays / 5, "{hits} of {rays} rays hit");
+}

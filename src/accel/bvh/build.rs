@@ -82,7 +82,7 @@ pub(super) const WIDTH: usize = 8;
 const _: () = assert!(std::mem::size_of::<NodeW>().is_multiple_of(64));
 
 impl NodeW {
-    const EMPTY: NodeW = NodeW {
+    pub(super) const EMPTY: NodeW = NodeW {
         b: [
             [f32::INFINITY; WIDTH],
             [f32::NEG_INFINITY; WIDTH],

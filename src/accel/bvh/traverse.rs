@@ -67,10 +67,28 @@ impl RayBox {
     }
 
     /// Entry distances of the node's boxes, and a bit mask of those the
-    /// ray meets within [tmin, tmax].
-    #[cfg(not(target_arch = "x86_64"))]
+    /// ray meets within [tmin, tmax]: the SSE version on x86_64, the
+    /// portable one elsewhere or with the `bvh-portable` feature.
+    #[cfg(all(target_arch = "x86_64", not(feature = "bvh-portable")))]
     #[inline(always)]
     pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
+        self.hit_w_sse(n, tmin, tmax)
+    }
+
+    /// The same, on the portable box test (see above).
+    #[cfg(any(not(target_arch = "x86_64"), feature = "bvh-portable"))]
+    #[inline(always)]
+    pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
+        self.hit_w_portable(n, tmin, tmax)
+    }
+
+    /// [`hit_w`](Self::hit_w) in plain Rust, one box after another: what
+    /// other architectures run. Compiled on x86_64 too for the unit tests
+    /// (which compare it with the SSE version bit for bit) and with the
+    /// `bvh-portable` feature (which makes the whole BVH use it).
+    #[cfg(any(test, not(target_arch = "x86_64"), feature = "bvh-portable"))]
+    #[inline(always)]
+    pub fn hit_w_portable(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
         let mut lo = [tmin; WIDTH];
         let mut hi = [tmax; WIDTH];
         for a in 0..3 {
@@ -96,9 +114,9 @@ impl RayBox {
     /// scalar). `maxps(a, b)` is `a > b ? a : b` and `minps(a, b)` is
     /// `a < b ? a : b`, exactly the selects of the portable code, so both
     /// give bit-identical results.
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", any(test, not(feature = "bvh-portable"))))]
     #[inline(always)]
-    pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
+    pub fn hit_w_sse(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
         use std::arch::x86_64::*;
         const _: () = assert!(WIDTH.is_multiple_of(4));
         let mut out = [0f32; WIDTH];
@@ -163,6 +181,37 @@ fn prefetch<T>(p: &T, bytes: usize) {
     let _ = (p, bytes);
 }
 
+/// Per-thread traversal counts for the unit tests: wide nodes whose boxes
+/// were tested, leaves visited, and the deepest the stack got. Mutations
+/// that only slow the traversal down (a box test that accepts every box,
+/// children visited farthest first) leave every answer right; these counts
+/// make them visible. Compiled only into the unit tests: the renderer
+/// pays nothing.
+#[cfg(test)]
+pub(super) mod stats {
+    use std::cell::Cell;
+
+    thread_local! {
+        static NODES: Cell<u64> = const { Cell::new(0) };
+        static LEAVES: Cell<u64> = const { Cell::new(0) };
+        static MAX_STACK: Cell<usize> = const { Cell::new(0) };
+    }
+
+    pub(crate) fn node() {
+        NODES.set(NODES.get() + 1);
+    }
+    pub(crate) fn leaf() {
+        LEAVES.set(LEAVES.get() + 1);
+    }
+    pub(crate) fn stack(sp: usize) {
+        MAX_STACK.set(MAX_STACK.get().max(sp));
+    }
+    /// (nodes, leaves, deepest stack) since the last call; resets them.
+    pub(crate) fn take() -> (u64, u64, usize) {
+        (NODES.replace(0), LEAVES.replace(0), MAX_STACK.replace(0))
+    }
+}
+
 /// What a leaf visit asks of the traversal.
 pub(super) enum Visit {
     Continue,
@@ -196,6 +245,8 @@ pub(super) fn traverse<const ORDERED: bool, L>(
         if !ray.hit1(&tree.bounds, tmin, *tmax) {
             return false;
         }
+        #[cfg(test)]
+        stats::leaf();
         let (first, count) = leaf_range(tree.root);
         return matches!(leaf(first, count, tmax), Visit::Stop);
     }
@@ -212,6 +263,8 @@ pub(super) fn traverse<const ORDERED: bool, L>(
         // Descend from r to a leaf or a dead end.
         loop {
             if is_leaf(r) {
+                #[cfg(test)]
+                stats::leaf();
                 let (first, count) = leaf_range(r);
                 if let Visit::Stop = leaf(first, count, tmax) {
                     return true;
@@ -219,6 +272,8 @@ pub(super) fn traverse<const ORDERED: bool, L>(
                 break;
             }
             let n = &tree.nodes[r as usize];
+            #[cfg(test)]
+            stats::node();
             let (t, mut hit) = ray.hit_w(n, tmin, *tmax);
             // Hit children, sorted nearest first (insertion sort) if ORDERED.
             let mut kids = [(0 as NodeRef, 0f32); WIDTH];
@@ -253,6 +308,8 @@ pub(super) fn traverse<const ORDERED: bool, L>(
                 stack[sp] = MaybeUninit::new((c, tc));
                 sp += 1;
             }
+            #[cfg(test)]
+            stats::stack(sp);
             r = kids[0].0;
         }
         // Pop the next box that still starts within the interval.
@@ -268,5 +325,82 @@ pub(super) fn traverse<const ORDERED: bool, L>(
                 break;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Vec3;
+    use crate::sampling::Rng;
+
+    /// The portable box test (what other architectures run) and the SSE
+    /// one agree bit for bit — entry distances and masks — on random
+    /// boxes, flat boxes, empty lanes, rays with zero direction components
+    /// and origins lying exactly on box planes.
+    #[test]
+    fn portable_box_test_is_the_sse_test() {
+        let mut rng = Rng::from_key(11);
+        let mut u = |s: f32| (rng.uniform() * 2.0 - 1.0) * s;
+        let mut accepted = 0;
+        for case in 0..20_000 {
+            let mut n = NodeW::EMPTY;
+            for k in 0..WIDTH {
+                if k == case % WIDTH {
+                    continue; // one empty lane
+                }
+                for a in 0..3 {
+                    let lo = u(1.0);
+                    let hi = if case % 5 == 0 { lo } else { lo + u(1.0).abs() };
+                    n.b[2 * a][k] = lo;
+                    n.b[2 * a + 1][k] = hi;
+                }
+            }
+            // aimed at a point of another lane's box (or its corner)
+            let k = (case + 1 + case / WIDTH % (WIDTH - 1)) % WIDTH;
+            let f = if case % 4 == 0 { 0.0 } else { 0.5 + u(0.5) };
+            let target = Vec3::new(
+                n.b[0][k] + f * (n.b[1][k] - n.b[0][k]),
+                n.b[2][k] + f * (n.b[3][k] - n.b[2][k]),
+                n.b[4][k] + f * (n.b[5][k] - n.b[4][k]),
+            );
+            let mut o = Vec3::new(u(2.0), u(2.0), u(2.0));
+            let mut d = target - o;
+            match case % 7 {
+                0 => d.x = 0.0,
+                1 => {
+                    d.y = -0.0;
+                    o.y = n.b[2][1]; // on a box's plane, parallel to it
+                }
+                2 => o.z = n.b[5][2],
+                _ => {}
+            }
+            let ray = RayBox::new(&Ray::new(o, d));
+            let (tmin, tmax) = if case % 3 == 0 {
+                (0.0, f32::INFINITY)
+            } else {
+                (u(1.0).abs(), 1.0 + u(3.0).abs())
+            };
+            let (ts, ms) = ray.hit_w_sse(&n, tmin, tmax);
+            let (tp, mp) = ray.hit_w_portable(&n, tmin, tmax);
+            assert_eq!(ms, mp, "mask, case {case}");
+            assert_eq!(ts.map(f32::to_bits), tp.map(f32::to_bits), "t, case {case}");
+            assert_eq!(mp >> (case % WIDTH) & 1, 0, "empty lane hit");
+            // each lane agrees with the scalar test of that box
+            for k in 0..WIDTH {
+                let b = [
+                    [n.b[0][k], n.b[2][k], n.b[4][k]],
+                    [n.b[1][k], n.b[3][k], n.b[5][k]],
+                ];
+                assert_eq!(
+                    ray.hit1(&b, tmin, tmax),
+                    mp >> k & 1 == 1,
+                    "case {case} lane {k}"
+                );
+            }
+            accepted += mp.count_ones();
+        }
+        // a comparison of all-miss masks would prove little
+        assert!(accepted > 12_000, "{accepted} boxes hit");
     }
 }

@@ -203,7 +203,7 @@ impl Hits4 {
 
 impl RayTri {
     /// [`intersect`](Self::intersect) on the four triangles of a packet.
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", not(feature = "bvh-portable")))]
     #[inline(always)]
     pub fn intersect4(&self, tri: &Tri4, tmin: f32, tmax: f32) -> Hits4 {
         use std::arch::x86_64::*;
@@ -292,7 +292,7 @@ impl RayTri {
 
     /// [`intersect`](Self::intersect) on the four triangles of a packet,
     /// one at a time.
-    #[cfg(not(target_arch = "x86_64"))]
+    #[cfg(any(not(target_arch = "x86_64"), feature = "bvh-portable"))]
     #[inline(always)]
     pub fn intersect4(&self, tri: &Tri4, tmin: f32, tmax: f32) -> Hits4 {
         let mut out = Hits4 {
