@@ -309,6 +309,9 @@ const _: () = {
 /// Sizes and offsets of the shared structs as Rust lays them out, named as
 /// the C expression that should give the same number (`sizeof(RTCRay)`,
 /// `offsetof(RTCRay, tfar)`, ...), for `tests/embree_layout.rs`.
+///
+/// Over 120 lines on purpose: it is a flat table, one line per size or
+/// offset checked, and reads best as one list beside the C side's.
 #[doc(hidden)]
 pub fn layout_table() -> Vec<(&'static str, usize)> {
     macro_rules! s {

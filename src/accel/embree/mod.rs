@@ -225,9 +225,35 @@ unsafe impl Send for EmbreeAccel {}
 // SAFETY: see `Send` above.
 unsafe impl Sync for EmbreeAccel {}
 
+/// Checks that Embree can share every mesh's buffers safely: Embree reads
+/// them without bounds checks, so an index out of range would be an
+/// out-of-bounds read (`Mesh::new` checks only in debug builds).
+fn check_shareable(meshes: &[Mesh]) -> Result<(), Error> {
+    for (i, m) in meshes.iter().enumerate() {
+        let nv = m.vertex_count();
+        if nv > u32::MAX as usize || m.triangle_count() > u32::MAX as usize {
+            return Err(Error::Backend(format!("Embree: mesh {i} is too large")));
+        }
+        if let Some(bad) = m.indices.iter().flatten().find(|&&v| v as usize >= nv) {
+            return Err(Error::Backend(format!(
+                "Embree: mesh {i} has vertex index {bad} but only {nv} vertices"
+            )));
+        }
+        // Embree's 16-byte vertex loads need the padding element
+        // (`Mesh::default()` has none, but also no vertices to index).
+        if m.triangle_count() > 0 && m.padded_positions().len() <= nv {
+            return Err(Error::Backend(format!(
+                "Embree: mesh {i} lacks its padding vertex"
+            )));
+        }
+    }
+    Ok(())
+}
+
 impl EmbreeAccel {
     /// Builds and commits an Embree scene over `meshes`, sharing their
-    /// buffers; called inside a rayon pool, the build uses that many threads. Fails (without leaking) if Embree reports any error or if a
+    /// buffers; called inside a rayon pool, the build uses that many
+    /// threads. Fails (without leaking) if Embree reports any error or if a
     /// mesh cannot be shared safely (index out of range, too many elements).
     pub fn build(meshes: &Arc<Vec<Mesh>>) -> Result<EmbreeAccel, Error> {
         if meshes.len() >= ffi::RTC_INVALID_GEOMETRY_ID as usize {
@@ -236,27 +262,7 @@ impl EmbreeAccel {
                 meshes.len()
             )));
         }
-        // Embree reads the buffers without bounds checks, so an index out of
-        // range would be an out-of-bounds read; `Mesh::new` checks only in
-        // debug builds.
-        for (i, m) in meshes.iter().enumerate() {
-            let nv = m.vertex_count();
-            if nv > u32::MAX as usize || m.triangle_count() > u32::MAX as usize {
-                return Err(Error::Backend(format!("Embree: mesh {i} is too large")));
-            }
-            if let Some(bad) = m.indices.iter().flatten().find(|&&v| v as usize >= nv) {
-                return Err(Error::Backend(format!(
-                    "Embree: mesh {i} has vertex index {bad} but only {nv} vertices"
-                )));
-            }
-            // Embree's 16-byte vertex loads need the padding element
-            // (`Mesh::default()` has none, but also no vertices to index).
-            if m.triangle_count() > 0 && m.padded_positions().len() <= nv {
-                return Err(Error::Backend(format!(
-                    "Embree: mesh {i} lacks its padding vertex"
-                )));
-            }
-        }
+        check_shareable(meshes)?;
 
         // Inside a rayon pool, build with as many threads as it has (so a
         // one-thread pool means a one-thread build, as for our BVH). Outside
