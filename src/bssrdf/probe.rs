@@ -426,6 +426,20 @@ impl ProbeSampler {
         pdf
     }
 
+    /// The surface-area density with which one probe (channel, axis, radius
+    /// and angle all sampled) reaches an entry point xi = xo + d with unit
+    /// normal `n_hit`, before the pick among the segment's hits: the
+    /// channel is uniform among the active ones, so Σ_c pdf_c / n_active.
+    /// 0 beyond Rmax, where no chord of the probe sphere reaches. Where
+    /// every probe segment has one hit it is the density of the sampled xi;
+    /// the integrator's tests compare the two.
+    pub(crate) fn pdf_area(&self, d: DVec3, frame: &Frame, n_hit: DVec3) -> f64 {
+        if self.n_active == 0 || d.length() > self.rmax {
+            return 0.0;
+        }
+        self.pdf_area_d(d, frame, n_hit).iter().sum::<f64>() / self.n_active as f64
+    }
+
     /// Rd(|d|)/p(xi) per channel (before the hit count) for an entry point
     /// at xi = xo + d with unit normal `n_hit`, `ch` the sampled channel:
     /// the f64 oracle.

@@ -5,7 +5,9 @@
 //! ([`Accel::hits_on_segment`]), keeps one ([`pick_hit`]) and the BSSRDF
 //! weighs it ([`ProbeSampler::weigh`]). The tests here check the whole
 //! estimator end to end on a brute-force accel: energy on planes for every
-//! option, hit counting, empty and degenerate geometry.
+//! option, hit counting, empty and degenerate geometry, and on curved
+//! geometry that entry points stay within Rmax of xo and are distributed
+//! with the density the weights divide by (a χ² test).
 
 use crate::accel::{Accel, Hit, ProbeHits};
 use crate::bssrdf::{pick_hit, ProbeRandoms, ProbeSampler};
@@ -80,6 +82,7 @@ mod tests {
     };
     use crate::geometry::{Mesh, Ray};
     use crate::sampling::Rng;
+    use glam::DVec3;
 
     /// A brute-force [`Accel`]: every query loops over every triangle with a
     /// Möller–Trumbore test in f64. Slow, obviously right, and independent of
@@ -908,5 +911,342 @@ mod tests {
             }
         }
         println!("largest |xi − xo| / Rmax: {worst:.6}");
+    }
+
+    /// The octant of the sphere of radius `rs` around `c` where the
+    /// outward normal has no negative T, B or N component in `frame`: the
+    /// directions of an `m`-step barycentric grid on the octant's spherical
+    /// triangle, times `rs`. It is a graph over each of the frame's
+    /// coordinate planes, so a line along T, B or N crosses it at most once:
+    /// every probe segment from this frame has at most one hit (the test
+    /// asserts it). (A flat cap on it, pushed radially, folds at the crease:
+    /// some segments then hit three times.) Returns the mesh and a function
+    /// giving the index of grid vertex (i, j), i + j ≤ m.
+    fn octant_patch(rs: f64, m: u32, frame: &Frame, c: DVec3) -> (Mesh, impl Fn(u32, u32) -> u32) {
+        let mut p = Vec::new();
+        let mut id = vec![vec![u32::MAX; (m + 1) as usize]; (m + 1) as usize];
+        let (t, b, n) = (frame.t.as_dvec3(), frame.b.as_dvec3(), frame.n.as_dvec3());
+        for i in 0..=m {
+            for j in 0..=m - i {
+                let k = m - i - j;
+                let w = DVec3::new(i as f64, j as f64, k as f64).normalize();
+                let l = w * rs;
+                id[i as usize][j as usize] = p.len() as u32;
+                p.push((c + t * l.x + b * l.y + n * l.z).as_vec3());
+            }
+        }
+        let mut idx = Vec::new();
+        for i in 0..m as usize {
+            for j in 0..(m as usize - i) {
+                idx.push([id[i][j], id[i + 1][j], id[i][j + 1]]);
+                if i + j + 1 < m as usize {
+                    idx.push([id[i + 1][j], id[i + 1][j + 1], id[i][j + 1]]);
+                }
+            }
+        }
+        (Mesh::new(p, idx, None), move |i: u32, j: u32| {
+            id[i as usize][j as usize]
+        })
+    }
+
+    /// Gauss–Legendre nodes and weights on [0, 1] (Newton on P_n).
+    fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+        use std::f64::consts::PI;
+        (0..n)
+            .map(|i| {
+                let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+                let mut dp = 0.0;
+                for _ in 0..100 {
+                    let (mut p0, mut p1) = (1.0, x);
+                    for k in 2..=n {
+                        let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                        p0 = p1;
+                        p1 = p2;
+                    }
+                    dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                    let dx = p1 / dp;
+                    x -= dx;
+                    if dx.abs() < 1e-15 {
+                        break;
+                    }
+                }
+                ((1.0 - x) / 2.0, 1.0 / ((1.0 - x * x) * dp * dp))
+            })
+            .collect()
+    }
+
+    /// ∫ f dA over triangle `tri`, f zero beyond `rmax` from `xo`: Gauss–
+    /// Legendre in the Duffy square collapsed at the vertex nearest xo (its
+    /// Jacobian ∝ distance cancels f's 1/r singularity at xo, a vertex of
+    /// the triangles around it); a triangle the sphere of radius `rmax`
+    /// cuts is split in four, `depth` times, so the jump there is resolved.
+    fn integrate_triangle(
+        f: &dyn Fn(DVec3) -> f64,
+        xo: DVec3,
+        rmax: f64,
+        tri: [DVec3; 3],
+        depth: u32,
+        gl: &[(f64, f64)],
+    ) -> f64 {
+        let dist = tri.map(|p| (p - xo).length());
+        let cen = (tri[0] + tri[1] + tri[2]) / 3.0;
+        let rad = tri.iter().map(|p| (*p - cen).length()).fold(0.0, f64::max);
+        if (cen - xo).length() - rad > rmax {
+            return 0.0;
+        }
+        if depth > 0 && dist.iter().any(|&r| r > rmax) {
+            let m = [0, 1, 2].map(|k| (tri[k] + tri[(k + 1) % 3]) / 2.0);
+            return [
+                [tri[0], m[0], m[2]],
+                [m[0], tri[1], m[1]],
+                [m[2], m[1], tri[2]],
+                [m[0], m[1], m[2]],
+            ]
+            .into_iter()
+            .map(|t| integrate_triangle(f, xo, rmax, t, depth - 1, gl))
+            .sum();
+        }
+        let k = (0..3).min_by(|&x, &y| dist[x].total_cmp(&dist[y])).unwrap();
+        let (a, b, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        let area2 = (b - a).cross(c - a).length();
+        let mut sum = 0.0;
+        for &(s, ws) in gl {
+            for &(t, wt) in gl {
+                sum += ws * wt * s * f(a + ((b - a) + (c - b) * t) * s);
+            }
+        }
+        sum * area2
+    }
+
+    /// Q(a, x) = Γ(a, x)/Γ(a), the regularized upper incomplete gamma
+    /// function (series for x < a + 1, Lentz's continued fraction beyond;
+    /// Numerical Recipes §6.2), with ln Γ from Lanczos (g = 7, n = 9).
+    fn gamma_q(a: f64, x: f64) -> f64 {
+        fn ln_gamma(x: f64) -> f64 {
+            const C: [f64; 9] = [
+                0.999_999_999_999_809_9,
+                676.520_368_121_885_1,
+                -1_259.139_216_722_402_8,
+                771.323_428_777_653_1,
+                -176.615_029_162_140_6,
+                12.507_343_278_686_905,
+                -0.138_571_095_265_720_12,
+                9.984_369_578_019_572e-6,
+                1.505_632_735_149_311_6e-7,
+            ];
+            let x = x - 1.0;
+            let s = C[0] + (1..9).map(|i| C[i] / (x + i as f64)).sum::<f64>();
+            let t = x + 7.5;
+            0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + s.ln()
+        }
+        if x <= 0.0 {
+            return 1.0;
+        }
+        let front = (-x + a * x.ln() - ln_gamma(a)).exp();
+        if x < a + 1.0 {
+            let (mut ap, mut del) = (a, 1.0 / a);
+            let mut sum = del;
+            for _ in 0..10_000 {
+                ap += 1.0;
+                del *= x / ap;
+                sum += del;
+                if del.abs() < sum.abs() * 1e-16 {
+                    break;
+                }
+            }
+            (1.0 - sum * front).max(0.0)
+        } else {
+            let tiny = 1e-300;
+            let mut b = x + 1.0 - a;
+            let mut c = 1.0 / tiny;
+            let mut d = 1.0 / b;
+            let mut h = d;
+            for i in 1..10_000 {
+                let an = -(i as f64) * (i as f64 - a);
+                b += 2.0;
+                d = an * d + b;
+                if d.abs() < tiny {
+                    d = tiny;
+                }
+                c = b + an / c;
+                if c.abs() < tiny {
+                    c = tiny;
+                }
+                d = 1.0 / d;
+                let del = d * c;
+                h *= del;
+                if (del - 1.0).abs() < 1e-16 {
+                    break;
+                }
+            }
+            front * h
+        }
+    }
+
+    /// Pearson's χ² of observed against expected counts, consecutive bins
+    /// merged until each expects ≥ 5 (a remainder joins the last): χ², the
+    /// degrees of freedom (merged bins − 1) and the p-value Q(dof/2, χ²/2).
+    fn pearson(obs: &[f64], exp: &[f64]) -> (f64, usize, f64) {
+        let (mut o, mut e) = (Vec::new(), Vec::new());
+        let (mut ao, mut ae) = (0.0, 0.0);
+        for (&x, &y) in obs.iter().zip(exp) {
+            ao += x;
+            ae += y;
+            if ae >= 5.0 {
+                o.push(ao);
+                e.push(ae);
+                (ao, ae) = (0.0, 0.0);
+            }
+        }
+        if ao > 0.0 || ae > 0.0 {
+            match (o.last_mut(), e.last_mut()) {
+                (Some(lo), Some(le)) => {
+                    *lo += ao;
+                    *le += ae;
+                }
+                _ => {
+                    o.push(ao);
+                    e.push(ae);
+                }
+            }
+        }
+        let chi2: f64 = o.iter().zip(&e).map(|(o, e)| (o - e) * (o - e) / e).sum();
+        let dof = o.len().saturating_sub(1).max(1);
+        (chi2, dof, gamma_q(dof as f64 / 2.0, chi2 / 2.0))
+    }
+
+    #[test]
+    fn incomplete_gamma_matches_known_values() {
+        // Q(1, x) = e^−x; Q(½, x) = erfc(√x); the χ² table: 18.307 is the
+        // 5% point for 10 degrees of freedom, 3.841 for 1, 124.342 for 100.
+        for x in [0.1, 1.0, 2.5, 7.0, 30.0] {
+            assert!((gamma_q(1.0, x) - (-x).exp()).abs() < 1e-13);
+        }
+        assert!((gamma_q(0.5, 1.0) - 0.157_299_207_050_285_1).abs() < 1e-12);
+        for (dof, x) in [(10.0, 18.307), (1.0, 3.841), (100.0, 124.342)] {
+            let p = gamma_q(dof / 2.0, x / 2.0);
+            assert!((p - 0.05).abs() < 1e-4, "dof {dof}: {p}");
+        }
+    }
+
+    #[test]
+    fn sampled_entry_points_follow_the_density_the_estimator_divides_by() {
+        // Pearson χ² of where probes land against p(xi), the surface-area
+        // density the weight Rd/p divides by (summed over axes with their
+        // probabilities and averaged over channels), on an octant of a
+        // sphere (`octant_patch`) of radius 1.6 Rmax or Rmax, so the sphere
+        // of radius Rmax around xo cuts it and the surface drops up to
+        // 0.3–0.5 Rmax below its tangent plane within it. Every probe segment there has
+        // at most one hit (asserted), so the hit is picked with probability 1
+        // and the density of xi is p(xi) itself. Bins: the patch's
+        // triangles grouped by the distance of their centroid from xo (in
+        // Rmax/8 bands) and its direction around N (4 sectors), plus "no
+        // entry point"; expected counts integrate p over each triangle by
+        // quadrature (`integrate_triangle`), so the test also checks that p
+        // integrates to the probability of a hit. Each sample's weight must
+        // be Rd(|xi − xo|)/p(xi) (× its hit count, 1). For both axis
+        // choices, every radius sampler, two exit points and frames.
+        let params = SubsurfaceParams {
+            albedo: [0.8, 0.5, 0.3],
+            d: [1.0, 0.5, 0.25],
+            eta: 1.3,
+            medium: None,
+        };
+        let gl = gauss_legendre(8);
+        let n_samples = 25_000;
+        let (bands, sectors) = (8usize, 4usize);
+        let mut rng = Rng::from_key(2024);
+        let mut hits = ProbeHits::new();
+        let mut p_min = 1.0f64;
+        for (case, (rs, (i0, j0))) in [(1.6, (5, 4)), (1.0, (3, 9))].into_iter().enumerate() {
+            for axes in [ProbeAxes::Normal, ProbeAxes::Mis3] {
+                for radius in [
+                    RadiusSampler::Uniform,
+                    RadiusSampler::table(64),
+                    RadiusSampler::Analytic,
+                    RadiusSampler::Mixture,
+                ] {
+                    let opts = ProbeOptions {
+                        axes,
+                        channel: ChannelStrategy::Mis,
+                        radius,
+                        rmax_quantile: 0.99,
+                        renormalize: false,
+                    };
+                    let s = ProbeSampler::new(&params, &opts).unwrap();
+                    let rm = s.rmax();
+                    let frame = rotated_frame(
+                        crate::sampling::uniform_sphere(rng.uniform2()),
+                        rng.uniform(),
+                    );
+                    let c = DVec3::new(0.3, -0.2, 0.1) * rm;
+                    let (mesh, vertex) = octant_patch(rs * rm, 16, &frame, c);
+                    let xo = mesh.positions()[vertex(i0, j0) as usize];
+                    let xo64 = xo.as_dvec3();
+                    let accel = Brute { meshes: vec![mesh] };
+                    let mesh = &accel.meshes[0];
+                    let n_tri = mesh.triangle_count();
+                    // bin 0: no entry point; then band-major, sector-minor
+                    let bin_of = |prim: u32| {
+                        let [a, b, c] = mesh.triangle(prim);
+                        let cen = ((a + b + c) / 3.0).as_dvec3() - xo64;
+                        let band = ((cen.length() / rm * bands as f64) as usize).min(bands);
+                        let (x, y) = (cen.dot(frame.t.as_dvec3()), cen.dot(frame.b.as_dvec3()));
+                        let turn = (y.atan2(x) / std::f64::consts::TAU).rem_euclid(1.0);
+                        let sector = ((turn * sectors as f64) as usize).min(sectors - 1);
+                        1 + band * sectors + sector
+                    };
+                    let n_bins = 1 + (bands + 1) * sectors;
+                    let mut expected = vec![0.0; n_bins];
+                    let mut observed = vec![0.0; n_bins];
+                    for prim in 0..n_tri as u32 {
+                        let n_hit = mesh.face_normal(prim).as_dvec3();
+                        let pdf = |x: DVec3| s.pdf_area(x - xo64, &frame, n_hit);
+                        let tri = mesh.triangle(prim).map(|p| p.as_dvec3());
+                        expected[bin_of(prim)] += integrate_triangle(&pdf, xo64, rm, tri, 6, &gl);
+                    }
+                    let p_hit: f64 = expected.iter().sum();
+                    let what = format!("case {case}, {opts:?}");
+                    assert!(p_hit > 0.05 && p_hit < 1.0 + 1e-9, "{what}: P(hit) {p_hit}");
+                    expected[0] = 1.0 - p_hit;
+                    for e in &mut expected {
+                        *e *= n_samples as f64;
+                    }
+                    for _ in 0..n_samples {
+                        let u = ProbeRandoms::from_rng(&mut rng);
+                        let Some(ps) = sample_entry(&s, xo, &frame, &u, &target(&accel), &mut hits)
+                        else {
+                            observed[0] += 1.0;
+                            continue;
+                        };
+                        assert_eq!(hits.total(), 1, "{what}: a segment with several hits");
+                        observed[bin_of(ps.hit.prim)] += 1.0;
+                        let d = ps.point.as_dvec3() - xo64;
+                        if d.length() > 1e-3 * rm {
+                            let p = s.pdf_area(d, &frame, ps.normal.as_dvec3());
+                            assert!(p > 0.0, "{what}: an entry point where p = 0, at {d}");
+                            let rd = s.rd(d.length());
+                            for c in 0..3 {
+                                let want = rd[c] / p;
+                                let got = ps.weight[c] as f64;
+                                assert!(
+                                    (got - want).abs() <= 2e-3 * want,
+                                    "{what} ch{c}: weight {got}, Rd/p = {want} at {d}"
+                                );
+                            }
+                        }
+                    }
+                    let (chi2, dof, p) = pearson(&observed, &expected);
+                    p_min = p_min.min(p);
+                    println!("{what}: P(hit) {p_hit:.3}, χ² {chi2:.1} / {dof}, p {p:.3}");
+                    assert!(
+                        p > 1e-3,
+                        "{what}: χ² = {chi2:.1} on {dof} degrees of freedom, p = {p:.2e}\n\
+                         observed {observed:?}\nexpected {expected:?}"
+                    );
+                }
+            }
+        }
+        println!("smallest p-value: {p_min:.3}");
     }
 }
