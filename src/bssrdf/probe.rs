@@ -400,12 +400,19 @@ impl ProbeSampler {
     /// their probabilities (pbrt-v3 `Pdf_Sp` without the channel sum).
     /// Inactive channels give 0.
     fn pdf_area_d(&self, d: DVec3, frame: &Frame, n_hit: DVec3) -> [f64; 3] {
+        let per_axis = self.pdf_area_axes(d, frame, n_hit);
+        std::array::from_fn(|c| per_axis.iter().map(|p| p[c]).sum())
+    }
+
+    /// [`pdf_area_d`](Self::pdf_area_d)'s terms, axis by axis (T, B, N):
+    /// P(a) p_c(r_a) |V_a·N| per channel c.
+    fn pdf_area_axes(&self, d: DVec3, frame: &Frame, n_hit: DVec3) -> [[f64; 3]; 3] {
         let axes = [frame.t.as_dvec3(), frame.b.as_dvec3(), frame.n.as_dvec3()];
         let probs = self.axis_probs();
         // Disk radii from the squares of the other two local coordinates:
         // |d|² − (d·V)² would cancel when r ≪ |d|.
         let sq = axes.map(|v| d.dot(v).powi(2));
-        let mut pdf = [0.0; 3];
+        let mut pdf = [[0.0; 3]; 3];
         for a in 0..3 {
             if probs[a] == 0.0 {
                 continue;
@@ -419,7 +426,7 @@ impl ProbeSampler {
             }
             for &c in &self.active[..self.n_active] {
                 if let Some(dist) = &self.dists[c] {
-                    pdf[c] += probs[a] * dist.pdf(r_a) * cos;
+                    pdf[a][c] += probs[a] * dist.pdf(r_a) * cos;
                 }
             }
         }
@@ -438,6 +445,18 @@ impl ProbeSampler {
             return 0.0;
         }
         self.pdf_area_d(d, frame, n_hit).iter().sum::<f64>() / self.n_active as f64
+    }
+
+    /// [`pdf_area`](Self::pdf_area) axis by axis (T, B, N): the density of
+    /// reaching xi with a probe along that axis. Where the segment through
+    /// xi along axis a has k_a hits, xi is chosen with density
+    /// Σ_a pdf_area_axes_mean[a] / k_a.
+    pub(crate) fn pdf_area_axes_mean(&self, d: DVec3, frame: &Frame, n_hit: DVec3) -> [f64; 3] {
+        if self.n_active == 0 || d.length() > self.rmax {
+            return [0.0; 3];
+        }
+        self.pdf_area_axes(d, frame, n_hit)
+            .map(|p| p.iter().sum::<f64>() / self.n_active as f64)
     }
 
     /// Rd(|d|)/p(xi) per channel (before the hit count) for an entry point

@@ -976,25 +976,47 @@ mod tests {
     }
 
     /// ∫ f dA over triangle `tri`, f zero beyond `rmax` from `xo`: Gauss–
-    /// Legendre in the Duffy square collapsed at the vertex nearest xo (its
-    /// Jacobian ∝ distance cancels f's 1/r singularity at xo, a vertex of
-    /// the triangles around it); a triangle the sphere of radius `rmax`
-    /// cuts is split in four, `depth` times, so the jump there is resolved.
+    /// Legendre in the Duffy square, or in polar coordinates around a
+    /// vertex that is a point of `sing` where f has a 1/r singularity (xo
+    /// = `sing[0]`, a vertex of the triangles around it, and `sing[1..]`,
+    /// where a line xo + sV_a pierces the surface, which the caller makes
+    /// a vertex of the pieces of the pierced triangle). A triangle the
+    /// sphere of radius `rmax` cuts, or for which `split` says f jumps
+    /// inside, or near a point of `sing[1..]` (f nearly singular on it), is
+    /// split in four, `depth` times.
+    #[allow(clippy::too_many_arguments)]
     fn integrate_triangle(
         f: &dyn Fn(DVec3) -> f64,
+        split: &dyn Fn(&[DVec3; 3]) -> bool,
         xo: DVec3,
+        sing: &[DVec3],
         rmax: f64,
         tri: [DVec3; 3],
         depth: u32,
         gl: &[(f64, f64)],
     ) -> f64 {
         let dist = tri.map(|p| (p - xo).length());
+        let to_sing = tri.map(|p| {
+            sing.iter()
+                .map(|q| (p - *q).length())
+                .fold(f64::INFINITY, f64::min)
+        });
         let cen = (tri[0] + tri[1] + tri[2]) / 3.0;
         let rad = tri.iter().map(|p| (*p - cen).length()).fold(0.0, f64::max);
         if (cen - xo).length() - rad > rmax {
             return 0.0;
         }
-        if depth > 0 && dist.iter().any(|&r| r > rmax) {
+        // near a singular point that is not one of its vertices, f is
+        // nearly singular on the triangle: refine toward the point
+        let size = (0..3)
+            .map(|k| (tri[k] - tri[(k + 1) % 3]).length())
+            .fold(0.0, f64::max);
+        let near = sing.len() > 1
+            && to_sing.iter().all(|&r| r > 1e-6 * rmax)
+            && tri
+                .iter()
+                .any(|p| sing[1..].iter().any(|q| (*p - *q).length() < size));
+        if depth > 0 && (near || dist.iter().any(|&r| r > rmax) || split(&tri)) {
             let m = [0, 1, 2].map(|k| (tri[k] + tri[(k + 1) % 3]) / 2.0);
             return [
                 [tri[0], m[0], m[2]],
@@ -1003,11 +1025,46 @@ mod tests {
                 [m[0], m[1], m[2]],
             ]
             .into_iter()
-            .map(|t| integrate_triangle(f, xo, rmax, t, depth - 1, gl))
+            .map(|t| integrate_triangle(f, split, xo, sing, rmax, t, depth - 1, gl))
             .sum();
         }
-        let k = (0..3).min_by(|&x, &y| dist[x].total_cmp(&dist[y])).unwrap();
+        let k = (0..3)
+            .min_by(|&x, &y| to_sing[x].total_cmp(&to_sing[y]))
+            .unwrap();
         let (a, b, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        if to_sing[k] < 1e-6 * rmax {
+            // a singular point at vertex a: polar coordinates around it,
+            // the angle θ from b − a toward c − a, the distance r up to the
+            // edge bc on geometrically graded pieces (f ~ e^(−r/d)/r, so
+            // f·r is bounded; unlike Duffy's, the angular integrand stays
+            // smooth when a is close to the edge bc)
+            let e1 = (b - a).normalize();
+            let e2 = ((c - a) - e1 * (c - a).dot(e1)).normalize();
+            let theta = (c - a).dot(e2).atan2((c - a).dot(e1));
+            let edge = (c - b).normalize();
+            let mut n_edge = (b - a) - edge * (b - a).dot(edge);
+            let h = n_edge.length();
+            n_edge /= h;
+            let graded = [
+                (0.0, 1.0 / 27.0),
+                (1.0 / 27.0, 1.0 / 9.0),
+                (1.0 / 9.0, 1.0 / 3.0),
+                (1.0 / 3.0, 1.0),
+            ];
+            let mut sum = 0.0;
+            for &(t, wt) in gl {
+                let th = t * theta;
+                let u = e1 * th.cos() + e2 * th.sin();
+                let rho = h / u.dot(n_edge);
+                for (s0, s1) in graded {
+                    for &(s, ws) in gl {
+                        let r = rho * (s0 + (s1 - s0) * s);
+                        sum += wt * theta * ws * (s1 - s0) * rho * r * f(a + u * r);
+                    }
+                }
+            }
+            return sum;
+        }
         let area2 = (b - a).cross(c - a).length();
         let mut sum = 0.0;
         for &(s, ws) in gl {
@@ -1203,7 +1260,8 @@ mod tests {
                         let n_hit = mesh.face_normal(prim).as_dvec3();
                         let pdf = |x: DVec3| s.pdf_area(x - xo64, &frame, n_hit);
                         let tri = mesh.triangle(prim).map(|p| p.as_dvec3());
-                        expected[bin_of(prim)] += integrate_triangle(&pdf, xo64, rm, tri, 6, &gl);
+                        expected[bin_of(prim)] +=
+                            integrate_triangle(&pdf, &|_| false, xo64, &[xo64], rm, tri, 6, &gl);
                     }
                     let p_hit: f64 = expected.iter().sum();
                     let what = format!("case {case}, {opts:?}");
@@ -1248,5 +1306,219 @@ mod tests {
             }
         }
         println!("smallest p-value: {p_min:.3}");
+    }
+
+    #[test]
+    fn a_chosen_entry_point_has_density_p_over_the_hits_on_its_segment() {
+        // Two concentric octant patches (`octant_patch`, radii 1.6 Rmax and
+        // 1.3 Rmax, xo on the outer one): a probe segment can cross both, and
+        // the query then returns two hits of which one is picked uniformly.
+        // The density of the chosen xi is Σ_a p_a(xi) / k_a(xi), p_a the
+        // density of reaching xi along axis a (`pdf_area_axes_mean`) and k_a
+        // the hits on the segment through xi along a (1 or 2, counted here
+        // by intersecting that segment with the other patch); the weight
+        // must be Rd/p × k, p = Σ_a p_a. Pearson χ² as in
+        // `sampled_entry_points_follow_the_density_the_estimator_divides_by`,
+        // the bins separating the two patches; triangles across which some
+        // k_a changes are subdivided so the quadrature resolves the jump,
+        // and where the line xo + sV_a pierces the inner patch (p_a ~ 1/r_a
+        // there, as at xo) the quadrature is polar around that point.
+        // Normal and Mis3 axes; more than half the segments hit twice.
+        let params = SubsurfaceParams {
+            albedo: [0.8, 0.5, 0.3],
+            d: [1.0, 0.5, 0.25],
+            eta: 1.3,
+            medium: None,
+        };
+        let gl = gauss_legendre(8);
+        let n_samples = 25_000;
+        let (bands, sectors) = (8usize, 4usize);
+        let mut rng = Rng::from_key(2025);
+        let mut hits = ProbeHits::new();
+        let mut p_min = 1.0f64;
+        let mut two = 0usize;
+        for (axes, radius) in [
+            (ProbeAxes::Normal, RadiusSampler::Uniform),
+            (ProbeAxes::Normal, RadiusSampler::Analytic),
+            (ProbeAxes::Mis3, RadiusSampler::Mixture),
+        ] {
+            let opts = ProbeOptions {
+                axes,
+                channel: ChannelStrategy::Mis,
+                radius,
+                rmax_quantile: 0.99,
+                renormalize: false,
+            };
+            let s = ProbeSampler::new(&params, &opts).unwrap();
+            let rm = s.rmax();
+            let frame = rotated_frame(
+                crate::sampling::uniform_sphere(rng.uniform2()),
+                rng.uniform(),
+            );
+            let c = DVec3::new(0.3, -0.2, 0.1) * rm;
+            let (outer, vertex) = octant_patch(1.6 * rm, 12, &frame, c);
+            let xo = outer.positions()[vertex(4, 3) as usize];
+            let xo64 = xo.as_dvec3();
+            let (inner, _) = octant_patch(1.3 * rm, 12, &frame, c);
+            // one mesh, triangles of the outer patch first
+            let n_outer = outer.triangle_count() as u32;
+            let tris: Vec<[Vec3; 3]> = (0..n_outer)
+                .map(|p| outer.triangle(p))
+                .chain((0..inner.triangle_count() as u32).map(|p| inner.triangle(p)))
+                .collect();
+            let mesh = Mesh::new(
+                tris.iter().flatten().copied().collect(),
+                (0..tris.len() as u32)
+                    .map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
+                    .collect(),
+                None,
+            );
+            let accel = Brute { meshes: vec![mesh] };
+            let mesh = &accel.meshes[0];
+            let n_tri = mesh.triangle_count() as u32;
+            let axes_v = [frame.t, frame.b, frame.n].map(|v| v.as_dvec3());
+            // k_a(x) for x on triangle `prim`: 1 + the hits of the
+            // other patch on the segment along axis a through x
+            // the triangles of each patch that reach into the sphere of
+            // radius Rmax around xo (the others are beyond every chord)
+            let near = |r: std::ops::Range<u32>| -> Vec<u32> {
+                r.filter(|&q| {
+                    let t = mesh.triangle(q).map(|p| p.as_dvec3());
+                    let cen = (t[0] + t[1] + t[2]) / 3.0;
+                    let rad = t.iter().map(|p| (*p - cen).length()).fold(0.0, f64::max);
+                    (cen - xo64).length() - rad <= rm
+                })
+                .collect()
+            };
+            let (near_outer, near_inner) = (near(0..n_outer), near(n_outer..n_tri));
+            // k_a(x) for x on triangle `prim`: 1 + the hits of the
+            // other patch on the segment along axis a through x
+            let count = |x: DVec3, prim: u32, a: usize| -> usize {
+                let v = axes_v[a];
+                let d = x - xo64;
+                let along = d.dot(v);
+                let h = (rm * rm - (d.length_squared() - along * along))
+                    .max(0.0)
+                    .sqrt();
+                let ray = Ray::new((x + v * (h - along)).as_vec3(), (-v).as_vec3());
+                let others = if prim < n_outer {
+                    &near_inner
+                } else {
+                    &near_outer
+                };
+                1 + others
+                    .iter()
+                    .filter(|&&q| tri_hit(&ray, mesh.triangle(q), 0.0, (2.0 * h) as f32).is_some())
+                    .count()
+            };
+            let bin_of = |prim: u32| {
+                let [a, b, c] = mesh.triangle(prim);
+                let cen = ((a + b + c) / 3.0).as_dvec3() - xo64;
+                let band = ((cen.length() / rm * bands as f64) as usize).min(bands);
+                let (x, y) = (cen.dot(axes_v[0]), cen.dot(axes_v[1]));
+                let turn = (y.atan2(x) / std::f64::consts::TAU).rem_euclid(1.0);
+                let sector = ((turn * sectors as f64) as usize).min(sectors - 1);
+                let patch = (prim >= n_outer) as usize;
+                1 + (patch * (bands + 1) + band) * sectors + sector
+            };
+            let n_bins = 1 + 2 * (bands + 1) * sectors;
+            let mut expected = vec![0.0; n_bins];
+            let mut observed = vec![0.0; n_bins];
+            // where the lines xo + sV_a pierce the mesh, p_a has a 1/r_a
+            // singularity: the quadrature needs to know
+            let mut sing = vec![xo64];
+            let mut pierced = vec![None; n_tri as usize];
+            for prim in 0..n_tri {
+                let tri = mesh.triangle(prim);
+                for v in axes_v {
+                    let ray = Ray::new((xo64 - v * 4.0 * rm).as_vec3(), v.as_vec3());
+                    if let Some((_, u, w)) = tri_hit(&ray, tri, 0.0, (8.0 * rm) as f32) {
+                        let [a, b, c] = tri.map(|p| p.as_dvec3());
+                        let (u, w) = (u as f64, w as f64);
+                        let q = a * (1.0 - u - w) + b * u + c * w;
+                        if (q - xo64).length() > 1e-6 * rm {
+                            sing.push(q);
+                            pierced[prim as usize] = Some(q);
+                        }
+                    }
+                }
+            }
+            for prim in 0..n_tri {
+                let n_hit = mesh.face_normal(prim).as_dvec3();
+                let pdf = |x: DVec3| {
+                    let pa = s.pdf_area_axes_mean(x - xo64, &frame, n_hit);
+                    (0..3)
+                        .filter(|&a| pa[a] > 0.0)
+                        .map(|a| pa[a] / count(x, prim, a) as f64)
+                        .sum::<f64>()
+                };
+                // k_a changes inside where it differs at the corners
+                let split = |t: &[DVec3; 3]| {
+                    (0..3).any(|a| {
+                        let k = t.map(|x| count(x, prim, a));
+                        k[0] != k[1] || k[1] != k[2]
+                    })
+                };
+                // a pierce point becomes the common vertex of three pieces
+                let [a, b, c] = mesh.triangle(prim).map(|p| p.as_dvec3());
+                let pieces = match pierced[prim as usize] {
+                    Some(q) => vec![[q, b, c], [q, c, a], [q, a, b]],
+                    None => vec![[a, b, c]],
+                };
+                expected[bin_of(prim)] += pieces
+                    .into_iter()
+                    .map(|t| integrate_triangle(&pdf, &split, xo64, &sing, rm, t, 3, &gl))
+                    .sum::<f64>();
+            }
+            let p_hit: f64 = expected.iter().sum();
+            let what = format!("{opts:?}");
+            assert!(p_hit > 0.05 && p_hit < 1.0 + 1e-9, "{what}: P(hit) {p_hit}");
+            expected[0] = 1.0 - p_hit;
+            for e in &mut expected {
+                *e *= n_samples as f64;
+            }
+            for _ in 0..n_samples {
+                let u = ProbeRandoms::from_rng(&mut rng);
+                let Some(ps) = sample_entry(&s, xo, &frame, &u, &target(&accel), &mut hits) else {
+                    observed[0] += 1.0;
+                    continue;
+                };
+                let k = hits.total();
+                assert!(k <= 2, "{what}: {k} hits on two single-hit patches");
+                two += (k == 2) as usize;
+                observed[bin_of(ps.hit.prim)] += 1.0;
+                let d = ps.point.as_dvec3() - xo64;
+                // the f32 point's rounding is relative to |xo|; p_a
+                // ∝ 1/r_a near a line xo + sV_a
+                let r_min = axes_v
+                    .map(|v| (d.length_squared() - d.dot(v).powi(2)).max(0.0).sqrt())
+                    .into_iter()
+                    .fold(f64::INFINITY, f64::min);
+                if r_min > 1e-3 * rm {
+                    let p = s.pdf_area(d, &frame, ps.normal.as_dvec3());
+                    assert!(p > 0.0, "{what}: an entry point where p = 0, at {d}");
+                    let rd = s.rd(d.length());
+                    for c in 0..3 {
+                        let want = rd[c] / p * k as f64;
+                        let got = ps.weight[c] as f64;
+                        assert!(
+                            (got - want).abs() <= 2e-3 * want,
+                            "{what} ch{c}: weight {got}, Rd/p × {k} = {want} at {d}"
+                        );
+                    }
+                }
+            }
+            let (chi2, dof, p) = pearson(&observed, &expected);
+            p_min = p_min.min(p);
+            println!("{what}: P(hit) {p_hit:.3}, χ² {chi2:.1} / {dof}, p {p:.3}");
+            assert!(
+                p > 1e-3,
+                "{what}: χ² = {chi2:.1} on {dof} degrees of freedom, p = {p:.2e}\n\
+                     observed {observed:?}\nexpected {expected:?}"
+            );
+        }
+        // the case this test is for happens often
+        assert!(two > n_samples / 2, "{two} two-hit segments");
+        println!("smallest p-value: {p_min:.3}, {two} two-hit segments");
     }
 }
