@@ -118,7 +118,7 @@ fn camera(cx: &Cx, c: &Spanned<CameraDef>) -> Res<Camera> {
         }
         None => 40.0,
     };
-    let [w, h] = *resolution.get_ref();
+    let [w, h] = resolution.get_ref().0;
     if w == 0 || h == 0 || w > MAX_RESOLUTION || h > MAX_RESOLUTION {
         return Err(cx.err(
             resolution.span(),
