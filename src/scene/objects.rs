@@ -81,7 +81,7 @@ fn shape_mesh(cx: &Cx, dir: &Path, field: &str, s: &Spanned<ShapeDef>) -> Res<Me
                 ));
             };
             let path = dir.join(f.get_ref());
-            let text = std::fs::read_to_string(&path).map_err(|e| {
+            let text = super::load::read_regular_file(&path).map_err(|e| {
                 cx.err(
                     f.span(),
                     &format!("{field}.file"),
