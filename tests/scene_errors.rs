@@ -158,14 +158,14 @@ fn cases() -> Vec<Case> {
         ),
         case(
             "sigma_s_prime with four entries",
-            format!("{CAM}{SSS}sigma_s_prime = [1, 1, 1, 1]\nsigma_a = [0.1, 0.1, 0.1]\n"),
+            format!("{CAM}{SSS}sigma_s_prime = [1, 1, 1, 1]\nsigma_a = [0.1, 0.1, 0.1]\nalbedo = [0.5, 0.5, 0.5]\n"),
             "expected 3 numbers, found 4",
             Some("sigma_s_prime"),
             Some("materials.skin.sigma_s_prime"),
         ),
         case(
             "sigma_a with four entries",
-            format!("{CAM}{SSS}sigma_s_prime = [1, 1, 1]\nsigma_a = [0.1, 0.1, 0.1, 0.1]\n"),
+            format!("{CAM}{SSS}sigma_s_prime = [1, 1, 1]\nsigma_a = [0.1, 0.1, 0.1, 0.1]\nalbedo = [0.5, 0.5, 0.5]\n"),
             "expected 3 numbers, found 4",
             Some("sigma_a"),
             Some("materials.skin.sigma_a"),
