@@ -10,7 +10,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use lucent::accel::{self, Backend};
 use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
 use lucent::error::{Param, ParamError};
-use lucent::film::{self, ToneMap};
+use lucent::film::ToneMap;
 use lucent::integrator::IntegratorKind;
 use lucent::materials::SubsurfaceOverrides;
 use lucent::render::{self, RenderOptions};
@@ -61,8 +61,8 @@ enum Command {
         /// Samples per pixel (default: the scene's `render.spp`).
         #[arg(long)]
         spp: Option<u32>,
-        /// Worker threads (default: all cores).
-        #[arg(long)]
+        /// Worker threads, 1 to 1024 (default: all cores).
+        #[arg(long, value_parser = lucent::tools::bench::parse_threads)]
         threads: Option<usize>,
         /// Random seed (default: the scene's `render.seed`).
         #[arg(long)]
@@ -296,8 +296,7 @@ fn run_render(
         .map_err(option_error)?;
     let accel = accel::build(&scene.meshes, backend)?;
     let (film, stats) = render::render(&scene, accel.as_ref(), opts)?;
-    film.write_exr(output)?;
-    film.write_png(&film::preview_path(output), tonemap, exposure)?;
+    film.write_exr_and_preview(output, tonemap, exposure)?;
     if !quiet {
         eprintln!(
             "{}: {}x{} at {} spp, {} triangles: {}",
@@ -322,8 +321,8 @@ struct StudyArgs {
     /// Small images, few configurations, short ladders: under two minutes.
     #[arg(long)]
     quick: bool,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
+    /// Worker threads, 1 to 1024 (default: all cores).
+    #[arg(long, value_parser = lucent::tools::bench::parse_threads)]
     threads: Option<usize>,
     /// Integrator of the reference render: diffusion | randomwalk.
     #[arg(long, default_value = "diffusion", value_parser = parse_study_integrator)]

@@ -21,13 +21,18 @@ use crate::scene::Scene;
 
 pub const TILE: u32 = 16;
 
+/// The most worker threads a render, a study or a benchmark accepts: far
+/// above any core count, far below what exhausts memory in thread stacks.
+pub const MAX_THREADS: usize = 1024;
+
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
     /// Samples per pixel (overrides the scene's when Some).
     pub spp: Option<u32>,
     /// Seed (overrides the scene's when Some).
     pub seed: Option<u64>,
-    /// Worker threads; None: rayon's default (all cores).
+    /// Worker threads, 1 to [`MAX_THREADS`]; None: rayon's default (all
+    /// cores).
     pub threads: Option<usize>,
     /// Draw a progress bar on stderr.
     pub progress: bool,
@@ -100,6 +105,12 @@ pub fn render(
     } else {
         scene
     };
+    if let Some(n) = opts.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
+        return Err(Error::Argument {
+            argument: "--threads".into(),
+            problem: format!("{n} is not a thread count (1 to {MAX_THREADS})"),
+        });
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads.unwrap_or(0))
         .build()

@@ -1,7 +1,9 @@
 //! The film: one RGB radiance estimate per pixel, and its outputs — a float
 //! RGBA OpenEXR for compositing and a tone-mapped sRGB PNG preview. Both are
 //! written atomically (a temporary file in the target's directory, then a
-//! rename), so a reader never sees a half-written image under the real name.
+//! rename), so a reader never sees a half-written image under the real name;
+//! the outputs of one command are committed together ([`commit_all`]), so a
+//! failure never leaves an EXR without its PNG.
 
 pub mod tonemap;
 
@@ -41,6 +43,12 @@ impl Film {
     /// they finish, which would make the file's bytes (not its pixels)
     /// differ from run to run.
     pub fn write_exr(&self, path: &Path) -> Result<(), Error> {
+        commit_all(vec![self.stage_exr(path)?])
+    }
+
+    /// [`write_exr`](Self::write_exr) to the temporary file only, for
+    /// [`commit_all`].
+    pub fn stage_exr(&self, path: &Path) -> Result<Staged, Error> {
         use exr::prelude::*;
         let w = self.width as usize;
         let channels = SpecificChannels::rgba(|pos: Vec2<usize>| {
@@ -53,13 +61,27 @@ impl Film {
             line_order: LineOrder::Increasing,
         };
         let image = Image::from_encoded_channels((w, self.height as usize), encoding, channels);
-        write_atomically(path, |tmp| {
+        Staged::write(path, |tmp| {
             image
                 .write()
                 .non_parallel()
                 .to_file(tmp)
                 .map_err(|e| e.to_string())
         })
+    }
+
+    /// The EXR at `exr` and its PNG preview beside it
+    /// ([`preview_path`]), committed together: both appear, or neither
+    /// does and whatever was under the names stays.
+    pub fn write_exr_and_preview(
+        &self,
+        exr: &Path,
+        tonemap: ToneMap,
+        exposure: f32,
+    ) -> Result<(), Error> {
+        let a = self.stage_exr(exr)?;
+        let b = self.stage_png(&preview_path(exr), tonemap, exposure)?;
+        commit_all(vec![a, b])
     }
 
     /// Reads an RGBA/RGB float OpenEXR written by [`write_exr`](Self::write_exr)
@@ -83,6 +105,12 @@ impl Film {
     /// Writes an 8-bit sRGB PNG preview through `tonemap` after scaling by
     /// 2^exposure.
     pub fn write_png(&self, path: &Path, tonemap: ToneMap, exposure: f32) -> Result<(), Error> {
+        commit_all(vec![self.stage_png(path, tonemap, exposure)?])
+    }
+
+    /// [`write_png`](Self::write_png) to the temporary file only, for
+    /// [`commit_all`].
+    pub fn stage_png(&self, path: &Path, tonemap: ToneMap, exposure: f32) -> Result<Staged, Error> {
         let scale = exposure.exp2();
         let mut buf = Vec::with_capacity(self.pixels.len() * 3);
         for p in &self.pixels {
@@ -97,7 +125,7 @@ impl Film {
                 problem: "bad film size".into(),
             }
         })?;
-        write_atomically(path, |tmp| {
+        Staged::write(path, |tmp| {
             img.save_with_format(tmp, image::ImageFormat::Png)
                 .map_err(|e| e.to_string())
         })
@@ -112,15 +140,110 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), Error> {
-    let tmp = temp_path(path);
-    let result = write(&tmp).and_then(|()| fs::rename(&tmp, path).map_err(|e| e.to_string()));
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
+    commit_all(vec![Staged::write(path, write)?])
+}
+
+/// An output written in full to a temporary file next to its path, not yet
+/// under its name: [`commit_all`] moves it there together with the other
+/// outputs of the same command. Dropped uncommitted, the temporary file is
+/// removed.
+#[must_use = "a staged output appears only when committed"]
+#[derive(Debug)]
+pub struct Staged {
+    tmp: PathBuf,
+    path: PathBuf,
+}
+
+impl Staged {
+    /// Runs `write` on the temporary path of `path`; on failure the
+    /// temporary file is removed and the error names `path`.
+    pub fn write(
+        path: &Path,
+        write: impl FnOnce(&Path) -> Result<(), String>,
+    ) -> Result<Staged, Error> {
+        let staged = Staged {
+            tmp: temp_path(path),
+            path: path.to_path_buf(),
+        };
+        // on failure, dropping `staged` removes the temporary file
+        write(&staged.tmp).map_err(|problem| Error::Write {
+            path: path.to_path_buf(),
+            problem,
+        })?;
+        Ok(staged)
     }
-    result.map_err(|problem| Error::Write {
+
+    /// Where the output goes.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        // gone already once committed
+        let _ = fs::remove_file(&self.tmp);
+    }
+}
+
+/// Moves every staged output under its name, all or none: the outputs of
+/// one command (an EXR and its PNG preview) appear together, or the
+/// directory is left as it was. A destination that is a directory (or
+/// otherwise cannot be replaced by a file) fails the whole commit before
+/// anything moves. Files already under the names are set aside first and
+/// put back if a later rename fails; each rename on its own is atomic.
+pub fn commit_all(files: Vec<Staged>) -> Result<(), Error> {
+    let write_err = |path: &Path, problem: String| Error::Write {
         path: path.to_path_buf(),
         problem,
-    })
+    };
+    for f in &files {
+        if let Ok(meta) = fs::symlink_metadata(&f.path) {
+            if meta.is_dir() {
+                return Err(write_err(&f.path, "it is a directory".into()));
+            }
+        }
+    }
+    // (destination, where its previous file was set aside)
+    let mut done: Vec<(&Path, Option<PathBuf>)> = Vec::new();
+    let last = files.len().saturating_sub(1);
+    for (i, f) in files.iter().enumerate() {
+        // The last rename needs no way back: if it fails, it changed nothing.
+        let mut aside = None;
+        if i < last && fs::symlink_metadata(&f.path).is_ok() {
+            let old = old_path(&f.path);
+            if let Err(e) = fs::rename(&f.path, &old) {
+                roll_back(done);
+                return Err(write_err(&f.path, e.to_string()));
+            }
+            aside = Some(old);
+        }
+        if let Err(e) = fs::rename(&f.tmp, &f.path) {
+            if let Some(old) = &aside {
+                let _ = fs::rename(old, &f.path);
+            }
+            roll_back(done);
+            return Err(write_err(&f.path, e.to_string()));
+        }
+        done.push((&f.path, aside));
+    }
+    for (_, aside) in done {
+        if let Some(old) = aside {
+            let _ = fs::remove_file(old);
+        }
+    }
+    Ok(())
+}
+
+/// Undoes committed renames, last first: removes the new file and puts the
+/// previous one back.
+fn roll_back(done: Vec<(&Path, Option<PathBuf>)>) {
+    for (path, aside) in done.into_iter().rev() {
+        let _ = fs::remove_file(path);
+        if let Some(old) = aside {
+            let _ = fs::rename(old, path);
+        }
+    }
 }
 
 /// [`write_atomically`] with the error as its message (`cannot write PATH:
@@ -138,6 +261,16 @@ fn temp_path(path: &Path) -> PathBuf {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+/// Where [`commit_all`] sets a file it replaces aside until all renames
+/// succeeded.
+fn old_path(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.old.tmp", std::process::id()))
 }
 
 /// The PNG preview's path beside an EXR path: same stem, `.png`.
@@ -169,6 +302,40 @@ mod tests {
             .map(|e| e.unwrap().file_name())
             .collect();
         assert_eq!(names.len(), 2, "{names:?}");
+    }
+
+    #[test]
+    fn a_failed_commit_puts_every_output_back_as_it_was() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.exr"), dir.path().join("a.png"));
+        fs::write(&a, b"old a").unwrap();
+        let write =
+            |text: &'static [u8]| move |tmp: &Path| fs::write(tmp, text).map_err(|e| e.to_string());
+        let sa = Staged::write(&a, write(b"new a")).unwrap();
+        let sb = Staged::write(&b, write(b"new b")).unwrap();
+        // the second rename fails after the first succeeded
+        fs::remove_file(&sb.tmp).unwrap();
+        let e = commit_all(vec![sa, sb]).unwrap_err();
+        assert!(e.to_string().contains("a.png"), "{e}");
+        assert_eq!(fs::read(&a).unwrap(), b"old a");
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+        // a destination that is a directory fails before anything moves
+        fs::create_dir(&b).unwrap();
+        let sa = Staged::write(&a, write(b"new a")).unwrap();
+        let sb = Staged::write(&b, write(b"new b")).unwrap();
+        let e = commit_all(vec![sa, sb]).unwrap_err();
+        assert!(e.to_string().contains("directory"), "{e}");
+        assert_eq!(fs::read(&a).unwrap(), b"old a");
+        assert!(b.is_dir());
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 2);
+        // and when all succeed, both are replaced and nothing else remains
+        fs::remove_dir(&b).unwrap();
+        let sa = Staged::write(&a, write(b"new a")).unwrap();
+        let sb = Staged::write(&b, write(b"new b")).unwrap();
+        commit_all(vec![sa, sb]).unwrap();
+        assert_eq!(fs::read(&a).unwrap(), b"new a");
+        assert_eq!(fs::read(&b).unwrap(), b"new b");
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 2);
     }
 
     #[test]

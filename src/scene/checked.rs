@@ -10,7 +10,7 @@
 use std::ops::Range;
 use std::path::Path;
 
-use super::format::{Spanned, Triple};
+use super::format::{Spanned, Triple3};
 use super::key_path::{key_path_at, line_of};
 use crate::error::InputError;
 use crate::geometry::Vec3;
@@ -68,7 +68,7 @@ impl Cx<'_> {
     }
 
     /// A finite `Vec3` (finite also after narrowing to f32).
-    pub fn vec3(&self, v: &Spanned<Triple>, field: &str) -> Res<Vec3> {
+    pub fn vec3(&self, v: &Spanned<Triple3>, field: &str) -> Res<Vec3> {
         let a = v.get_ref();
         let out = Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
         if !out.is_finite() {
@@ -105,7 +105,7 @@ impl Cx<'_> {
     }
 
     /// RGB with every component ≥ 0 (and ≤ 1 if `unit`).
-    pub fn rgb(&self, v: &Spanned<Triple>, field: &str, unit: bool) -> Res<Vec3> {
+    pub fn rgb(&self, v: &Spanned<Triple3>, field: &str, unit: bool) -> Res<Vec3> {
         let c = self.vec3(v, field)?;
         let ok = c.min_element() >= 0.0 && (!unit || c.max_element() <= 1.0);
         if !ok {

@@ -28,6 +28,39 @@ pub use toml::Spanned;
 /// Three numbers: a point, a direction or an RGB triple.
 pub type Triple = [f64; 3];
 
+/// Exactly `N` numbers, as a TOML array: unlike serde's `[T; N]`, which
+/// stops reading after `N` elements and ignores the rest, a wrong length is
+/// rejected ("expected 3 numbers, found 4"). Derefs to the array.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Numbers<T, const N: usize>(pub [T; N]);
+
+/// A [`Triple`] as written in the file: exactly three numbers.
+pub type Triple3 = Numbers<f64, 3>;
+
+impl<T, const N: usize> std::ops::Deref for Numbers<T, N> {
+    type Target = [T; N];
+    fn deref(&self) -> &[T; N] {
+        &self.0
+    }
+}
+
+impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Deserialize<'de> for Numbers<T, N> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V<T, const N: usize>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Visitor<'de> for V<T, N> {
+            type Value = Numbers<T, N>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                write!(f, "an array of {N} numbers")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+                let out = exactly::<A, T, N>(seq, &format!("{N} numbers"))?;
+                Ok(Numbers(out))
+            }
+        }
+        d.deserialize_seq(V::<T, N>(std::marker::PhantomData))
+    }
+}
+
 /// The whole file.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -50,14 +83,14 @@ pub struct SceneFile {
 #[serde(deny_unknown_fields)]
 pub struct CameraDef {
     /// Required.
-    pub look_from: Option<Spanned<Triple>>,
+    pub look_from: Option<Spanned<Triple3>>,
     /// Required.
-    pub look_at: Option<Spanned<Triple>>,
-    pub up: Option<Spanned<Triple>>,
+    pub look_at: Option<Spanned<Triple3>>,
+    pub up: Option<Spanned<Triple3>>,
     /// Vertical field of view in degrees.
     pub fov_y: Option<Spanned<f64>>,
     /// `[width, height]` in pixels. Required.
-    pub resolution: Option<Spanned<[u32; 2]>>,
+    pub resolution: Option<Spanned<Numbers<u32, 2>>>,
 }
 
 /// `[render]`; every key is optional.
@@ -74,7 +107,7 @@ pub struct RenderDef {
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDef {
     /// Required.
-    pub radiance: Option<Spanned<Triple>>,
+    pub radiance: Option<Spanned<Triple3>>,
 }
 
 /// The `type` of a `[materials.NAME]` table.
@@ -104,14 +137,14 @@ pub struct MaterialDef {
     /// Required.
     #[serde(rename = "type")]
     pub kind: Option<Spanned<MaterialKind>>,
-    pub albedo: Option<Spanned<Triple>>,
+    pub albedo: Option<Spanned<Triple3>>,
     pub eta: Option<Spanned<f64>>,
     // subsurface: parameters (one of three forms)
     pub preset: Option<Spanned<String>>,
-    pub sigma_s_prime: Option<Spanned<Triple>>,
-    pub sigma_a: Option<Spanned<Triple>>,
+    pub sigma_s_prime: Option<Spanned<Triple3>>,
+    pub sigma_a: Option<Spanned<Triple3>>,
     pub g: Option<Spanned<f64>>,
-    pub dmfp: Option<Spanned<Triple>>,
+    pub dmfp: Option<Spanned<Triple3>>,
     pub fit: Option<Spanned<String>>,
     // subsurface: sampling options
     pub radius: Option<Spanned<String>>,
@@ -197,10 +230,10 @@ pub struct ShapeDef {
     pub subdivisions: Option<Spanned<u32>>,
     /// The material's name. Required.
     pub material: Option<Spanned<String>>,
-    pub emission: Option<Spanned<Triple>>,
+    pub emission: Option<Spanned<Triple3>>,
     pub scale: Option<Spanned<Scale>>,
     pub rotate: Option<Vec<Spanned<Rotation>>>,
-    pub translate: Option<Spanned<Triple>>,
+    pub translate: Option<Spanned<Triple3>>,
 }
 
 impl ShapeDef {
@@ -242,7 +275,7 @@ impl<'de> Deserialize<'de> for Scale {
                 Ok(Scale([s as f64; 3]))
             }
             fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Scale, A::Error> {
-                let [x, y, z] = numbers::<A, 3>(seq, &self)?;
+                let [x, y, z] = numbers::<A, 3>(seq, "an array [x, y, z] of 3 numbers")?;
                 Ok(Scale([x, y, z]))
             }
         }
@@ -267,7 +300,10 @@ impl<'de> Deserialize<'de> for Rotation {
                 f.write_str("a rotation [angle_degrees, axis_x, axis_y, axis_z]")
             }
             fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Rotation, A::Error> {
-                let [a, x, y, z] = numbers::<A, 4>(seq, &self)?;
+                let [a, x, y, z] = numbers::<A, 4>(
+                    seq,
+                    "a rotation [angle_degrees, axis_x, axis_y, axis_z] of 4 numbers",
+                )?;
                 Ok(Rotation {
                     angle_deg: a,
                     axis: [x, y, z],
@@ -278,21 +314,38 @@ impl<'de> Deserialize<'de> for Rotation {
     }
 }
 
-/// Reads exactly `N` numbers from `seq`, reporting a wrong length with the
-/// visitor's own `expecting` text.
+/// Reads exactly `N` numbers from `seq` for a `scale` or `rotate` entry;
+/// a wrong length is reported as "expected `what`, found M".
 fn numbers<'de, A: SeqAccess<'de>, const N: usize>(
-    mut seq: A,
-    exp: &dyn de::Expected,
+    seq: A,
+    what: &str,
 ) -> Result<[f64; N], A::Error> {
-    let mut out = [0.0; N];
-    for (i, slot) in out.iter_mut().enumerate() {
-        *slot = seq
-            .next_element()?
-            .ok_or_else(|| de::Error::invalid_length(i, exp))?;
+    exactly::<A, f64, N>(seq, what)
+}
+
+/// Reads exactly `N` elements from `seq`; any other length is an error
+/// "expected `what`, found M" that counts every element given.
+fn exactly<'de, A: SeqAccess<'de>, T: Deserialize<'de> + Copy + Default, const N: usize>(
+    mut seq: A,
+    what: &str,
+) -> Result<[T; N], A::Error> {
+    let mut out = [T::default(); N];
+    let mut found = 0;
+    while found < N {
+        match seq.next_element()? {
+            Some(v) => out[found] = v,
+            None => break,
+        }
+        found += 1;
     }
-    if seq.next_element::<de::IgnoredAny>()?.is_some() {
+    if found == N {
+        while seq.next_element::<de::IgnoredAny>()?.is_some() {
+            found += 1;
+        }
+    }
+    if found != N {
         return Err(de::Error::custom(format_args!(
-            "more than {N} elements, expected {exp}"
+            "expected {what}, found {found}"
         )));
     }
     Ok(out)

@@ -11,7 +11,7 @@
 use std::sync::Arc;
 
 use super::checked::{Cx, Res};
-use super::format::{MaterialDef, MaterialKind, Spanned};
+use super::format::{MaterialDef, MaterialKind, Spanned, Triple3};
 use crate::bssrdf::{
     ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler, SubsurfaceParams,
 };
@@ -171,9 +171,9 @@ fn one_form(cx: &Cx, field: &str, m: &Spanned<MaterialDef>) -> Res<()> {
 }
 
 /// A triple checked as f32 and kept as written (no 1.2000000476837158).
-fn triple(cx: &Cx, field: &str, v: &Option<Spanned<[f64; 3]>>, k: &str) -> Res<Option<[f64; 3]>> {
+fn triple(cx: &Cx, field: &str, v: &Option<Spanned<Triple3>>, k: &str) -> Res<Option<[f64; 3]>> {
     v.as_ref()
-        .map(|t| cx.vec3(t, &format!("{field}.{k}")).map(|_| *t.get_ref()))
+        .map(|t| cx.vec3(t, &format!("{field}.{k}")).map(|_| t.get_ref().0))
         .transpose()
 }
 

@@ -5,6 +5,7 @@
 //! number and index is checked first (errors name the OBJ file and line),
 //! and the `tobj` call is additionally fenced with `catch_unwind`.
 
+use std::borrow::Cow;
 use std::path::Path;
 
 use crate::error::InputError;
@@ -15,6 +16,7 @@ use crate::geometry::{Mesh, Vec3};
 /// ignored — the scene file assigns the material.
 pub fn load_obj(text: &str, path: &Path) -> Result<Mesh, InputError> {
     check_obj(text).map_err(|(line, msg)| InputError::new(path, msg).at_line(line))?;
+    let text = &*without_vertex_colours(text);
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -171,6 +173,31 @@ fn check_obj(text: &str) -> Result<(), (usize, String)> {
         }
     }
     Ok(())
+}
+
+/// The text with the colours of `v x y z r g b` lines dropped (`v x y z`),
+/// other lines as they are. Colours are ignored anyway, and `tobj` rejects
+/// a file where only some vertices carry them. Runs after [`check_obj`].
+fn without_vertex_colours(text: &str) -> Cow<'_, str> {
+    let coloured = |line: &str| {
+        let mut w = line.split_whitespace();
+        w.next() == Some("v") && w.count() == 6
+    };
+    if !text.lines().any(coloured) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        if coloured(line) {
+            let xyz: Vec<&str> = line.split_whitespace().skip(1).take(3).collect();
+            out.push_str("v ");
+            out.push_str(&xyz.join(" "));
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    Cow::Owned(out)
 }
 
 /// Checks one face/line/point vertex reference `v`, `v/vt`, `v//vn` or

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use super::checked::{Cx, Res};
-use super::format::{ShapeDef, ShapeKind, Spanned};
+use super::format::{Numbers, ShapeDef, ShapeKind, Spanned};
 use super::obj::load_obj;
 use super::transform::Transform;
 use super::{shapes, Object};
@@ -81,7 +81,7 @@ fn shape_mesh(cx: &Cx, dir: &Path, field: &str, s: &Spanned<ShapeDef>) -> Res<Me
                 ));
             };
             let path = dir.join(f.get_ref());
-            let text = std::fs::read_to_string(&path).map_err(|e| {
+            let text = super::load::read_regular_file(&path).map_err(|e| {
                 cx.err(
                     f.span(),
                     &format!("{field}.file"),
@@ -121,7 +121,7 @@ fn transform(cx: &Cx, field: &str, d: &ShapeDef) -> Res<Transform> {
     let scale = match &d.scale {
         Some(s) => {
             let f = format!("{field}.scale");
-            let v = cx.vec3(&Spanned::new(s.span(), s.get_ref().0), &f)?;
+            let v = cx.vec3(&Spanned::new(s.span(), Numbers(s.get_ref().0)), &f)?;
             if v.x == 0.0 || v.y == 0.0 || v.z == 0.0 {
                 return Err(cx.err(
                     s.span(),
@@ -138,7 +138,7 @@ fn transform(cx: &Cx, field: &str, d: &ShapeDef) -> Res<Transform> {
         let f = format!("{field}.rotate[{k}]");
         let rot = r.get_ref();
         let angle = cx.scalar(&Spanned::new(r.span(), rot.angle_deg), &f)?;
-        let axis = cx.vec3(&Spanned::new(r.span(), rot.axis), &f)?;
+        let axis = cx.vec3(&Spanned::new(r.span(), Numbers(rot.axis)), &f)?;
         if axis.length() == 0.0 || !axis.length().is_finite() {
             return Err(cx.err(r.span(), &f, "rotation axis must be non-zero"));
         }

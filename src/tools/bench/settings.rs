@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use crate::accel::Backend;
+use crate::render::MAX_THREADS;
 use crate::Error;
 
 /// Sizes of the full run: displaced spheres of 1.3k to 5.2M triangles.
@@ -109,11 +110,14 @@ pub fn parse_size(s: &str) -> Result<usize, String> {
     Ok(n as usize)
 }
 
-/// Parses a thread count: 1 to 1024.
+/// Parses a thread count: 1 to [`MAX_THREADS`] (1024); `render` and
+/// `study` parse `--threads` with it too.
 pub fn parse_threads(s: &str) -> Result<usize, String> {
     match s.trim().parse::<usize>() {
-        Ok(n) if (1..=1024).contains(&n) => Ok(n),
-        _ => Err(format!("\"{s}\" is not a thread count (1 to 1024)")),
+        Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "\"{s}\" is not a thread count (1 to {MAX_THREADS})"
+        )),
     }
 }
 
@@ -139,8 +143,8 @@ pub(super) fn validate(s: &Settings) -> Result<(), Error> {
     if s.sizes.is_empty() {
         return bad("--sizes: give at least one size");
     }
-    if s.threads.is_empty() || s.threads.contains(&0) {
-        return bad("--threads: thread counts must be at least 1");
+    if s.threads.is_empty() || s.threads.iter().any(|n| !(1..=MAX_THREADS).contains(n)) {
+        return bad("--threads: thread counts must be 1 to 1024");
     }
     if s.rays == 0 {
         return bad("--rays must be at least 1");

@@ -22,7 +22,7 @@ use super::resume::{slug, state_path, Job};
 use super::settings::Settings;
 use super::{render_opts, runtime};
 use crate::accel::Accel;
-use crate::film::{self, Film, ToneMap};
+use crate::film::{Film, ToneMap};
 use crate::geometry::Vec3;
 use crate::render;
 use crate::Error;
@@ -179,8 +179,7 @@ pub(super) fn write_final_images(s: &Settings, jobs: &[Job]) -> Result<(), Error
                 .join("images")
                 .join(format!("{}.exr", slug(&job.config.name)));
             fs::create_dir_all(img.parent().unwrap()).map_err(runtime)?;
-            film.write_exr(&img).map_err(runtime)?;
-            film.write_png(&film::preview_path(&img), ToneMap::Filmic, 0.0)
+            film.write_exr_and_preview(&img, ToneMap::Filmic, 0.0)
                 .map_err(runtime)?;
         }
     }

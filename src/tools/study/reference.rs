@@ -153,8 +153,7 @@ pub(super) fn reference(
         &render_opts(s, s.reference_spp, ref_seed, s.reference, s.progress),
     )
     .map_err(runtime)?;
-    film.write_exr(&path).map_err(runtime)?;
-    film.write_png(&film::preview_path(&path), ToneMap::Filmic, 0.0)
+    film.write_exr_and_preview(&path, ToneMap::Filmic, 0.0)
         .map_err(runtime)?;
     info.seconds = stats.seconds;
     let text = format!(

@@ -58,8 +58,14 @@ impl Settings {
 /// if it exists, is a directory.
 pub(super) fn validate(s: &Settings) -> Result<(), Error> {
     let bad = |m: String| Err(Error::Input(m));
-    if s.threads == Some(0) {
-        return bad("--threads must be at least 1".into());
+    if let Some(n) = s
+        .threads
+        .filter(|n| !(1..=crate::render::MAX_THREADS).contains(n))
+    {
+        return bad(format!(
+            "--threads: {n} is not a thread count (1 to {})",
+            crate::render::MAX_THREADS
+        ));
     }
     if s.reference_spp == 0 || s.max_spp == 0 {
         return bad("sample counts must be at least 1".into());

@@ -60,8 +60,9 @@ pub(super) fn validate(s: &Settings) -> Result<(), Error> {
     if s.spp == 0 {
         return input("--spp must be at least 1".into());
     }
-    if s.threads.is_empty() || s.threads.contains(&0) {
-        return input("--threads: thread counts must be at least 1".into());
+    let max = crate::render::MAX_THREADS;
+    if s.threads.is_empty() || s.threads.iter().any(|n| !(1..=max).contains(n)) {
+        return input(format!("--threads: thread counts must be 1 to {max}"));
     }
     if s.backends.is_empty() {
         return input("no backend to measure".into());

@@ -1,0 +1,317 @@
+//! Hostile input through the real binary (issue 14): thread counts beyond
+//! any machine, outputs that cannot all be written, OBJ files that mix
+//! coloured and plain vertices, and special files (FIFOs, directories) given
+//! as the scene or a mesh. Each must end promptly with a clear error (exit 2
+//! for input, 1 for output) and leave nothing behind, or load.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const SCENE: &str = "[camera]\nlook_from = [0, 0, 3]\nlook_at = [0, 0, 0]\nresolution = [8, 8]\n\
+                     [render]\nspp = 1\n\
+                     [materials.white]\ntype = \"diffuse\"\nalbedo = [0.8, 0.8, 0.8]\n\
+                     [environment]\nradiance = [1, 1, 1]\n\
+                     [[shapes]]\ntype = \"quad\"\nmaterial = \"white\"\n";
+
+/// A scene with one OBJ shape, `mesh.obj` beside it.
+const OBJ_SCENE: &str =
+    "[camera]\nlook_from = [0, 0, 3]\nlook_at = [0, 0, 0]\nresolution = [8, 8]\n\
+                         [render]\nspp = 1\n\
+                         [materials.white]\ntype = \"diffuse\"\nalbedo = [0.8, 0.8, 0.8]\n\
+                         [environment]\nradiance = [1, 1, 1]\n\
+                         [[shapes]]\ntype = \"obj\"\nfile = \"mesh.obj\"\nmaterial = \"white\"\n";
+
+/// Runs `lucent ARGS`, killing it and failing the test if it has not ended
+/// within 10 s (a FIFO opened for reading blocks forever).
+fn lucent(args: &[&str]) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    loop {
+        if child.try_wait().unwrap().is_some() {
+            return child.wait_with_output().unwrap();
+        }
+        if start.elapsed() > Duration::from_secs(10) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("lucent {args:?} did not end within 10 s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+fn write_scene(dir: &Path, text: &str) -> PathBuf {
+    let p = dir.join("scene.toml");
+    fs::write(&p, text).unwrap();
+    p
+}
+
+fn mkfifo(path: &Path) {
+    let ok = Command::new("mkfifo").arg(path).status().unwrap().success();
+    assert!(ok, "mkfifo {}", path.display());
+}
+
+// --- (2) thread counts
+
+#[test]
+fn thread_counts_beyond_the_bound_are_rejected_before_anything_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path(), SCENE);
+    let exr = dir.path().join("out.exr");
+    for n in [
+        "100000",
+        "1025",
+        "18446744073709551615",
+        "18446744073709551616",
+        "0",
+    ] {
+        let o = lucent(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            exr.to_str().unwrap(),
+            "--quiet",
+            "--threads",
+            n,
+        ]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "--threads {n}: {e}");
+        assert!(e.contains("--threads") && e.contains("1 to 1024"), "{e}");
+        assert!(!exr.exists());
+        let o = lucent(&[
+            "study",
+            scene.to_str().unwrap(),
+            "-o",
+            dir.path().join("study").to_str().unwrap(),
+            "--threads",
+            n,
+        ]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "study --threads {n}: {e}");
+        assert!(e.contains("--threads") && e.contains("1 to 1024"), "{e}");
+    }
+    assert_eq!(names(dir.path()), ["scene.toml"]);
+    // the bound itself is accepted
+    let o = lucent(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--quiet",
+        "--threads",
+        "3",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn the_library_refuses_unbounded_thread_counts_too() {
+    use lucent::render::{self, RenderOptions, MAX_THREADS};
+    let scene = lucent::scene::load_str(SCENE, Path::new("mem.toml")).unwrap();
+    let accel = lucent::accel::build(&scene.meshes, lucent::accel::Backend::Bvh).unwrap();
+    for n in [MAX_THREADS + 1, usize::MAX] {
+        let opts = RenderOptions {
+            threads: Some(n),
+            ..RenderOptions::default()
+        };
+        let e = render::render(&scene, accel.as_ref(), &opts).unwrap_err();
+        assert!(e.is_input() && e.to_string().contains("1 to 1024"), "{e}");
+    }
+}
+
+// --- (4) outputs committed together
+
+#[test]
+fn an_unwritable_png_leaves_no_exr_and_keeps_the_previous_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path(), SCENE);
+    let exr = dir.path().join("out.exr");
+    // the preview's path is a directory: the PNG cannot be written
+    fs::create_dir(dir.path().join("out.png")).unwrap();
+    let o = lucent(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("out.png") && e.contains("directory"), "{e}");
+    assert_eq!(names(dir.path()), ["out.png", "scene.toml"]);
+    assert!(dir.path().join("out.png").is_dir());
+
+    // an EXR from an earlier render stays as it was
+    fs::write(&exr, b"earlier render").unwrap();
+    let o = lucent(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert_eq!(fs::read(&exr).unwrap(), b"earlier render");
+    assert_eq!(names(dir.path()), ["out.exr", "out.png", "scene.toml"]);
+}
+
+// --- (5) OBJ vertex colours
+
+#[test]
+fn obj_files_mixing_coloured_and_plain_vertices_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path(), OBJ_SCENE);
+    for obj in [
+        // some vertices coloured, some not
+        "v -1 -1 0 1 0 0\nv 1 -1 0\nv 1 1 0 0 0 1\nv -1 1 0\nf 1 2 3\nf 1 3 4\n",
+        // all coloured
+        "v -1 -1 0 1 0 0\nv 1 -1 0 0 1 0\nv 1 1 0 0 0 1\nv -1 1 0 1 1 1\nf 1 2 3\nf 1 3 4\n",
+        // coloured after plain, with a weight elsewhere
+        "v -1 -1 0\nv 1 -1 0 0.5 0.5 0.5\nv 2 2 0 2\nv -1 1 0\nf 1 2 3 4\n",
+    ] {
+        fs::write(dir.path().join("mesh.obj"), obj).unwrap();
+        let s = lucent::scene::load(&scene).unwrap_or_else(|e| panic!("{obj}: {e}"));
+        assert_eq!(s.triangle_count(), 2, "{obj}");
+        let m = &s.meshes[0];
+        assert_eq!(m.positions().len(), 4, "{obj}");
+        // positions, not colours: the square spans [-1, 1] in x and y
+        assert!(
+            m.positions()
+                .iter()
+                .all(|p| p.z.abs() < 1e-6 && p.x.abs() <= 1.0 + 1e-6 && p.y.abs() <= 1.0 + 1e-6),
+            "{obj}: {:?}",
+            m.positions()
+        );
+    }
+    let o = lucent(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        dir.path().join("out.exr").to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+// --- (7) special files
+
+#[test]
+fn a_fifo_as_the_scene_is_refused_promptly() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("scene.toml");
+    mkfifo(&fifo);
+    let exr = dir.path().join("out.exr");
+    let o = lucent(&[
+        "render",
+        fifo.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("scene.toml") && e.contains("not a regular file") && e.contains("FIFO"),
+        "{e}"
+    );
+    assert!(!exr.exists());
+    // through a symlink too (followed)
+    let link = dir.path().join("link.toml");
+    std::os::unix::fs::symlink(&fifo, &link).unwrap();
+    let o = lucent(&[
+        "render",
+        link.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("link.toml") && e.contains("FIFO"), "{e}");
+}
+
+#[test]
+fn a_fifo_as_an_obj_mesh_is_refused_promptly_at_its_scene_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path(), OBJ_SCENE);
+    mkfifo(&dir.path().join("mesh.obj"));
+    let exr = dir.path().join("out.exr");
+    let o = lucent(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    let line = OBJ_SCENE
+        .lines()
+        .position(|l| l.starts_with("file ="))
+        .unwrap()
+        + 1;
+    assert!(e.contains(&format!("scene.toml:{line}:")), "{e}");
+    assert!(
+        e.contains("shapes[0].file") && e.contains("mesh.obj") && e.contains("FIFO"),
+        "{e}"
+    );
+    assert!(!exr.exists());
+}
+
+#[test]
+fn a_directory_or_device_as_the_scene_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let sub = dir.path().join("scenes.toml");
+    fs::create_dir(&sub).unwrap();
+    let exr = dir.path().join("out.exr");
+    let o = lucent(&[
+        "render",
+        sub.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("scenes.toml") && e.contains("a directory"),
+        "{e}"
+    );
+    // /dev/zero never ends: refused without reading it
+    if Path::new("/dev/zero").exists() {
+        let o = lucent(&[
+            "render",
+            "/dev/zero",
+            "-o",
+            exr.to_str().unwrap(),
+            "--quiet",
+        ]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(
+            e.contains("/dev/zero") && e.contains("character device"),
+            "{e}"
+        );
+    }
+    assert!(!exr.exists());
+}
