@@ -308,7 +308,22 @@ fn run_render(
             stats.summary(accel.name())
         );
     }
+    report_rejected_rays(accel.as_ref());
     Ok(())
+}
+
+/// Says on stderr (even with `--quiet`: it means the image may be wrong)
+/// how many ray queries the backend refused as out of range, if any.
+fn report_rejected_rays(accel: &dyn accel::Accel) {
+    let n = accel.rejected_rays();
+    if n > 0 {
+        eprintln!(
+            "warning: {n} ray queries had a non-finite or out-of-range origin, direction or \
+             interval (beyond ±{:e}) and were answered as misses; the image may be missing \
+             light there (see \"Supported ranges\" in docs/scene-format.md)",
+            accel::MAX_RAY_COMPONENT
+        );
+    }
 }
 
 #[derive(clap::Args)]

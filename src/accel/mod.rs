@@ -12,6 +12,7 @@
 
 pub mod bvh;
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use crate::error::Error;
@@ -161,7 +162,65 @@ fn by_t(a: &Hit, b: &Hit) -> std::cmp::Ordering {
         .then(a.prim.cmp(&b.prim))
 }
 
+/// The largest |component| of a ray origin or direction a query accepts.
+///
+/// Embree 3 asserts `ray.valid()` on every query, which requires each
+/// origin and direction component to be at most `FLT_LARGE` = 1.844e18 in
+/// magnitude and tnear/tfar not NaN, and aborts the process otherwise. The
+/// scene loader keeps geometry within [`crate::scene::MAX_COORDINATE`], far
+/// inside this; the guard is the last line of defence, on both backends.
+pub const MAX_RAY_COMPONENT: f32 = 1.0e18;
+
+/// Whether a query on `ray` over [tmin, tmax] may reach a backend: origin
+/// and direction within ±[`MAX_RAY_COMPONENT`] (which excludes NaN and
+/// infinities) and neither end of the interval NaN (tmax may be +∞). Eight
+/// compares; an empty interval (tmin > tmax) is valid and simply misses.
+#[inline(always)]
+pub fn valid_query(ray: &Ray, tmin: f32, tmax: f32) -> bool {
+    let l = MAX_RAY_COMPONENT;
+    let (o, d) = (ray.o.abs(), ray.d.abs());
+    // `<=` is false for NaN, so a NaN component fails too.
+    o.x <= l
+        && o.y <= l
+        && o.z <= l
+        && d.x <= l
+        && d.y <= l
+        && d.z <= l
+        && !tmin.is_nan()
+        && !tmax.is_nan()
+}
+
+/// How many queries a backend refused (see [`valid_query`]): they were
+/// answered "no hit" / "not occluded" / no probe hits instead of reaching
+/// the traversal. Bumped only on the rare refusal, so it costs nothing on
+/// the hot path.
+#[derive(Debug, Default)]
+pub struct RejectedRays(AtomicU64);
+
+impl RejectedRays {
+    /// Counts one refused query.
+    #[cold]
+    #[inline(never)]
+    pub fn count(&self) {
+        self.0.fetch_add(1, Ordering::Relaxed);
+    }
+    pub fn get(&self) -> u64 {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+impl Clone for RejectedRays {
+    fn clone(&self) -> Self {
+        RejectedRays(AtomicU64::new(self.get()))
+    }
+}
+
 /// A ray-query backend built over the scene's meshes (mesh index = `geom`).
+///
+/// Every query first checks [`valid_query`]: a ray with a non-finite or
+/// out-of-range origin or direction, or a NaN interval end, never reaches
+/// the traversal (or Embree, which would abort the process); it misses and
+/// is counted in [`Accel::rejected_rays`].
 pub trait Accel: Send + Sync {
     /// Short name for logs and `lucent info` ("bvh", "embree").
     fn name(&self) -> &'static str;
@@ -175,6 +234,11 @@ pub trait Accel: Send + Sync {
     /// Every hit on mesh `geom` with t in [0, tmax], in one traversal; `out`
     /// is reset with `seed` first and finished (sorted by t) on return.
     fn hits_on_segment(&self, ray: &Ray, tmax: f32, geom: u32, seed: u32, out: &mut ProbeHits);
+
+    /// How many queries were refused by [`valid_query`] so far (answered
+    /// as misses). Non-zero means the scene produced rays outside the
+    /// supported range; the CLI reports it after the render.
+    fn rejected_rays(&self) -> u64;
 }
 
 /// Which backend to build.
@@ -228,3 +292,89 @@ pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>
 
 #[cfg(feature = "embree")]
 pub mod embree;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Vec3;
+    use crate::scene::shapes;
+
+    /// Queries the guard must refuse: NaN or huge origin, NaN or huge
+    /// direction, NaN interval ends. Each is a miss and is counted; the valid
+    /// rays around them still hit.
+    fn guard_turns_bad_rays_into_counted_misses(accel: &dyn Accel) {
+        // Off the quad's diagonal, so exactly one triangle is hit.
+        let good = Ray::new(Vec3::new(0.7, 0.1, 5.0), -Vec3::Z);
+        let mut probe = ProbeHits::new();
+        assert!(accel.intersect(&good, 0.0, f32::INFINITY).is_some());
+        assert!(accel.occluded(&good, 0.0, f32::INFINITY));
+        accel.hits_on_segment(&good, 10.0, 0, 1, &mut probe);
+        assert_eq!(probe.total(), 1);
+        assert_eq!(accel.rejected_rays(), 0);
+
+        let huge = 1e30;
+        let bad = [
+            (
+                Ray::new(Vec3::new(f32::NAN, 0.0, 5.0), -Vec3::Z),
+                0.0,
+                f32::INFINITY,
+            ),
+            (
+                Ray::new(Vec3::new(0.0, 0.0, huge), -Vec3::Z),
+                0.0,
+                f32::INFINITY,
+            ),
+            (
+                Ray::new(Vec3::new(0.0, 0.0, f32::INFINITY), -Vec3::Z),
+                0.0,
+                1.0,
+            ),
+            (
+                Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -huge)),
+                0.0,
+                1.0,
+            ),
+            (
+                Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(f32::NAN, 0.0, -1.0)),
+                0.0,
+                10.0,
+            ),
+            (good, f32::NAN, 10.0),
+            (good, 0.0, f32::NAN),
+        ];
+        for (i, (ray, tmin, tmax)) in bad.iter().enumerate() {
+            assert_eq!(accel.intersect(ray, *tmin, *tmax), None, "case {i}");
+            assert!(!accel.occluded(ray, *tmin, *tmax), "case {i}");
+            accel.hits_on_segment(ray, *tmax, 0, 1, &mut probe);
+            // A NaN tmin does not reach the probe query (it starts at 0).
+            if !tmin.is_nan() {
+                assert_eq!((probe.total(), probe.hits().len()), (0, 0), "case {i}");
+            }
+        }
+        // 7 intersect + 7 occluded + 6 probe queries (not the NaN-tmin one).
+        assert_eq!(accel.rejected_rays(), 20, "{}", accel.name());
+        // Just inside the bound is still a query (whatever it answers).
+        let far = Ray::new(Vec3::new(0.0, 0.0, MAX_RAY_COMPONENT), -Vec3::Z);
+        accel.occluded(&far, 0.0, f32::INFINITY);
+        assert_eq!(accel.rejected_rays(), 20);
+    }
+
+    fn quad() -> Arc<Vec<crate::geometry::Mesh>> {
+        Arc::new(vec![shapes::quad()])
+    }
+
+    #[test]
+    fn bvh_guard_turns_nan_and_huge_rays_into_counted_misses() {
+        let accel = build(&quad(), Backend::Bvh).unwrap();
+        guard_turns_bad_rays_into_counted_misses(accel.as_ref());
+    }
+
+    #[cfg(feature = "embree")]
+    #[test]
+    fn embree_guard_turns_nan_and_huge_rays_into_counted_misses() {
+        // Without the guard, the first bad ray aborts the test process
+        // inside Embree (its `ray.valid()` assertion).
+        let accel = build(&quad(), Backend::Embree).unwrap();
+        guard_turns_bad_rays_into_counted_misses(accel.as_ref());
+    }
+}

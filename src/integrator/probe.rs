@@ -138,6 +138,9 @@ mod tests {
         fn occluded(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
             self.intersect(ray, tmin, tmax).is_some()
         }
+        fn rejected_rays(&self) -> u64 {
+            0
+        }
         fn hits_on_segment(&self, ray: &Ray, tmax: f32, geom: u32, seed: u32, out: &mut ProbeHits) {
             out.reset(seed);
             let m = &self.meshes[geom as usize];

@@ -17,7 +17,7 @@ use super::checked::{Cx, Res};
 use super::format::{CameraDef, RenderDef, SceneFile, Spanned};
 use super::material::material;
 use super::objects::object;
-use super::{Camera, RenderSettings, Scene};
+use super::{show_point, Camera, RenderSettings, Scene, MAX_COORDINATE};
 use crate::error::InputError;
 use crate::geometry::Vec3;
 
@@ -97,7 +97,13 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
     let mut material_index = HashMap::new();
     for (name, m) in &def.materials {
         material_index.insert(name.as_str(), materials.len());
-        materials.push(material(cx, name, m, units_per_mm)?);
+        materials.push(material(
+            cx,
+            name,
+            m,
+            units_per_mm,
+            def.units_per_mm.as_ref(),
+        )?);
     }
 
     let scene_dir = cx.file.parent().unwrap_or(Path::new(""));
@@ -140,6 +146,22 @@ fn camera(cx: &Cx, c: &Spanned<CameraDef>) -> Res<Camera> {
     let resolution = cx.required(&d.resolution, Some(c.span()), "camera.resolution")?;
     let from = cx.vec3(look_from, "camera.look_from")?;
     let at = cx.vec3(look_at, "camera.look_at")?;
+    for (p, v, field) in [
+        (from, look_from, "camera.look_from"),
+        (at, look_at, "camera.look_at"),
+    ] {
+        if p.abs().max_element() > MAX_COORDINATE {
+            return Err(cx.err(
+                v.span(),
+                field,
+                format!(
+                    "{} is beyond ±{MAX_COORDINATE:e} scene units, the supported \
+                     range (see \"Supported ranges\" in docs/scene-format.md)",
+                    show_point(p.to_array())
+                ),
+            ));
+        }
+    }
     let up = match &d.up {
         Some(u) => cx.vec3(u, "camera.up")?,
         None => Vec3::Y,

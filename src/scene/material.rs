@@ -12,6 +12,7 @@ use std::sync::Arc;
 
 use super::checked::{Cx, Res};
 use super::format::{MaterialDef, MaterialKind, Spanned, Triple3};
+use super::MAX_SUBSURFACE_RADIUS;
 use crate::bssrdf::{
     ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler, SubsurfaceParams,
 };
@@ -48,6 +49,7 @@ pub(super) fn material(
     name: &str,
     m: &Spanned<MaterialDef>,
     units_per_mm: f32,
+    units_def: Option<&Spanned<f64>>,
 ) -> Res<Material> {
     let field = format!("materials.{name}");
     let d = m.get_ref();
@@ -88,9 +90,71 @@ pub(super) fn material(
                 flag(&d.specular),
             )
             .map_err(|e| locate_param(cx, &field, m, &e))?;
+            check_rmax(cx, &field, m, &ss, units_per_mm, units_def)?;
             Ok(Material::Subsurface(Arc::new(ss)))
         }
     }
+}
+
+/// Rejects a probe radius Rmax beyond [`MAX_SUBSURFACE_RADIUS`] scene
+/// units, blaming `units_per_mm` when the radius in millimetres would be in
+/// range (the scale made it too large), else the material's length key:
+/// `dmfp`, `sigma_a` (a small coefficient is a long path), the preset, or
+/// `rmax_quantile` when that is given.
+fn check_rmax(
+    cx: &Cx,
+    field: &str,
+    m: &Spanned<MaterialDef>,
+    ss: &Subsurface,
+    units_per_mm: f32,
+    units_def: Option<&Spanned<f64>>,
+) -> Res<()> {
+    let rmax = ss.probe.rmax();
+    let lim = MAX_SUBSURFACE_RADIUS;
+    if rmax <= lim {
+        return Ok(());
+    }
+    let why = format!(
+        "Rmax = {rmax:e} scene units, beyond {lim:e}, the supported range (see \
+         \"Supported ranges\" in docs/scene-format.md)"
+    );
+    let in_mm = rmax / units_per_mm as f64;
+    if let Some(u) = units_def {
+        if units_per_mm > 1.0 && in_mm <= lim {
+            return Err(cx.err(
+                u.span(),
+                "units_per_mm",
+                format!(
+                    "units_per_mm = {:e} makes the subsurface probe radius of material \
+                     `{}` {why}",
+                    u.get_ref(),
+                    field.trim_start_matches("materials.")
+                ),
+            ));
+        }
+    }
+    let d = m.get_ref();
+    let key = ["dmfp", "sigma_a", "preset", "rmax_quantile"]
+        .into_iter()
+        .find(|k| match *k {
+            "dmfp" => d.dmfp.is_some(),
+            "sigma_a" => d.sigma_a.is_some(),
+            "preset" => d.preset.is_some(),
+            _ => d.rmax_quantile.is_some(),
+        });
+    let span = key
+        .and_then(|k| {
+            d.present_keys()
+                .into_iter()
+                .find(|(p, _)| *p == k)
+                .map(|(_, s)| s)
+        })
+        .unwrap_or(m.span());
+    let f = match key {
+        Some(k) => format!("{field}.{k}"),
+        None => field.to_string(),
+    };
+    Err(cx.err(span, &f, format!("the subsurface probe radius is {why}")))
 }
 
 /// A boolean option, true when absent.

@@ -23,6 +23,32 @@ pub use load::{load, load_str};
 use crate::geometry::{Mesh, Vec3};
 use crate::materials::Material;
 
+/// The largest |coordinate| (scene units) of any vertex after its shape's
+/// transform, and of the camera's `look_from` and `look_at`: the loader
+/// rejects anything beyond. See "Supported ranges" in
+/// `docs/scene-format.md` for the reasons (f32 hit points, ray offsets and
+/// probe segments; Embree's limit of 1.844e18 on ray components).
+pub const MAX_COORDINATE: f32 = 1.0e7;
+
+/// The largest subsurface probe radius Rmax (scene units) the loader
+/// accepts: probe segments start up to Rmax away from a surface point and
+/// are 2·Rmax long, so this keeps them within a few times
+/// [`MAX_COORDINATE`].
+pub const MAX_SUBSURFACE_RADIUS: f64 = 1.0e7;
+
+/// `[x, y, z]` for messages: huge or tiny components in exponent form
+/// (`1e30`, not thirty zeros), others as written (`0`, `1.5`).
+pub(crate) fn show_point(p: [f32; 3]) -> String {
+    let one = |x: f32| {
+        if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+            format!("{x:e}")
+        } else {
+            format!("{x}")
+        }
+    };
+    format!("[{}, {}, {}]", one(p[0]), one(p[1]), one(p[2]))
+}
+
 /// Sample count, path depth and seed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {

@@ -96,6 +96,28 @@ pub fn load_obj(text: &str, path: &Path) -> Result<Mesh, InputError> {
     Ok(Mesh::new(positions, indices, normals))
 }
 
+/// The first `v` line of `text` (1-based) whose vertex (after the division
+/// by w) satisfies `pred`, with that vertex. The file must have passed
+/// [`load_obj`]'s checks.
+pub(super) fn first_vertex_where(text: &str, pred: impl Fn(Vec3) -> bool) -> Option<(usize, Vec3)> {
+    for (ln, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("v") {
+            continue;
+        }
+        let v: Vec<f32> = words.filter_map(|w| w.parse().ok()).collect();
+        if v.len() < 3 {
+            continue;
+        }
+        let w = if v.len() == 4 { v[3] } else { 1.0 };
+        let p = Vec3::new(v[0] / w, v[1] / w, v[2] / w);
+        if pred(p) {
+            return Some((ln + 1, p));
+        }
+    }
+    None
+}
+
 /// Checks the OBJ statements `tobj` would trust: numbers in `v`/`vt`/`vn`
 /// lines must parse and be finite, and every face index must be non-zero
 /// and refer to an element defined before it. Returns (line, message).

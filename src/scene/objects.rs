@@ -4,13 +4,14 @@
 //! emission.
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::checked::{Cx, Res};
 use super::format::{Numbers, ShapeDef, ShapeKind, Spanned};
-use super::obj::load_obj;
+use super::obj::{first_vertex_where, load_obj};
 use super::transform::Transform;
-use super::{shapes, Object};
+use super::{shapes, show_point, Object, MAX_COORDINATE};
+use crate::error::InputError;
 use crate::geometry::{Mesh, Vec3};
 
 /// Highest accepted `subdivisions` for spheres: 20·4⁹ ≈ 5.2 M triangles.
@@ -48,8 +49,10 @@ pub(super) fn object(
         }
         None => None,
     };
-    let mut mesh = shape_mesh(cx, dir, &field, s)?;
-    transform(cx, &field, sd)?.apply(&mut mesh);
+    let (mut mesh, source) = shape_mesh(cx, dir, &field, s)?;
+    let tf = transform(cx, &field, sd)?;
+    tf.apply(&mut mesh);
+    check_range(cx, &field, s, &mesh, &tf, source.as_ref())?;
     let object = Object {
         name: sd.name.clone().unwrap_or(field),
         material: mat,
@@ -58,9 +61,90 @@ pub(super) fn object(
     Ok((mesh, object))
 }
 
-/// The mesh of shape `field` (entry `s`) before its transform; OBJ paths
-/// are relative to `dir`.
-fn shape_mesh(cx: &Cx, dir: &Path, field: &str, s: &Spanned<ShapeDef>) -> Res<Mesh> {
+/// An OBJ file's path and text, kept to locate an out-of-range vertex.
+struct ObjSource {
+    path: PathBuf,
+    text: String,
+}
+
+/// Rejects a shape with a vertex beyond ±[`MAX_COORDINATE`] after its
+/// transform, blaming what put it there: the `translate` if it is out of
+/// range by itself, else the OBJ file's first `v` line that lands out of
+/// range if it is out of range as written, else the `scale` (or the
+/// `rotate`, with no scale).
+fn check_range(
+    cx: &Cx,
+    field: &str,
+    s: &Spanned<ShapeDef>,
+    mesh: &Mesh,
+    tf: &Transform,
+    source: Option<&ObjSource>,
+) -> Res<()> {
+    let lim = MAX_COORDINATE;
+    let out = |p: Vec3| !(p.x.abs() <= lim && p.y.abs() <= lim && p.z.abs() <= lim);
+    let Some(&p) = mesh.positions().iter().find(|&&p| out(p)) else {
+        return Ok(());
+    };
+    let d = s.get_ref();
+    let range = format!(
+        "beyond ±{lim:e} scene units, the supported range (see \"Supported ranges\" in \
+         docs/scene-format.md)"
+    );
+    let placed = format!(
+        "a vertex of this shape lands at {} after the transform, {range}",
+        show_point(p.to_array())
+    );
+    if let Some(t) = &d.translate {
+        if t.get_ref().iter().any(|x| x.abs() > lim as f64) {
+            return Err(cx.err(
+                t.span(),
+                &format!("{field}.translate"),
+                format!(
+                    "translate {} is {range}",
+                    show_point(t.get_ref().map(|x| x as f32))
+                ),
+            ));
+        }
+    }
+    if let Some(src) = source {
+        match first_vertex_where(&src.text, |v| out(tf.point(v))) {
+            Some((line, v)) if out(v) => {
+                return Err(InputError::new(
+                    &src.path,
+                    format!(
+                        "vertex {} is {range} (as written, and after the transform of `{field}` \
+                         in {})",
+                        show_point(v.to_array()),
+                        cx.file.display()
+                    ),
+                )
+                .at_line(line));
+            }
+            _ => {}
+        }
+    }
+    let (span, key) = match (&d.scale, &d.rotate, &d.translate) {
+        (Some(sc), _, _) => (sc.span(), "scale"),
+        (None, Some(r), _) if !r.is_empty() => (r[0].span(), "rotate"),
+        (None, _, Some(t)) => (t.span(), "translate"),
+        _ => (s.span(), ""),
+    };
+    let f = if key.is_empty() {
+        field.to_string()
+    } else {
+        format!("{field}.{key}")
+    };
+    Err(cx.err(span, &f, placed))
+}
+
+/// The mesh of shape `field` (entry `s`) before its transform, with the
+/// OBJ file it came from; OBJ paths are relative to `dir`.
+fn shape_mesh(
+    cx: &Cx,
+    dir: &Path,
+    field: &str,
+    s: &Spanned<ShapeDef>,
+) -> Res<(Mesh, Option<ObjSource>)> {
     let d = s.get_ref();
     let kind = *cx
         .required(&d.kind, Some(s.span()), &format!("{field}.type"))?
@@ -92,7 +176,7 @@ fn shape_mesh(cx: &Cx, dir: &Path, field: &str, s: &Spanned<ShapeDef>) -> Res<Me
             if d.smooth.as_ref().is_some_and(|b| *b.get_ref()) && mesh.normals.is_none() {
                 mesh.compute_smooth_normals();
             }
-            Ok(mesh)
+            Ok((mesh, Some(ObjSource { path, text })))
         }
         ShapeKind::Sphere => {
             let level = match &d.subdivisions {
@@ -109,10 +193,10 @@ fn shape_mesh(cx: &Cx, dir: &Path, field: &str, s: &Spanned<ShapeDef>) -> Res<Me
                 Some(l) => *l.get_ref(),
                 None => 4,
             };
-            Ok(shapes::sphere(level))
+            Ok((shapes::sphere(level), None))
         }
-        ShapeKind::Quad => Ok(shapes::quad()),
-        ShapeKind::Box => Ok(shapes::cuboid()),
+        ShapeKind::Quad => Ok((shapes::quad(), None)),
+        ShapeKind::Box => Ok((shapes::cuboid(), None)),
     }
 }
 

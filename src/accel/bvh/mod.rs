@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use self::build::{PrimRef, Tree, PAD};
 use self::traverse::{traverse, RayBox, Visit};
 use self::triangle::{RayTri, Tri4};
-use super::{Accel, Hit, ProbeHits};
+use super::{valid_query, Accel, Hit, ProbeHits, RejectedRays};
 use crate::geometry::{Mesh, Ray};
 
 /// Most triangles per leaf (two packets); the SAH usually stops earlier.
@@ -91,6 +91,8 @@ pub struct Bvh {
     /// to mesh indices.
     top: Tree,
     meshes: Vec<MeshBvh>,
+    /// Queries refused by [`valid_query`].
+    rejected: RejectedRays,
 }
 
 impl Bvh {
@@ -112,6 +114,7 @@ impl Bvh {
         Bvh {
             top: build::build(prims, 1, 1),
             meshes: built,
+            rejected: RejectedRays::default(),
         }
     }
 
@@ -125,20 +128,19 @@ impl Bvh {
     }
 }
 
-/// Rays the traversal should not see: NaN or infinite origin or
-/// direction (NaN slab distances would make every box look hit).
-#[inline(always)]
-fn bad_ray(ray: &Ray) -> bool {
-    !(ray.o.is_finite() && ray.d.is_finite())
-}
-
 impl Accel for Bvh {
     fn name(&self) -> &'static str {
         "bvh"
     }
 
     fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        if bad_ray(ray) || tmin.is_nan() || tmax.is_nan() || tmin > tmax {
+        // NaN or huge components would make NaN slab distances, and every
+        // box would look hit.
+        if !valid_query(ray, tmin, tmax) {
+            self.rejected.count();
+            return None;
+        }
+        if tmin > tmax {
             return None;
         }
         let rb = RayBox::new(ray);
@@ -174,7 +176,11 @@ impl Accel for Bvh {
     }
 
     fn occluded(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        if bad_ray(ray) || tmin.is_nan() || tmax.is_nan() || tmin > tmax {
+        if !valid_query(ray, tmin, tmax) {
+            self.rejected.count();
+            return false;
+        }
+        if tmin > tmax {
             return false;
         }
         let rb = RayBox::new(ray);
@@ -203,8 +209,13 @@ impl Accel for Bvh {
 
     fn hits_on_segment(&self, ray: &Ray, tmax: f32, geom: u32, seed: u32, out: &mut ProbeHits) {
         out.reset(seed);
+        if !valid_query(ray, 0.0, tmax) {
+            self.rejected.count();
+            out.finish();
+            return;
+        }
         if let Some(m) = self.meshes.get(geom as usize) {
-            if !bad_ray(ray) && tmax >= 0.0 {
+            if tmax >= 0.0 {
                 let rb = RayBox::new(ray);
                 let rt = RayTri::new(ray);
                 let mut t = tmax;
@@ -229,6 +240,10 @@ impl Accel for Bvh {
             }
         }
         out.finish();
+    }
+
+    fn rejected_rays(&self) -> u64 {
+        self.rejected.get()
     }
 }
 
@@ -355,7 +370,11 @@ mod tests {
         let mesh = deep_mesh(n);
         let bvh = Bvh::build(std::slice::from_ref(&mesh));
         let depth = bvh.stats()[0].1;
-        let far = RATIO.powi(n as i32) * 2.0;
+        // Rays from the far end start at the largest origin a query accepts
+        // (beyond it they are refused as misses, see `valid_query`); they
+        // still cross the levels below it from the other side.
+        let far = crate::accel::MAX_RAY_COMPONENT;
+        assert!(far < RATIO.powi(n as i32));
         let mut rng = crate::sampling::Rng::from_key(3);
         let mut deepest = 0;
         for i in 0..300 {

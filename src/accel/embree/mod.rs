@@ -18,7 +18,7 @@ use std::ptr;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use super::{Accel, Hit, ProbeHits};
+use super::{valid_query, Accel, Hit, ProbeHits, RejectedRays};
 use crate::error::Error;
 use crate::geometry::{Mesh, Ray, Vec3};
 
@@ -212,6 +212,9 @@ pub struct EmbreeAccel {
     scene: Scene,
     device: Device,
     meshes: Arc<Vec<Mesh>>,
+    /// Queries refused by [`valid_query`] before they reached Embree
+    /// (whose `ray.valid()` assertion would abort the process).
+    rejected: RejectedRays,
 }
 
 // SAFETY: after `build` commits the scene, nothing modifies it: `&self`
@@ -360,6 +363,7 @@ impl EmbreeAccel {
             scene,
             device,
             meshes: Arc::clone(meshes),
+            rejected: RejectedRays::default(),
         })
     }
 
@@ -465,6 +469,10 @@ impl Accel for EmbreeAccel {
     }
 
     fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
+        if !valid_query(ray, tmin, tmax) {
+            self.rejected.count();
+            return None;
+        }
         let mut ctx = ffi::RTCIntersectContext::new();
         let mut rh = make_rayhit(ray, tmin, tmax);
         // SAFETY: the scene is committed (thread-safe queries); ctx and rh
@@ -480,6 +488,10 @@ impl Accel for EmbreeAccel {
     }
 
     fn occluded(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
+        if !valid_query(ray, tmin, tmax) {
+            self.rejected.count();
+            return false;
+        }
         let mut ctx = ffi::RTCIntersectContext::new();
         let mut r = make_ray(ray, tmin, tmax);
         // SAFETY: as in `intersect`.
@@ -490,6 +502,11 @@ impl Accel for EmbreeAccel {
 
     fn hits_on_segment(&self, ray: &Ray, tmax: f32, geom: u32, seed: u32, out: &mut ProbeHits) {
         out.reset(seed);
+        if !valid_query(ray, 0.0, tmax) {
+            self.rejected.count();
+            out.finish();
+            return;
+        }
         let mut pc = ProbeContext {
             ctx: ffi::RTCIntersectContext {
                 filter: Some(probe_filter),
@@ -508,5 +525,9 @@ impl Accel for EmbreeAccel {
         // `probe_filter`). `out` is not used until the call returns.
         unsafe { ffi::rtcIntersect1(self.scene.raw, ctx, &mut rh) };
         out.finish();
+    }
+
+    fn rejected_rays(&self) -> u64 {
+        self.rejected.get()
     }
 }

@@ -131,4 +131,8 @@ impl Accel for Recorder<'_> {
         };
         self.log(rec, Answer::Probe(out));
     }
+
+    fn rejected_rays(&self) -> u64 {
+        self.inner.rejected_rays()
+    }
 }
