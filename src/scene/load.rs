@@ -17,6 +17,7 @@ use super::checked::{Cx, Res};
 use super::format::{CameraDef, RenderDef, SceneFile, Spanned};
 use super::material::material;
 use super::objects::object;
+pub use super::regular_file::read_regular_file;
 use super::{show_point, Camera, RenderSettings, Scene, MAX_COORDINATE};
 use crate::error::InputError;
 use crate::geometry::Vec3;
@@ -32,46 +33,6 @@ pub fn load(path: &Path) -> Result<Scene, InputError> {
     let text = read_regular_file(path)
         .map_err(|e| InputError::new(path, format!("cannot read scene file: {e}")))?;
     load_str(&text, path)
-}
-
-/// Reads a text file that must be a regular file (symlinks followed): a
-/// FIFO, a character device such as `/dev/zero` or a socket would block or
-/// never end, and a directory cannot be read, so each is refused before it
-/// is opened, by what it is ("not a regular file: it is a FIFO").
-pub fn read_regular_file(path: &Path) -> std::io::Result<String> {
-    let meta = std::fs::metadata(path)?;
-    if !meta.is_file() {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            format!("not a regular file: it is {}", file_kind(&meta.file_type())),
-        ));
-    }
-    std::fs::read_to_string(path)
-}
-
-/// What a file that is not a regular file is, for messages.
-fn file_kind(t: &std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO";
-        }
-        if t.is_char_device() {
-            return "a character device";
-        }
-        if t.is_block_device() {
-            return "a block device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_dir() {
-        "a directory"
-    } else {
-        "a special file"
-    }
 }
 
 /// Loads a scene from `text`; `path` names it in errors and is where

@@ -11,6 +11,7 @@ pub mod load;
 mod material;
 pub mod obj;
 mod objects;
+mod regular_file;
 pub mod shapes;
 pub mod transform;
 

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use super::checked::{Cx, Res};
 use super::format::{Numbers, ShapeDef, ShapeKind, Spanned};
 use super::obj::{first_vertex_where, load_obj};
+use super::regular_file::read_regular_file;
 use super::transform::Transform;
 use super::{shapes, show_point, Object, MAX_COORDINATE};
 use crate::error::InputError;
@@ -165,7 +166,7 @@ fn shape_mesh(
                 ));
             };
             let path = dir.join(f.get_ref());
-            let text = super::load::read_regular_file(&path).map_err(|e| {
+            let text = read_regular_file(&path).map_err(|e| {
                 cx.err(
                     f.span(),
                     &format!("{field}.file"),
