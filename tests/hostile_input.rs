@@ -47,6 +47,17 @@ fn lucent(args: &[&str]) -> Output {
     }
 }
 
+/// `lucent render SCENE -o EXR --quiet`.
+fn render_scene(scene: &Path, exr: &Path) -> Output {
+    lucent(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--quiet",
+    ])
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -148,13 +159,7 @@ fn an_unwritable_png_leaves_no_exr_and_keeps_the_previous_one() {
     let exr = dir.path().join("out.exr");
     // the preview's path is a directory: the PNG cannot be written
     fs::create_dir(dir.path().join("out.png")).unwrap();
-    let o = lucent(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        exr.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = render_scene(&scene, &exr);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{e}");
     assert!(e.contains("out.png") && e.contains("directory"), "{e}");
@@ -163,13 +168,7 @@ fn an_unwritable_png_leaves_no_exr_and_keeps_the_previous_one() {
 
     // an EXR from an earlier render stays as it was
     fs::write(&exr, b"earlier render").unwrap();
-    let o = lucent(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        exr.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = render_scene(&scene, &exr);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert_eq!(fs::read(&exr).unwrap(), b"earlier render");
     assert_eq!(names(dir.path()), ["out.exr", "out.png", "scene.toml"]);
@@ -203,13 +202,7 @@ fn obj_files_mixing_coloured_and_plain_vertices_load() {
             m.positions()
         );
     }
-    let o = lucent(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        dir.path().join("out.exr").to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = render_scene(&scene, &dir.path().join("out.exr"));
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
@@ -221,13 +214,7 @@ fn a_fifo_as_the_scene_is_refused_promptly() {
     let fifo = dir.path().join("scene.toml");
     mkfifo(&fifo);
     let exr = dir.path().join("out.exr");
-    let o = lucent(&[
-        "render",
-        fifo.to_str().unwrap(),
-        "-o",
-        exr.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = render_scene(&fifo, &exr);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(
@@ -238,13 +225,7 @@ fn a_fifo_as_the_scene_is_refused_promptly() {
     // through a symlink too (followed)
     let link = dir.path().join("link.toml");
     std::os::unix::fs::symlink(&fifo, &link).unwrap();
-    let o = lucent(&[
-        "render",
-        link.to_str().unwrap(),
-        "-o",
-        exr.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = render_scene(&link, &exr);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(e.contains("link.toml") && e.contains("FIFO"), "{e}");
@@ -256,13 +237,7 @@ fn a_fifo_as_an_obj_mesh_is_refused_promptly_at_its_scene_line() {
     let scene = write_scene(dir.path(), OBJ_SCENE);
     mkfifo(&dir.path().join("mesh.obj"));
     let exr = dir.path().join("out.exr");
-    let o = lucent(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        exr.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = render_scene(&scene, &exr);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{e}");
     let line = OBJ_SCENE
@@ -284,13 +259,7 @@ fn a_directory_or_device_as_the_scene_is_refused() {
     let sub = dir.path().join("scenes.toml");
     fs::create_dir(&sub).unwrap();
     let exr = dir.path().join("out.exr");
-    let o = lucent(&[
-        "render",
-        sub.to_str().unwrap(),
-        "-o",
-        exr.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = render_scene(&sub, &exr);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(
