@@ -93,7 +93,7 @@ fn probes(c: &mut Criterion) {
         let a = deg.to_radians();
         let frame =
             Frame::from_normal(Vec3::new(a.sin() * 0.6, a.sin() * 0.8, a.cos()).normalize());
-        for axes in [ProbeAxes::Normal, ProbeAxes::Mis3] {
+        for axes in ProbeAxes::ALL {
             for channel in [ChannelStrategy::Single, ChannelStrategy::Mis] {
                 for (name, radius) in samplers() {
                     let opts = ProbeOptions {
@@ -110,7 +110,7 @@ fn probes(c: &mut Criterion) {
                             let mut acc = Vec3::ZERO;
                             for u in &us {
                                 if let Some(ps) =
-                                    sample_entry(&s, xo, &frame, u, &target, &mut hits)
+                                    sample_entry(&s, xo, &frame, 0.0, u, &target, &mut hits)
                                 {
                                     acc += ps.weight;
                                 }

@@ -110,7 +110,8 @@ struct SubsurfaceArgs {
     /// Probe sphere radius as a quantile of the widest channel's profile, in (0, 1).
     #[arg(long)]
     rmax_quantile: Option<f64>,
-    /// Probe axes: normal (the seed) | mis3 (N/T/B with MIS).
+    /// Probe axes: curvature (N/T/B with MIS, T/B probabilities from the
+    /// curvature) | normal (the seed) | mis3 (N/T/B at ½, ¼, ¼ with MIS).
     #[arg(long, value_enum)]
     axes: Option<AxesArg>,
     /// Channel choice: single (the seed) | mis (all channels, balance heuristic).
@@ -129,6 +130,7 @@ struct SubsurfaceArgs {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum AxesArg {
+    Curvature,
     Normal,
     Mis3,
 }
@@ -149,6 +151,7 @@ impl SubsurfaceArgs {
             radius: self.radius,
             rmax_quantile: self.rmax_quantile,
             axes: self.axes.map(|a| match a {
+                AxesArg::Curvature => ProbeAxes::Curvature,
                 AxesArg::Normal => ProbeAxes::Normal,
                 AxesArg::Mis3 => ProbeAxes::Mis3,
             }),

@@ -459,6 +459,7 @@ fn grazing_probe_hits_on_a_thin_wedge() {
                             &s,
                             xo,
                             &frame,
+                            0.0,
                             &u,
                             &target(acc.as_ref(), &mesh),
                             &mut hits,
@@ -574,6 +575,7 @@ fn probes_that_find_nothing_on_geometry_thinner_than_d() {
                 &s,
                 xo,
                 &Frame::from_normal(Vec3::Y),
+                0.0,
                 &u,
                 &target(acc.as_ref(), &thin),
                 &mut hits,
@@ -710,9 +712,15 @@ fn extreme_random_numbers_through_the_probe_sampler() {
                         hit: x(4),
                         seed: if bits >> 5 & 1 == 1 { u32::MAX } else { 0 },
                     };
-                    if let Some(ps) =
-                        sample_entry(&s, xo, &frame, &u, &target(acc.as_ref(), &mesh), &mut hits)
-                    {
+                    if let Some(ps) = sample_entry(
+                        &s,
+                        xo,
+                        &frame,
+                        0.0,
+                        &u,
+                        &target(acc.as_ref(), &mesh),
+                        &mut hits,
+                    ) {
                         found += 1;
                         assert!(
                             ps.weight.is_finite() && ps.weight.min_element() >= 0.0,
@@ -920,9 +928,15 @@ fn degenerate_triangles_are_harmless() {
                 let frame = Frame::from_normal(dirty.normals.as_ref().unwrap()[v]);
                 for _ in 0..50 {
                     let u = ProbeRandoms::from_rng(&mut rng);
-                    if let Some(ps) =
-                        sample_entry(&s, xo, &frame, &u, &target(acc.as_ref(), &dirty), &mut hits)
-                    {
+                    if let Some(ps) = sample_entry(
+                        &s,
+                        xo,
+                        &frame,
+                        0.0,
+                        &u,
+                        &target(acc.as_ref(), &dirty),
+                        &mut hits,
+                    ) {
                         found += 1;
                         assert!(
                             ps.weight.is_finite() && ps.weight.min_element() >= 0.0,

@@ -416,7 +416,7 @@ fn cases() -> Vec<Case> {
         case(
             "subsurface bad axes",
             format!("{CAM}{SSS}preset = \"skin1\"\naxes = \"tangent\"\n"),
-            "expected \"normal\" or \"mis3\", found \"tangent\"",
+            "expected \"curvature\", \"normal\" or \"mis3\", found \"tangent\"",
             Some("tangent"),
             Some("materials.skin.axes"),
         ),

@@ -23,6 +23,23 @@
 //!   exact samplers: the weight of one hit is at most
 //!   4√3 · n_active · A / CDF(Rmax)^(renormalize) (× total), independent of
 //!   the geometry.
+//! - [`ProbeAxes::Curvature`] (the default): N, T, B with probabilities
+//!   1 − 2ε, ε, ε and the same balance heuristic, ε a function of κ·d at xo
+//!   ([`tangent_probability`]), κ the surface's curvature there (the
+//!   integrator reads it from the shading normals of xo's triangle) and d
+//!   the widest channel's. Why: where d·κ is small the profile's mass lies
+//!   on a nearly flat surface, which probes along T and B almost never
+//!   meet; mis3 spends half its probes there and doubles the weight of the
+//!   other half, so its variance on a smooth convex body is several times
+//!   normal-only's. Where the surface turns within the profile (d·κ ≳ 1,
+//!   and thin or small objects) T and B are what bound the weights, and ε
+//!   rises to mis3's ¼. ε depends on xo alone, so sampling and density use
+//!   the same probabilities and the estimator stays exact. Since ε ≥ ε_min
+//!   = [`TANGENT_PROB_MIN`] and 1 − 2ε ≥ ½, the argument above bounds the
+//!   weight of one hit by
+//!   (√3/ε_min) · n_active · A / CDF(Rmax)^(renormalize) (× total)
+//!   (√3/0.02 ≈ 86.6 against mis3's 4√3 ≈ 6.9), for any geometry: larger
+//!   than mis3's, but finite, where normal-only's is not.
 //! - [`ChannelStrategy::Single`]: pick one active channel uniformly and
 //!   estimate only it (the others get 0 from this sample) — the seed.
 //! - [`ChannelStrategy::Mis`]: pick a channel uniformly, estimate all of them
@@ -50,8 +67,79 @@ pub enum ProbeAxes {
     /// Along the shading normal only (the seed).
     Normal,
     /// N, T, B with probabilities ½, ¼, ¼ and the balance heuristic.
-    #[default]
     Mis3,
+    /// N, T, B with probabilities 1 − 2ε, ε, ε and the balance heuristic,
+    /// ε = [`tangent_probability`] of the curvature at xo times the widest
+    /// channel's d: ε_min where the profile sees a flat surface, ¼ (mis3)
+    /// where it wraps around the surface.
+    #[default]
+    Curvature,
+}
+
+impl ProbeAxes {
+    pub const ALL: [ProbeAxes; 3] = [ProbeAxes::Normal, ProbeAxes::Mis3, ProbeAxes::Curvature];
+
+    /// The name the scene format and the command line use.
+    pub fn name(self) -> &'static str {
+        match self {
+            ProbeAxes::Normal => "normal",
+            ProbeAxes::Mis3 => "mis3",
+            ProbeAxes::Curvature => "curvature",
+        }
+    }
+
+    /// G in the bound G · n_active · A / CDF(Rmax)^(renormalize) on the
+    /// weight of one hit (before the hit count; module docs): 4√3 for
+    /// mis3, √3/ε_min for curvature; None for normal-only, whose weights
+    /// grow without bound at grazing hits.
+    pub fn weight_bound(self) -> Option<f64> {
+        match self {
+            ProbeAxes::Normal => None,
+            ProbeAxes::Mis3 => Some(3f64.sqrt() / 0.25),
+            ProbeAxes::Curvature => Some(3f64.sqrt() / TANGENT_PROB_MIN),
+        }
+    }
+
+    /// The variant named `s` (case-insensitive).
+    pub fn parse(s: &str) -> Option<ProbeAxes> {
+        ProbeAxes::ALL
+            .into_iter()
+            .find(|a| a.name().eq_ignore_ascii_case(s))
+    }
+}
+
+/// The smallest probability of each tangent axis under
+/// [`ProbeAxes::Curvature`]: it keeps every surface within Rmax reachable
+/// (so the estimator stays unbiased on any geometry) and bounds the weight
+/// of a hit by (√3/ε_min)·n_active·A (module docs).
+pub const TANGENT_PROB_MIN: f64 = 0.02;
+
+/// κ·d at and beyond which [`ProbeAxes::Curvature`] uses mis3's ¼.
+pub const TANGENT_PROB_FULL_AT: f64 = 1.0;
+
+/// The probability ε of each of T and B under [`ProbeAxes::Curvature`] at
+/// an exit point where the surface's curvature times the widest channel's d
+/// is `kd` (≥ 0):
+///
+///   ε = ε_min + (¼ − ε_min) · exp(−(π/6)(1/kd − 1/kd_full)),  kd < kd_full,
+///
+/// and ¼ beyond kd_full = [`TANGENT_PROB_FULL_AT`]. exp(−π/(6 kd)) is the
+/// slow lobe e^{−r/3d} of R at arc length r = π/(2κ), where a sphere of
+/// curvature κ has turned 90° from xo and probes along N meet it edge-on:
+/// the share of the profile that only T and B probes reach well. It is
+/// negligible on a smooth body (e^{−6} at kd = 0.087, a 10 mm marble
+/// sphere) and reaches ¼ where the profile wraps around the surface
+/// (scenes/grazing.toml: kd ≈ 1.2). A NaN kd gives ¼, the robust end.
+pub fn tangent_probability(kd: f64) -> f64 {
+    let (min, full) = (TANGENT_PROB_MIN, TANGENT_PROB_FULL_AT);
+    if kd.is_nan() || kd >= full {
+        return 0.25;
+    }
+    if kd <= 0.0 {
+        return min;
+    }
+    let s = (-(std::f64::consts::PI / 6.0) * (1.0 / kd - 1.0 / full)).exp();
+    min + (0.25 - min) * s
 }
 
 /// How the color channels share one probe sample.
@@ -79,7 +167,7 @@ pub struct ProbeOptions {
 impl Default for ProbeOptions {
     fn default() -> Self {
         ProbeOptions {
-            axes: ProbeAxes::Mis3,
+            axes: ProbeAxes::Curvature,
             channel: ChannelStrategy::Mis,
             radius: RadiusSampler::Analytic,
             rmax_quantile: 0.999,
@@ -162,6 +250,8 @@ pub struct ProbeSegment {
     /// The exit point xo and its shading frame.
     xo: Vec3,
     frame: Frame,
+    /// The axis probabilities P(a) at xo (T, B, N).
+    probs: [f64; 3],
     /// The channel the radius was sampled for.
     channel: usize,
 }
@@ -206,6 +296,8 @@ pub struct ProbeSampler {
     active: [usize; 3],
     n_active: usize,
     rmax: f64,
+    /// The widest active channel's d: the length curvature is measured in.
+    d_max: f64,
     /// p(xi) and Rd at an entry point.
     density: ProbeDensity,
 }
@@ -245,6 +337,7 @@ impl ProbeSampler {
             active,
             n_active,
             rmax,
+            d_max: params.max_active_d(),
             density,
         })
     }
@@ -276,21 +369,35 @@ impl ProbeSampler {
         })
     }
 
-    /// Axis probabilities (T, B, N).
+    /// Axis probabilities (T, B, N) at an exit point where the surface's
+    /// curvature is `curvature` (1/scene units, ≥ 0; only
+    /// [`ProbeAxes::Curvature`] reads it).
     #[inline]
-    fn axis_probs(&self) -> [f64; 3] {
+    pub fn axis_probs(&self, curvature: f32) -> [f64; 3] {
         match self.opts.axes {
             ProbeAxes::Normal => [0.0, 0.0, 1.0],
             ProbeAxes::Mis3 => [0.25, 0.25, 0.5],
+            ProbeAxes::Curvature => {
+                let e = tangent_probability(curvature as f64 * self.d_max);
+                [e, e, 1.0 - 2.0 * e]
+            }
         }
     }
 
-    /// Samples a probe for exit point `xo` with shading frame `frame`
-    /// (pbrt-v4 `SampleSp`): a channel c, a radius r from its disk density,
-    /// an axis V and an angle φ; the probe runs along −V through
-    /// xo + r(cos φ T' + sin φ B') (T', B' span the plane ⟂ V) across the
-    /// sphere of radius Rmax. None when no channel is active.
-    pub fn sample_probe(&self, xo: Vec3, frame: &Frame, u: &ProbeRandoms) -> Option<ProbeSegment> {
+    /// Samples a probe for exit point `xo` with shading frame `frame`, where
+    /// the surface's curvature is `curvature` (1/scene units; see
+    /// [`axis_probs`](Self::axis_probs)) (pbrt-v4 `SampleSp`): a channel c, a
+    /// radius r from its disk density, an axis V and an angle φ; the probe
+    /// runs along −V through xo + r(cos φ T' + sin φ B') (T', B' span the
+    /// plane ⟂ V) across the sphere of radius Rmax. None when no channel is
+    /// active.
+    pub fn sample_probe(
+        &self,
+        xo: Vec3,
+        frame: &Frame,
+        curvature: f32,
+        u: &ProbeRandoms,
+    ) -> Option<ProbeSegment> {
         if self.n_active == 0 {
             return None;
         }
@@ -300,17 +407,14 @@ impl ProbeSampler {
         let dist = self.dists[channel].as_ref()?;
         let r = dist.sample_radius(u.radius);
         let (t, b, n) = (frame.t.as_dvec3(), frame.b.as_dvec3(), frame.n.as_dvec3());
-        let axis = match self.opts.axes {
-            ProbeAxes::Normal => AXIS_N,
-            ProbeAxes::Mis3 => {
-                if u.axis < 0.5 {
-                    AXIS_N
-                } else if u.axis < 0.75 {
-                    0
-                } else {
-                    1
-                }
-            }
+        // N below P(N), then T, then B (for mis3: ½, ¼, ¼ as before).
+        let probs = self.axis_probs(curvature);
+        let axis = if u.axis < probs[AXIS_N] {
+            AXIS_N
+        } else if u.axis < probs[AXIS_N] + probs[0] {
+            0
+        } else {
+            1
         };
         let (v, t1, t2) = match axis {
             0 => (t, b, n),
@@ -328,6 +432,7 @@ impl ProbeSampler {
             t_max: (2.0 * h) as f32,
             xo,
             frame: *frame,
+            probs,
             channel,
         })
     }
@@ -359,7 +464,7 @@ impl ProbeSampler {
         let xi = seg.ray.o.as_dvec3() + seg.ray.d.as_dvec3() * t as f64;
         let d = xi - seg.xo.as_dvec3();
         // Rd(|xo − xi|) / p(xi) per channel
-        let w = self.weights(d, &seg.frame, n_hit.as_dvec3(), seg.channel)?;
+        let w = self.weights(d, &seg.frame, n_hit.as_dvec3(), seg.probs, seg.channel)?;
         // × total: the hit was picked with probability 1/total
         Some(ProbeEntry {
             point: xi.as_vec3(),
@@ -378,13 +483,20 @@ impl ProbeSampler {
     /// Rd(|d|)/p(xi) per channel (before the hit count) for an entry point
     /// at xi = xo + d with unit normal `n_hit`, `ch` the sampled channel:
     /// the frame's local coordinates of d, the cosines |V_a·N| and the axis
-    /// probabilities P(a), handed to [`ProbeDensity::weights`].
+    /// probabilities P(a) at xo, handed to [`ProbeDensity::weights`].
     #[inline]
-    fn weights(&self, d: DVec3, frame: &Frame, n_hit: DVec3, ch: usize) -> Option<[f32; 3]> {
+    fn weights(
+        &self,
+        d: DVec3,
+        frame: &Frame,
+        n_hit: DVec3,
+        probs: [f64; 3],
+        ch: usize,
+    ) -> Option<[f32; 3]> {
         let axes = [frame.t, frame.b, frame.n].map(|v| v.as_dvec3());
         let local = axes.map(|v| d.dot(v));
         let cos = axes.map(|v| v.dot(n_hit).abs() as f32);
-        let probs = self.axis_probs().map(|p| p as f32);
+        let probs = probs.map(|p| p as f32);
         self.density
             .weights(local, cos, probs, self.single(ch), self.n_active)
     }
@@ -399,16 +511,16 @@ impl ProbeSampler {
     /// that channel lands on xi (normal `n_hit`), summed over axes with
     /// their probabilities (pbrt-v3 `Pdf_Sp` without the channel sum).
     /// Inactive channels give 0.
-    fn pdf_area_d(&self, d: DVec3, frame: &Frame, n_hit: DVec3) -> [f64; 3] {
-        let per_axis = self.pdf_area_axes(d, frame, n_hit);
+    fn pdf_area_d(&self, d: DVec3, frame: &Frame, kappa: f32, n_hit: DVec3) -> [f64; 3] {
+        let per_axis = self.pdf_area_axes(d, frame, kappa, n_hit);
         std::array::from_fn(|c| per_axis.iter().map(|p| p[c]).sum())
     }
 
     /// [`pdf_area_d`](Self::pdf_area_d)'s terms, axis by axis (T, B, N):
     /// P(a) p_c(r_a) |V_a·N| per channel c.
-    fn pdf_area_axes(&self, d: DVec3, frame: &Frame, n_hit: DVec3) -> [[f64; 3]; 3] {
+    fn pdf_area_axes(&self, d: DVec3, frame: &Frame, kappa: f32, n_hit: DVec3) -> [[f64; 3]; 3] {
         let axes = [frame.t.as_dvec3(), frame.b.as_dvec3(), frame.n.as_dvec3()];
-        let probs = self.axis_probs();
+        let probs = self.axis_probs(kappa);
         // Disk radii from the squares of the other two local coordinates:
         // |d|² − (d·V)² would cancel when r ≪ |d|.
         let sq = axes.map(|v| d.dot(v).powi(2));
@@ -440,30 +552,43 @@ impl ProbeSampler {
     /// 0 beyond Rmax, where no chord of the probe sphere reaches. Where
     /// every probe segment has one hit it is the density of the sampled xi;
     /// the integrator's tests compare the two.
-    pub(crate) fn pdf_area(&self, d: DVec3, frame: &Frame, n_hit: DVec3) -> f64 {
+    pub(crate) fn pdf_area(&self, d: DVec3, frame: &Frame, kappa: f32, n_hit: DVec3) -> f64 {
         if self.n_active == 0 || d.length() > self.rmax {
             return 0.0;
         }
-        self.pdf_area_d(d, frame, n_hit).iter().sum::<f64>() / self.n_active as f64
+        self.pdf_area_d(d, frame, kappa, n_hit).iter().sum::<f64>() / self.n_active as f64
     }
 
     /// [`pdf_area`](Self::pdf_area) axis by axis (T, B, N): the density of
     /// reaching xi with a probe along that axis. Where the segment through
     /// xi along axis a has k_a hits, xi is chosen with density
     /// Σ_a pdf_area_axes_mean[a] / k_a.
-    pub(crate) fn pdf_area_axes_mean(&self, d: DVec3, frame: &Frame, n_hit: DVec3) -> [f64; 3] {
+    pub(crate) fn pdf_area_axes_mean(
+        &self,
+        d: DVec3,
+        frame: &Frame,
+        kappa: f32,
+        n_hit: DVec3,
+    ) -> [f64; 3] {
         if self.n_active == 0 || d.length() > self.rmax {
             return [0.0; 3];
         }
-        self.pdf_area_axes(d, frame, n_hit)
+        self.pdf_area_axes(d, frame, kappa, n_hit)
             .map(|p| p.iter().sum::<f64>() / self.n_active as f64)
     }
 
     /// Rd(|d|)/p(xi) per channel (before the hit count) for an entry point
     /// at xi = xo + d with unit normal `n_hit`, `ch` the sampled channel:
     /// the f64 oracle.
-    fn weights_f64(&self, d: DVec3, frame: &Frame, n_hit: DVec3, ch: usize) -> Option<[f32; 3]> {
-        let pdf = self.pdf_area_d(d, frame, n_hit);
+    fn weights_f64(
+        &self,
+        d: DVec3,
+        frame: &Frame,
+        kappa: f32,
+        n_hit: DVec3,
+        ch: usize,
+    ) -> Option<[f32; 3]> {
+        let pdf = self.pdf_area_d(d, frame, kappa, n_hit);
         let dist3 = d.length();
         let p = match self.single(ch) {
             Some(ch) => pdf[ch],
@@ -512,9 +637,11 @@ mod tests {
         // beyond this r/d, exp4's lane may be 0 (e^{−ρ/3} < e^{−87})
         let rho_lanes = 255.0;
         let mut rng = Rng::from_key(99);
+        let mut kappa_rng = Rng::from_key(100);
+        let mut curv_rng = Rng::from_key(101);
         let mut worst = 0.0f64;
         for params in &materials {
-            for axes in [ProbeAxes::Normal, ProbeAxes::Mis3] {
+            for axes in ProbeAxes::ALL {
                 for channel in [ChannelStrategy::Single, ChannelStrategy::Mis] {
                     for radius in [
                         RadiusSampler::Uniform,
@@ -531,6 +658,13 @@ mod tests {
                                 renormalize,
                             };
                             let s = ProbeSampler::new(params, &opts).unwrap();
+                            // the curvature rule draws its own cases, so the
+                            // others see the points they always did
+                            let rng = if axes == ProbeAxes::Curvature {
+                                &mut curv_rng
+                            } else {
+                                &mut rng
+                            };
                             for _ in 0..2_000 {
                                 let frame = Frame::from_normal(uniform_sphere(rng.uniform2()));
                                 let mut local = [0.0f64; 3];
@@ -556,8 +690,14 @@ mod tests {
                                 let n_hit = uniform_sphere(rng.uniform2()).as_dvec3().normalize();
                                 let ch = s.active
                                     [(rng.uniform() * s.n_active as f32) as usize % s.n_active];
-                                let f = s.weights(d, &frame, n_hit, ch);
-                                let r = s.weights_f64(d, &frame, n_hit, ch);
+                                // curvature from flat to ~100/Rmax: ε over
+                                // its whole range under `Curvature`
+                                // (its own stream: the cases above are the
+                                // ones this test always drew)
+                                let kappa = (100.0 * kappa_rng.uniform_f64().powi(2) / rm) as f32;
+                                let probs = s.axis_probs(kappa);
+                                let f = s.weights(d, &frame, n_hit, probs, ch);
+                                let r = s.weights_f64(d, &frame, kappa, n_hit, ch);
                                 // a single channel's density beyond ρ ≈ 240
                                 // underflows f32 (probability of such a
                                 // sample < 1e-34)
@@ -603,6 +743,53 @@ mod tests {
             }
         }
         println!("f32 weights: worst relative error {worst:.3} of the bound");
+    }
+
+    #[test]
+    fn tangent_probability_runs_from_eps_min_to_a_quarter() {
+        // ε_min on a flat surface, ¼ (mis3) from κd = 1 on, continuous and
+        // nondecreasing in between; what is not a curvature gives ¼.
+        assert_eq!(tangent_probability(0.0), TANGENT_PROB_MIN);
+        assert_eq!(tangent_probability(-1.0), TANGENT_PROB_MIN);
+        assert_eq!(tangent_probability(TANGENT_PROB_FULL_AT), 0.25);
+        assert_eq!(tangent_probability(f64::INFINITY), 0.25);
+        assert_eq!(tangent_probability(f64::NAN), 0.25);
+        let below = tangent_probability(TANGENT_PROB_FULL_AT * (1.0 - 1e-9));
+        assert!((below - 0.25).abs() < 1e-8, "{below}");
+        let mut last = 0.0;
+        for i in 0..=1000 {
+            let e = tangent_probability(i as f64 * 1e-3);
+            assert!(
+                (TANGENT_PROB_MIN..=0.25).contains(&e) && e >= last,
+                "{i}: {e}"
+            );
+            last = e;
+        }
+        // the 10 mm marble sphere (κd ≈ 0.087): within 1e-3 of ε_min
+        assert!(tangent_probability(0.087) - TANGENT_PROB_MIN < 1e-3);
+        // the axis probabilities of a sampler sum to 1, N gets the rest
+        let p = SubsurfaceParams {
+            albedo: [0.5; 3],
+            d: [2.0, 1.0, 0.5],
+            eta: 1.3,
+            medium: None,
+        };
+        let s = ProbeSampler::new(&p, &ProbeOptions::default()).unwrap();
+        assert_eq!(s.options().axes, ProbeAxes::Curvature);
+        for kappa in [0.0f32, 0.05, 0.2, 0.5, 10.0] {
+            let pr = s.axis_probs(kappa);
+            let e = tangent_probability(kappa as f64 * 2.0);
+            assert_eq!(pr, [e, e, 1.0 - 2.0 * e], "κ {kappa}");
+        }
+        // the weight bound's factor: √3/ε_min, and mis3's 4√3
+        let g = ProbeAxes::Curvature.weight_bound().unwrap();
+        assert!((g - 3f64.sqrt() / TANGENT_PROB_MIN).abs() < 1e-12);
+        assert!((ProbeAxes::Mis3.weight_bound().unwrap() - 4.0 * 3f64.sqrt()).abs() < 1e-12);
+        assert_eq!(ProbeAxes::Normal.weight_bound(), None);
+        for a in ProbeAxes::ALL {
+            assert_eq!(ProbeAxes::parse(&a.name().to_uppercase()), Some(a));
+        }
+        assert_eq!(ProbeAxes::parse("tangent"), None);
     }
 
     #[test]

@@ -16,7 +16,7 @@
 //! small (pbrt-v4 §13.1.1).
 
 use super::interaction::offset_along;
-use super::probe::{sample_entry, ProbeTarget};
+use super::probe::{curvature, sample_entry, ProbeTarget};
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
 use crate::bssrdf::ProbeRandoms;
@@ -286,6 +286,7 @@ fn subsurface_probe<'s>(
         &ss.probe,
         si.p,
         &frame_o,
+        curvature(target.mesh, si.prim),
         &u,
         &target,
         &mut scratch.probe_hits,

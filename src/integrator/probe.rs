@@ -13,6 +13,35 @@ use crate::accel::{Accel, Hit, ProbeHits};
 use crate::bssrdf::{pick_hit, ProbeRandoms, ProbeSampler};
 use crate::geometry::{Frame, Mesh, Vec3};
 
+/// The curvature of `mesh` at triangle `prim`, from its shading normals:
+/// the largest |n_i − n_j| / |p_i − p_j| over its edges (1/scene units),
+/// the rate at which the normal turns along the surface. Exact (1/ρ) on a
+/// triangle of a sphere of radius ρ whose vertex normals are radial; 0 on
+/// a mesh without shading normals (flat-shaded: nothing tells its facets
+/// from a flat surface), and for a degenerate edge. A deterministic
+/// function of the exit point's triangle, as the probe axes' probabilities
+/// built on it must be (`ProbeAxes::Curvature`).
+pub fn curvature(mesh: &Mesh, prim: u32) -> f32 {
+    let Some(normals) = &mesh.normals else {
+        return 0.0;
+    };
+    let idx = mesh.indices[prim as usize];
+    let p = mesh.vertices(idx);
+    let n = idx.map(|i| normals[i as usize]);
+    let mut k = 0.0f32;
+    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+        let len = (p[i] - p[j]).length();
+        let turn = (n[i] - n[j]).length();
+        if len > 0.0 {
+            let e = turn / len;
+            if e.is_finite() {
+                k = k.max(e);
+            }
+        }
+    }
+    k
+}
+
 /// The object a probe searches: mesh `geom` of `accel`, and that mesh (for
 /// its face normals).
 #[derive(Clone, Copy)]
@@ -36,22 +65,24 @@ pub struct ProbeSample {
     pub weight: Vec3,
 }
 
-/// Samples an entry point xi for exit point `xo` (shading frame `frame`) on
-/// `target` with one probe: sample the segment, query all its hits on the
-/// object into the scratch buffer `hits` (no allocation), pick one, weigh
-/// it. None when the material samples nothing, the probe finds nothing, or
-/// the picked hit has zero density; the estimate is then 0.
+/// Samples an entry point xi for exit point `xo` (shading frame `frame`,
+/// surface curvature `kappa` there, from [`curvature`]) on `target` with
+/// one probe: sample the segment, query all its hits on the object into
+/// the scratch buffer `hits` (no allocation), pick one, weigh it. None when
+/// the material samples nothing, the probe finds nothing, or the picked hit
+/// has zero density; the estimate is then 0.
 pub fn sample_entry(
     sampler: &ProbeSampler,
     xo: Vec3,
     frame: &Frame,
+    kappa: f32,
     u: &ProbeRandoms,
     target: &ProbeTarget,
     hits: &mut ProbeHits,
 ) -> Option<ProbeSample> {
     // docs/bssrdf.md §5: steps 1–2 in the BSSRDF, step 3 here (every hit
     // on the object, one picked uniformly), step 4 in the BSSRDF.
-    let seg = sampler.sample_probe(xo, frame, u)?;
+    let seg = sampler.sample_probe(xo, frame, kappa, u)?;
     target
         .accel
         .hits_on_segment(&seg.ray, seg.t_max, target.geom, u.seed, hits);
@@ -217,7 +248,12 @@ mod tests {
         };
         for _ in 0..n {
             let u = ProbeRandoms::from_rng(&mut rng);
-            if let Some(ps) = sample_entry(s, xo, frame, &u, &target, &mut hits) {
+            // The curvature `Curvature` reads, drawn per probe with κ·Rmax
+            // in [0, 40) (κ·d up to ~2: ε over its whole range, ε_min on a
+            // quarter of the probes): each probe is unbiased for its own
+            // axis probabilities, so the mean must be right for any mix.
+            let kappa = (40.0 * rng.uniform_f64().powi(2) / s.rmax()) as f32;
+            if let Some(ps) = sample_entry(s, xo, frame, kappa, &u, &target, &mut hits) {
                 found += 1;
                 assert!(ps.normal.is_finite() && (ps.normal.length() - 1.0).abs() < 1e-5);
                 assert!(ps.point.is_finite());
@@ -243,7 +279,7 @@ mod tests {
 
     fn all_options() -> Vec<ProbeOptions> {
         let mut v = Vec::new();
-        for axes in [ProbeAxes::Normal, ProbeAxes::Mis3] {
+        for axes in ProbeAxes::ALL {
             for channel in [ChannelStrategy::Single, ChannelStrategy::Mis] {
                 for radius in [
                     RadiusSampler::Uniform,
@@ -371,6 +407,7 @@ mod tests {
                     &s,
                     Vec3::new(0.3, 0.1, 0.0),
                     &tilted(20.0),
+                    0.0,
                     &u,
                     &target(&accel),
                     &mut hits,
@@ -514,11 +551,13 @@ mod tests {
     }
 
     #[test]
-    fn grazing_hits_are_bounded_by_mis3() {
+    fn grazing_hits_are_bounded_by_mis3_and_curvature() {
         // The shading normal is tilted 88° from the plane's normal: probes
-        // along N meet the plane at |V·N| = cos 88° ≈ 0.035. Both estimators
+        // along N meet the plane at |V·N| = cos 88° ≈ 0.035. All three rules
         // are unbiased, but Normal's weights reach 1/0.035 × larger values,
-        // while Mis3's are bounded by 4√3·n_active·A (module docs).
+        // while Mis3's are bounded by 4√3·n_active·A and Curvature's (ε from
+        // ε_min to ¼, drawn per probe by `run_on`) by (√3/ε_min)·n_active·A
+        // (module docs of bssrdf::probe, `ProbeAxes::weight_bound`).
         let params = SubsurfaceParams {
             albedo: [0.8, 0.8, 0.8],
             d: [1.0, 0.7, 0.4],
@@ -530,9 +569,11 @@ mod tests {
         };
         let frame = tilted(88.0);
         let xo = Vec3::new(0.37, -0.21, 0.0);
-        let bound = 4.0 * 3f64.sqrt() * 3.0 * 0.8;
+        let bound = |axes: ProbeAxes| axes.weight_bound().map(|g| g * 3.0 * 0.8);
+        let mis3_bound = bound(ProbeAxes::Mis3).unwrap();
+        assert!((mis3_bound - 4.0 * 3f64.sqrt() * 3.0 * 0.8).abs() < 1e-12);
         let mut maxes = Vec::new();
-        for axes in [ProbeAxes::Normal, ProbeAxes::Mis3] {
+        for axes in ProbeAxes::ALL {
             for radius in [RadiusSampler::Analytic, RadiusSampler::Mixture] {
                 let opts = ProbeOptions {
                     axes,
@@ -543,20 +584,23 @@ mod tests {
                 let st = run(&s, &accel, xo, &frame, 100_000, 7);
                 assert_close(&st, s.planar_reflectance(), &format!("{opts:?}"));
                 println!(
-                    "grazing 88°, {axes:?} {radius:?}: max weight {:.2} (Mis3 bound {bound:.2}), mean {:.4}, rel. s.e. {:.2e}",
+                    "grazing 88°, {axes:?} {radius:?}: max weight {:.2} (bound {:?}), mean {:.4}, rel. s.e. {:.2e}",
                     st.max,
+                    bound(axes),
                     st.mean[0],
                     st.se[0] / st.mean[0]
                 );
-                if axes == ProbeAxes::Mis3 {
-                    assert!(st.max <= bound * (1.0 + 1e-4), "{}", st.max);
+                if let Some(b) = bound(axes) {
+                    assert!(st.max <= b * (1.0 + 1e-4), "{axes:?}: {} > {b}", st.max);
                 }
-                maxes.push(st.max);
+                if axes == ProbeAxes::Normal {
+                    maxes.push(st.max);
+                }
             }
         }
-        // the normal-only probe's maximum is far above the bound
+        // the normal-only probe's maximum is far above mis3's bound
         assert!(
-            maxes[0] > 2.0 * bound && maxes[1] > 2.0 * bound,
+            maxes[0] > 2.0 * mis3_bound && maxes[1] > 2.0 * mis3_bound,
             "{maxes:?}"
         );
     }
@@ -668,6 +712,7 @@ mod tests {
                             &s,
                             Vec3::new(0.37, -0.21, 0.0),
                             &frame,
+                            [0.0, 1e30][(r == top) as usize],
                             &u,
                             &target(&accel),
                             &mut hits,
@@ -747,7 +792,7 @@ mod tests {
     // patch can.
 
     /// A closed UV sphere of radius `rs` around `c`: `rings` rings of
-    /// 2·`rings` segments, one vertex at each pole.
+    /// 2·`rings` segments, one vertex at each pole, radial shading normals.
     fn uv_sphere(c: Vec3, rs: f32, rings: u32) -> Mesh {
         use std::f32::consts::{PI, TAU};
         let segs = 2 * rings;
@@ -773,7 +818,34 @@ mod tests {
                 idx.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
             }
         }
-        Mesh::new(p, idx, None)
+        // radial shading normals: `curvature` reads 1/rs
+        let normals = p.iter().map(|&q| (q - c).normalize()).collect();
+        Mesh::new(p, idx, Some(normals))
+    }
+
+    #[test]
+    fn curvature_is_one_over_the_radius_of_a_sphere_and_zero_when_flat() {
+        // radial shading normals on a UV sphere of radius 2.5: every
+        // triangle reads 1/2.5 (|n_i − n_j| = |p_i − p_j|/ρ exactly)
+        let rs = 2.5f32;
+        let sphere = uv_sphere(Vec3::new(1.0, -2.0, 0.5), rs, 10);
+        for prim in 0..sphere.triangle_count() as u32 {
+            let k = curvature(&sphere, prim);
+            assert!((k * rs - 1.0).abs() < 1e-4, "triangle {prim}: {k}");
+        }
+        // no shading normals: nothing says the surface turns
+        let flat = planes(3.0, &[0.0, -1.0]);
+        assert!((0..flat.triangle_count() as u32).all(|p| curvature(&flat, p) == 0.0));
+        // equal normals (a flat patch with normals) and a degenerate edge
+        let mut m = Mesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::X, Vec3::Y],
+            vec![[0, 1, 3], [0, 1, 2]],
+            Some(vec![Vec3::Z; 4]),
+        );
+        assert_eq!(curvature(&m, 0), 0.0);
+        m.normals = Some(vec![Vec3::Z, Vec3::Z, Vec3::X, Vec3::Z]);
+        let k = curvature(&m, 1);
+        assert!(k.is_finite() && (k - 2f32.sqrt()).abs() < 1e-6, "{k}");
     }
 
     /// A closed thin wedge (triangular prism): faces z = ±x·tan(angle/2)
@@ -839,7 +911,7 @@ mod tests {
         let mut rng = Rng::from_key(1919);
         let mut hits = ProbeHits::new();
         let mut worst = 0.0f64;
-        for axes in [ProbeAxes::Normal, ProbeAxes::Mis3] {
+        for axes in ProbeAxes::ALL {
             for radius in [
                 RadiusSampler::Uniform,
                 RadiusSampler::table(64),
@@ -892,7 +964,9 @@ mod tests {
                                     _ => {}
                                 }
                                 let target = target(&accel);
-                                let Some(ps) = sample_entry(&s, xo, &frame, &u, &target, &mut hits)
+                                let kappa = curvature(mesh, prim);
+                                let Some(ps) =
+                                    sample_entry(&s, xo, &frame, kappa, &u, &target, &mut hits)
                                 else {
                                     continue;
                                 };
@@ -1219,7 +1293,7 @@ mod tests {
         let mut hits = ProbeHits::new();
         let mut p_min = 1.0f64;
         for (case, (rs, (i0, j0))) in [(1.6, (5, 4)), (1.0, (3, 9))].into_iter().enumerate() {
-            for axes in [ProbeAxes::Normal, ProbeAxes::Mis3] {
+            for axes in ProbeAxes::ALL {
                 for radius in [
                     RadiusSampler::Uniform,
                     RadiusSampler::table(64),
@@ -1243,6 +1317,9 @@ mod tests {
                     let (mesh, vertex) = octant_patch(rs * rm, 16, &frame, c);
                     let xo = mesh.positions()[vertex(i0, j0) as usize];
                     let xo64 = xo.as_dvec3();
+                    // the patch's own curvature (ε near ε_min), and one
+                    // with κ·d = ½ (ε halfway to ¼)
+                    let kappa = [1.0 / (rs * rm), 0.5 / params.d[0]][case] as f32;
                     let accel = Brute { meshes: vec![mesh] };
                     let mesh = &accel.meshes[0];
                     let n_tri = mesh.triangle_count();
@@ -1261,7 +1338,7 @@ mod tests {
                     let mut observed = vec![0.0; n_bins];
                     for prim in 0..n_tri as u32 {
                         let n_hit = mesh.face_normal(prim).as_dvec3();
-                        let pdf = |x: DVec3| s.pdf_area(x - xo64, &frame, n_hit);
+                        let pdf = |x: DVec3| s.pdf_area(x - xo64, &frame, kappa, n_hit);
                         let tri = mesh.triangle(prim).map(|p| p.as_dvec3());
                         expected[bin_of(prim)] +=
                             integrate_triangle(&pdf, &|_| false, xo64, &[xo64], rm, tri, 6, &gl);
@@ -1275,7 +1352,8 @@ mod tests {
                     }
                     for _ in 0..n_samples {
                         let u = ProbeRandoms::from_rng(&mut rng);
-                        let Some(ps) = sample_entry(&s, xo, &frame, &u, &target(&accel), &mut hits)
+                        let target = target(&accel);
+                        let Some(ps) = sample_entry(&s, xo, &frame, kappa, &u, &target, &mut hits)
                         else {
                             observed[0] += 1.0;
                             continue;
@@ -1283,16 +1361,36 @@ mod tests {
                         assert_eq!(hits.total(), 1, "{what}: a segment with several hits");
                         observed[bin_of(ps.hit.prim)] += 1.0;
                         let d = ps.point.as_dvec3() - xo64;
-                        if d.length() > 1e-3 * rm {
-                            let p = s.pdf_area(d, &frame, ps.normal.as_dvec3());
+                        // the f32 point's rounding is relative to |xo|;
+                        // p_a ∝ 1/r_a near a line xo + sV_a, which on a
+                        // nearly flat surface passes close to many hits
+                        let axes_v = [frame.t, frame.b, frame.n].map(|v| v.as_dvec3());
+                        let r_min = axes_v
+                            .map(|v| (d.length_squared() - d.dot(v).powi(2)).max(0.0).sqrt())
+                            .into_iter()
+                            .fold(f64::INFINITY, f64::min);
+                        if r_min > 1e-3 * rm {
+                            // A table's density is piecewise constant in r:
+                            // within the point's rounding of a cell edge
+                            // the weight may come from the other cell, so
+                            // Rd/p is also taken a rounding step in and out
+                            // (3e-4 r ≥ 3e-6 here, against ~2e-6).
+                            let n_hit = ps.normal.as_dvec3();
+                            let p = s.pdf_area(d, &frame, kappa, n_hit);
                             assert!(p > 0.0, "{what}: an entry point where p = 0, at {d}");
-                            let rd = s.rd(d.length());
+                            // (a step out of the sphere has p = 0: NaN, no match)
+                            let want = |d: DVec3| {
+                                let p = s.pdf_area(d, &frame, kappa, n_hit);
+                                s.rd(d.length())
+                                    .map(|rd| if p > 0.0 { rd / p } else { f64::NAN })
+                            };
+                            let wants = [1.0, 1.0 - 3e-4, 1.0 + 3e-4].map(|k| want(d * k));
                             for c in 0..3 {
-                                let want = rd[c] / p;
                                 let got = ps.weight[c] as f64;
                                 assert!(
-                                    (got - want).abs() <= 2e-3 * want,
-                                    "{what} ch{c}: weight {got}, Rd/p = {want} at {d}"
+                                    wants.iter().any(|w| (got - w[c]).abs() <= 2e-3 * w[c]),
+                                    "{what} ch{c}: weight {got}, Rd/p = {} at {d}",
+                                    wants[0][c]
                                 );
                             }
                         }
@@ -1344,6 +1442,7 @@ mod tests {
             (ProbeAxes::Normal, RadiusSampler::Uniform),
             (ProbeAxes::Normal, RadiusSampler::Analytic),
             (ProbeAxes::Mis3, RadiusSampler::Mixture),
+            (ProbeAxes::Curvature, RadiusSampler::Analytic),
         ] {
             let opts = ProbeOptions {
                 axes,
@@ -1360,6 +1459,9 @@ mod tests {
             );
             let c = DVec3::new(0.3, -0.2, 0.1) * rm;
             let (outer, vertex) = octant_patch(1.6 * rm, 12, &frame, c);
+            // κ·d = ¼ for `Curvature` (the patch's own 1/(1.6 Rmax) gives
+            // ε ≈ ε_min; this tests an ε in between)
+            let kappa = (0.25 / params.d[0]) as f32;
             let xo = outer.positions()[vertex(4, 3) as usize];
             let xo64 = xo.as_dvec3();
             let (inner, _) = octant_patch(1.3 * rm, 12, &frame, c);
@@ -1449,7 +1551,7 @@ mod tests {
             for prim in 0..n_tri {
                 let n_hit = mesh.face_normal(prim).as_dvec3();
                 let pdf = |x: DVec3| {
-                    let pa = s.pdf_area_axes_mean(x - xo64, &frame, n_hit);
+                    let pa = s.pdf_area_axes_mean(x - xo64, &frame, kappa, n_hit);
                     (0..3)
                         .filter(|&a| pa[a] > 0.0)
                         .map(|a| pa[a] / count(x, prim, a) as f64)
@@ -1482,7 +1584,8 @@ mod tests {
             }
             for _ in 0..n_samples {
                 let u = ProbeRandoms::from_rng(&mut rng);
-                let Some(ps) = sample_entry(&s, xo, &frame, &u, &target(&accel), &mut hits) else {
+                let target = target(&accel);
+                let Some(ps) = sample_entry(&s, xo, &frame, kappa, &u, &target, &mut hits) else {
                     observed[0] += 1.0;
                     continue;
                 };
@@ -1498,7 +1601,7 @@ mod tests {
                     .into_iter()
                     .fold(f64::INFINITY, f64::min);
                 if r_min > 1e-3 * rm {
-                    let p = s.pdf_area(d, &frame, ps.normal.as_dvec3());
+                    let p = s.pdf_area(d, &frame, kappa, ps.normal.as_dvec3());
                     assert!(p > 0.0, "{what}: an entry point where p = 0, at {d}");
                     let rd = s.rd(d.length());
                     for c in 0..3 {

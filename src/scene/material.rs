@@ -357,14 +357,13 @@ fn sampling_options(cx: &Cx, field: &str, m: &Spanned<MaterialDef>) -> Res<Probe
         opts.rmax_quantile = *q.get_ref();
     }
     if let Some((s, span)) = text(&d.axes) {
-        opts.axes = match s.to_ascii_lowercase().as_str() {
-            "normal" => ProbeAxes::Normal,
-            "mis3" => ProbeAxes::Mis3,
-            _ => {
+        opts.axes = match ProbeAxes::parse(s) {
+            Some(a) => a,
+            None => {
                 return Err(cx.err(
                     span,
                     &f("axes"),
-                    format!("expected \"normal\" or \"mis3\", found \"{s}\""),
+                    format!("expected \"curvature\", \"normal\" or \"mis3\", found \"{s}\""),
                 ))
             }
         };

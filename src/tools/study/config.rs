@@ -116,10 +116,7 @@ pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
 }
 
 fn axes_name(a: ProbeAxes) -> &'static str {
-    match a {
-        ProbeAxes::Normal => "normal",
-        ProbeAxes::Mis3 => "mis3",
-    }
+    a.name()
 }
 
 fn channel_name(c: ChannelStrategy) -> &'static str {
@@ -287,18 +284,17 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
             },
         );
     }
-    let other_axes = match base_probe.axes {
-        ProbeAxes::Normal => ProbeAxes::Mis3,
-        ProbeAxes::Mis3 => ProbeAxes::Normal,
-    };
-    m.vary(
-        Axis::Axes,
-        axes_name(other_axes).into(),
-        Overrides {
-            axes: Some(other_axes),
-            ..m.base
-        },
-    );
+    // every other axis rule (normal-only and mis3 for the default)
+    for other_axes in ProbeAxes::ALL.into_iter().filter(|&a| a != base_probe.axes) {
+        m.vary(
+            Axis::Axes,
+            axes_name(other_axes).into(),
+            Overrides {
+                axes: Some(other_axes),
+                ..m.base
+            },
+        );
+    }
     let other_channel = match base_probe.channel {
         ChannelStrategy::Single => ChannelStrategy::Mis,
         ChannelStrategy::Mis => ChannelStrategy::Single,
