@@ -549,7 +549,10 @@ fn grazing_probe_hits_on_a_thin_wedge() {
 /// whenever the disk point falls off the box. The estimate then loses that
 /// energy (correctly for this model) and must stay finite and ≥ 0: asserted
 /// that most probes do find nothing, and that the render is finite, under
-/// the Mis3 bound, and its mean ≤ A.
+/// the Mis3 bound, and its mean ≤ 2A: both faces lie within Rmax and each
+/// reflects at most A (by quadrature at the probed xo the two give
+/// 0.631 / 0.550 / 0.438 here, above A in blue: "≤ A" held only within
+/// the noise of mis3, and fails for the quieter default).
 #[test]
 fn probes_that_find_nothing_on_geometry_thinner_than_d() {
     let albedo = [0.8, 0.6, 0.4];
@@ -598,7 +601,7 @@ fn probes_that_find_nothing_on_geometry_thinner_than_d() {
         let (mean, se) = mean_se(&film);
         for c in 0..3 {
             assert!(
-                mean[c] > 0.0 && mean[c] <= albedo[c] + 4.0 * se[c],
+                mean[c] > 0.0 && mean[c] <= 2.0 * albedo[c] + 4.0 * se[c],
                 "{backend:?}: {mean:?} ± {se:?}"
             );
         }

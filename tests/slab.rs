@@ -80,7 +80,7 @@ fn uniformly_lit_slab_reflects_its_albedo() {
         RadiusSampler::Mixture,
         RadiusSampler::table(1024),
     ] {
-        for axes in [ProbeAxes::Mis3, ProbeAxes::Normal] {
+        for axes in [ProbeAxes::Curvature, ProbeAxes::Mis3, ProbeAxes::Normal] {
             for channel in [ChannelStrategy::Mis, ChannelStrategy::Single] {
                 configs.push(SubsurfaceOverrides {
                     radius: Some(radius),
