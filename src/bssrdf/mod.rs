@@ -21,9 +21,10 @@
 //! let params = SubsurfaceParams::from_preset("marble", units_per_mm, Fit::Searchlight)?;
 //! let sampler = ProbeSampler::new(&params, &ProbeOptions::default())?;   // once
 //! let c = sw_normalization(params.eta);                                    // once
-//! // at exit point xo with shading frame `frame` on mesh `geom`:
+//! // at exit point xo with shading frame `frame` on mesh `geom`, where the
+//! // surface's curvature is `kappa` (integrator::probe::curvature):
 //! let u = ProbeRandoms::from_rng(rng);
-//! let seg = sampler.sample_probe(xo, &frame, &u)?;
+//! let seg = sampler.sample_probe(xo, &frame, kappa, &u)?;
 //! accel.hits_on_segment(&seg.ray, seg.t_max, geom, u.seed, &mut probe_hits); // the integrator's query
 //! let hit = probe_hits.hits()[pick_hit(&u, probe_hits.hits().len())];
 //! let e = sampler.weigh(&seg, hit.t, mesh.face_normal(hit.prim), probe_hits.total())?;

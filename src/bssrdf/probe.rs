@@ -30,8 +30,9 @@
 //!   the widest channel's. Why: where d·κ is small the profile's mass lies
 //!   on a nearly flat surface, which probes along T and B almost never
 //!   meet; mis3 spends half its probes there and doubles the weight of the
-//!   other half, so its variance on a smooth convex body is several times
-//!   normal-only's. Where the surface turns within the profile (d·κ ≳ 1,
+//!   other half, so its relMSE per sample on a smooth convex body is about
+//!   twice normal-only's (2.3× on scenes/smooth-sphere.toml,
+//!   docs/accuracy.md). Where the surface turns within the profile (d·κ ≳ 1,
 //!   and thin or small objects) T and B are what bound the weights, and ε
 //!   rises to mis3's ¼. ε depends on xo alone, so sampling and density use
 //!   the same probabilities and the estimator stays exact. Since ε ≥ ε_min
