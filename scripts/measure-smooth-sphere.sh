@@ -8,13 +8,13 @@
 #
 # Usage: scripts/measure-smooth-sphere.sh [options] [-- study options]
 #   --out DIR          where the studies go (default: out/measure-smooth-sphere)
-#   --width N          image width (default 256, the scene's)
+#   --width N          image width (default 128; the scene's is 256)
 #   --spp N            the ladder's top sample count, where the figures are
 #                      read (default 64)
 #   --ref-spp N        diffusion reference samples per pixel (default 8192)
-#   --rw-ref-spp N     random-walk reference samples per pixel (default 1024)
-#   --rw-width N       image width of the random-walk rows (default: --width;
-#                      the walk costs ~100× a diffusion sample here)
+#   --rw-ref-spp N     random-walk reference samples per pixel (default 512)
+#   --rw-width N       image width of the random-walk rows (default 64: the
+#                      walk costs ~50× a diffusion sample per pixel here)
 #   --threads N        (default 2)
 #   --lucent PATH      the binary (default: target/release/lucent, built)
 #   --diffusion NAME 'TOML'
@@ -26,17 +26,19 @@
 #                      boundary mode); repeat either option for more rows
 #   -- ARGS            passed to every `lucent study` run
 #
+# The defaults are the run in docs/accuracy.md (about 20 minutes on 2
+# busy cores, most of it the two references).
 # Prints a Markdown table; the studies' reports and images stay in --out.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 scene="$root/scenes/smooth-sphere.toml"
 out="$root/out/measure-smooth-sphere"
-width=256
+width=128
 spp=64
 ref_spp=8192
-rw_ref_spp=1024
-rw_width=""
+rw_ref_spp=512
+rw_width=64
 threads=2
 lucent=""
 extra_diff=()
@@ -59,12 +61,11 @@ while [[ $# -gt 0 ]]; do
         if [[ $1 == --diffusion ]]; then extra_diff+=("$2" "$3"); else extra_rw+=("$2" "$3"); fi
         shift 3 ;;
     --) shift; pass=("$@"); break ;;
-    -h | --help) sed -n '2,29p' "$0"; exit 0 ;;
+    -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1' "$0"; exit 0 ;;
     *) echo "unknown option $1 (see --help)" >&2; exit 2 ;;
     esac
 done
 
-rw_width=${rw_width:-$width}
 if [[ -z $lucent ]]; then
     (cd "$root" && cargo build --release --quiet)
     lucent="$root/target/release/lucent"
