@@ -15,5 +15,6 @@
 //! it and names the offending file and line.
 
 pub mod bench;
+pub mod halfspace;
 pub mod plot;
 pub mod study;
