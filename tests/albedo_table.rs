@@ -12,7 +12,8 @@
 //!    diffusion (A from the table) against the random walk, in the mean
 //!    over view directions weighted by cos θ (what a uniformly lit body's
 //!    pixels average), by a three-point Gauss–Legendre rule in μ²: within
-//!    1 %, which the old A (the Jensen table's Rd column) misses.
+//!    1.5 % (measured: within 0.8 %), which the old A (the Jensen table's
+//!    Rd column, 2–4 % off) misses.
 
 mod common;
 
@@ -145,18 +146,27 @@ fn view_mean(params: SubsurfaceParams, integrator: IntegratorKind, spp: u32) -> 
     (mean, var.map(f64::sqrt))
 }
 
-/// Marble and Skin1 (the presets, A from the table): diffusion within 1 %
-/// of the random walk per channel in the view-direction mean; with the
-/// Jensen table's Rd as A (`given`), marble is several per cent off.
+/// Marble and Skin1 (the presets, A from the table): diffusion against the
+/// random walk per channel in the view-direction mean. Measured (seed 5,
+/// 8×8 px, walk 1024 spp, diffusion 512 spp; ± one standard error of the
+/// difference), (diffusion − walk) / walk:
+///
+/// - table A: marble −0.81 ± 0.38, −0.75 ± 0.33, −0.50 ± 0.36 %;
+///   skin1 −0.36 ± 0.48, −0.30 ± 0.48, −0.16 ± 0.66 %;
+/// - old A (Jensen Rd): marble −2.09, −2.35, −2.54 %; skin1 −3.92, −3.09,
+///   +2.57 %.
+///
+/// Bound 1.5 % per channel: the table's A passes with room for the noise,
+/// the old A fails in every channel.
 #[test]
 fn diffusion_matches_random_walk_on_the_slab_for_marble_and_skin1() {
     for name in ["marble", "skin1"] {
         let p = SubsurfaceParams::from_preset(name, 1.0, Fit::Searchlight).unwrap();
         let old = SubsurfaceParams::from_preset_with(name, 1.0, Fit::Searchlight, AlbedoSource::Given, None)
             .unwrap();
-        let (w, ew) = view_mean(p, IntegratorKind::RandomWalk, 256);
-        let (d, ed) = view_mean(p, IntegratorKind::Path, 64);
-        let (o, _) = view_mean(old, IntegratorKind::Path, 64);
+        let (w, ew) = view_mean(p, IntegratorKind::RandomWalk, 1024);
+        let (d, ed) = view_mean(p, IntegratorKind::Path, 512);
+        let (o, _) = view_mean(old, IntegratorKind::Path, 512);
         for c in 0..3 {
             let rel = d[c] / w[c] - 1.0;
             let rel_old = o[c] / w[c] - 1.0;
@@ -171,10 +181,8 @@ fn diffusion_matches_random_walk_on_the_slab_for_marble_and_skin1() {
                 100.0 * err,
                 100.0 * rel_old
             );
-            assert!(rel.abs() < 0.01, "{name} channel {c}: {rel}");
-            if name == "marble" {
-                assert!(rel_old.abs() > 0.02, "{name} channel {c}: old {rel_old}");
-            }
+            assert!(rel.abs() < 0.015, "{name} channel {c}: {rel}");
+            assert!(rel_old.abs() > 0.015, "{name} channel {c}: old {rel_old}");
         }
     }
 }
