@@ -39,7 +39,7 @@ PRESETS = {
     "wholemilk": ([2.55, 3.21, 3.77], [0.0011, 0.0024, 0.014]),
 }
 
-RES = 32
+RES = 16
 FOV_SLAB = 4.0
 VIEWS = [(math.degrees(math.acos(math.sqrt(u))), w) for u, w in
          ((0.5 - math.sqrt(0.15), 5 / 18), (0.5, 8 / 18), (0.5 + math.sqrt(0.15), 5 / 18))]
@@ -112,7 +112,7 @@ def fmt(r):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--presets", default="marble,skin1,skin2,wholemilk,apple,ketchup")
+    ap.add_argument("--presets", default="marble,skin1,wholemilk,ketchup,skin2,apple")
     ap.add_argument("--spp-walk", type=int, default=64)
     ap.add_argument("--spp-diffusion", type=int, default=64)
     ap.add_argument("--out", default=os.path.join(ROOT, "out/albedo-report"))
