@@ -11,7 +11,7 @@
 //!
 //! `scripts/albedo-table.sh` runs it. Deterministic for any thread count.
 
-use lucent::tools::halfspace::{albedo_from_reduced, generate, run, Entry, TableSettings};
+use lucent::tools::halfspace::{albedo_from_reduced, generate, run, Batch, Entry, TableSettings};
 use std::fmt::Write as _;
 
 fn main() {
@@ -31,16 +31,36 @@ fn main() {
         s.walks_normal /= 20;
     }
     let start = std::time::Instant::now();
-    let t = generate(&s, |m| eprintln!("{m} ({:.0} s)", start.elapsed().as_secs_f64()));
+    let t = generate(&s, |m| {
+        eprintln!("{m} ({:.0} s)", start.elapsed().as_secs_f64())
+    });
     let secs = start.elapsed().as_secs_f64();
     let mut csv = String::new();
     let h = |csv: &mut String, line: &str| writeln!(csv, "# {line}").unwrap();
-    h(&mut csv, "lucent albedo table: total diffuse reflectance of a semi-infinite medium");
-    h(&mut csv, "behind a smooth dielectric boundary (docs/bssrdf.md section 9).");
-    h(&mut csv, "Made by `cargo run --release --example albedo_table` (lucent::tools::halfspace):");
-    h(&mut csv, "the random walk's free flights, Henyey-Greenstein sampling (g = 0) and");
-    h(&mut csv, "dielectric boundary in the half-space z < 0, all albedos from one set of");
-    h(&mut csv, "walks (R(alpha) = E[alpha^n], n = scattering events before escape).");
+    h(
+        &mut csv,
+        "lucent albedo table: total diffuse reflectance of a semi-infinite medium",
+    );
+    h(
+        &mut csv,
+        "behind a smooth dielectric boundary (docs/bssrdf.md section 9).",
+    );
+    h(
+        &mut csv,
+        "Made by `cargo run --release --example albedo_table` (lucent::tools::halfspace):",
+    );
+    h(
+        &mut csv,
+        "the random walk's free flights, Henyey-Greenstein sampling (g = 0) and",
+    );
+    h(
+        &mut csv,
+        "dielectric boundary in the half-space z < 0, all albedos from one set of",
+    );
+    h(
+        &mut csv,
+        "walks (R(alpha) = E[alpha^n], n = scattering events before escape).",
+    );
     h(
         &mut csv,
         &format!(
@@ -55,10 +75,22 @@ fn main() {
             t.walk_events as f64
         ),
     );
-    h(&mut csv, "Columns: eta = inside/outside index; x = sqrt(1 - alpha'), alpha' the");
-    h(&mut csv, "reduced albedo; r_diffuse = fraction of the light entering from uniform");
-    h(&mut csv, "radiance outside that leaves again (the A of the diffusion model);");
-    h(&mut csv, "r_normal = the same for light entering along the normal; se_* = standard");
+    h(
+        &mut csv,
+        "Columns: eta = inside/outside index; x = sqrt(1 - alpha'), alpha' the",
+    );
+    h(
+        &mut csv,
+        "reduced albedo; r_diffuse = fraction of the light entering from uniform",
+    );
+    h(
+        &mut csv,
+        "radiance outside that leaves again (the A of the diffusion model);",
+    );
+    h(
+        &mut csv,
+        "r_normal = the same for light entering along the normal; se_* = standard",
+    );
     h(&mut csv, "errors. x = 0 is exact (R = 1).");
     h(
         &mut csv,
@@ -103,7 +135,7 @@ fn similarity(s: &TableSettings) {
     let eta = 1.3;
     let reduced = [0.3, 0.6, 0.8, 0.9, 0.95, 0.99, 0.995, 0.999];
     let walks = 100_000;
-    let base = run(eta, 0.0, Entry::Diffuse, &reduced, walks, s.cap, s.seed, s.chunk);
+    let base = run(eta, 0.0, Entry::Diffuse, &reduced, &s.batch(walks));
     println!("| α' | R, g = 0 | R, g = 0.5 | R, g = 0.8 |");
     println!("|---|---|---|---|");
     let mut rows: Vec<Vec<String>> = reduced
@@ -117,11 +149,23 @@ fn similarity(s: &TableSettings) {
     for g in [0.5, 0.8] {
         let albedos: Vec<f64> = reduced.iter().map(|&a| albedo_from_reduced(a, g)).collect();
         let cap = (s.cap as f64 / (1.0 - g)) as u32;
-        let t = run(eta, g, Entry::Diffuse, &albedos, walks, cap, s.seed, s.chunk);
+        let t = run(
+            eta,
+            g,
+            Entry::Diffuse,
+            &albedos,
+            &Batch {
+                cap,
+                ..s.batch(walks)
+            },
+        );
         for (i, row) in rows.iter_mut().enumerate() {
             let (r, se) = t.estimate(i);
             let (r0, _) = base.estimate(i);
-            row.push(format!("{r:.4} ± {se:.4} ({:+.2} %)", 100.0 * (r / r0 - 1.0)));
+            row.push(format!(
+                "{r:.4} ± {se:.4} ({:+.2} %)",
+                100.0 * (r / r0 - 1.0)
+            ));
         }
     }
     for r in rows {

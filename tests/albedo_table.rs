@@ -37,7 +37,9 @@ fn material(params: SubsurfaceParams) -> Material {
         renormalize: true,
         ..ProbeOptions::default()
     };
-    Material::Subsurface(Arc::new(Subsurface::new(params, &opts, true, true).unwrap()))
+    Material::Subsurface(Arc::new(
+        Subsurface::new(params, &opts, true, true).unwrap(),
+    ))
 }
 
 /// A slab `side` × `thickness` × `side`, top face at y = 0, seen from
@@ -107,7 +109,13 @@ fn integrator_random_walk_reproduces_table_nodes() {
         let j = t.xs.iter().position(|&v| (v - x).abs() < 1e-9).unwrap();
         let alpha = 1.0 - x * x;
         // ℓd = 1/√(3(1 − α')) = 5.8 and 1.9 mm: 100 mm thick is deep
-        let s = slab_scene(material(medium(alpha, eta as f32)), 1000.0, 100.0, 0.0, 1024);
+        let s = slab_scene(
+            material(medium(alpha, eta as f32)),
+            1000.0,
+            100.0,
+            0.0,
+            1024,
+        );
         let (m, se) = common::mean_se(&run(&s, IntegratorKind::RandomWalk));
         let fr = fresnel::dielectric(1.0, eta as f32) as f64;
         let expect = fr + (1.0 - fr) * t.normal[i][j];
@@ -118,7 +126,11 @@ fn integrator_random_walk_reproduces_table_nodes() {
         );
         for c in 0..3 {
             let tol = 4.0 * (se[c] * se[c] + t.max_se * t.max_se).sqrt();
-            assert!((m[c] - expect).abs() < tol, "channel {c}: {} vs {expect}", m[c]);
+            assert!(
+                (m[c] - expect).abs() < tol,
+                "channel {c}: {} vs {expect}",
+                m[c]
+            );
         }
     }
 }
@@ -132,7 +144,11 @@ fn view_rule() -> [(f32, f64); 3] {
 }
 
 /// Cosine-weighted mean radiance over view directions of the slab.
-fn view_mean(params: SubsurfaceParams, integrator: IntegratorKind, spp: u32) -> ([f64; 3], [f64; 3]) {
+fn view_mean(
+    params: SubsurfaceParams,
+    integrator: IntegratorKind,
+    spp: u32,
+) -> ([f64; 3], [f64; 3]) {
     let mut mean = [0.0; 3];
     let mut var = [0.0; 3];
     for (theta, w) in view_rule() {
@@ -162,8 +178,14 @@ fn view_mean(params: SubsurfaceParams, integrator: IntegratorKind, spp: u32) -> 
 fn diffusion_matches_random_walk_on_the_slab_for_marble_and_skin1() {
     for name in ["marble", "skin1"] {
         let p = SubsurfaceParams::from_preset(name, 1.0, Fit::Searchlight).unwrap();
-        let old = SubsurfaceParams::from_preset_with(name, 1.0, Fit::Searchlight, AlbedoSource::Given, None)
-            .unwrap();
+        let old = SubsurfaceParams::from_preset_with(
+            name,
+            1.0,
+            Fit::Searchlight,
+            AlbedoSource::Given,
+            None,
+        )
+        .unwrap();
         let (w, ew) = view_mean(p, IntegratorKind::RandomWalk, 1024);
         let (d, ed) = view_mean(p, IntegratorKind::Path, 512);
         let (o, _) = view_mean(old, IntegratorKind::Path, 512);
@@ -185,4 +207,38 @@ fn diffusion_matches_random_walk_on_the_slab_for_marble_and_skin1() {
             assert!(rel_old.abs() > 0.015, "{name} channel {c}: old {rel_old}");
         }
     }
+}
+
+/// The scene key `albedo_source`: "given" restores the Jensen Rd column,
+/// the default is the table, and anything else is an error naming the
+/// file, line and field.
+#[test]
+fn scene_key_albedo_source() {
+    use lucent::scene::load_str;
+    use std::path::Path;
+    let scene = |src: &str| {
+        format!(
+            "[camera]\nlook_from = [0, 1, 5]\nlook_at = [0, 1, 0]\nresolution = [8, 8]\n\
+             [materials.m]\ntype = \"subsurface\"\npreset = \"marble\"\n{src}\n\
+             [[shapes]]\ntype = \"sphere\"\nmaterial = \"m\"\n"
+        )
+    };
+    let albedo = |src: &str| match &load_str(&scene(src), Path::new("s.toml"))
+        .unwrap()
+        .materials[0]
+    {
+        Material::Subsurface(s) => s.params.albedo,
+        _ => unreachable!(),
+    };
+    assert_eq!(albedo("albedo_source = \"given\""), [0.83, 0.79, 0.75]);
+    let table = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
+    assert_eq!(albedo(""), table.albedo);
+    assert_eq!(albedo("albedo_source = \"Table\""), table.albedo);
+    let e = load_str(&scene("albedo_source = \"dipole\""), Path::new("s.toml")).unwrap_err();
+    assert_eq!(e.line, Some(8));
+    assert_eq!(e.field.as_deref(), Some("materials.m.albedo_source"));
+    assert!(
+        e.message.contains("dipole") && e.message.contains("table or given"),
+        "{e}"
+    );
 }

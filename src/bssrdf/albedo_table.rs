@@ -21,7 +21,7 @@
 //! curved near x = 0 at high η (the boundary term e^{−4/3·A_η·√(3(1−α'))}),
 //! so what is interpolated (bilinearly in x and η) is the ratio
 //! ρ = R / R_dipole(α', η) to the classical dipole
-//! (`params::dipole_reflectance`), which carries that curvature: the
+//! (`dipole::dipole_reflectance`), which carries that curvature: the
 //! interpolation error at the x midpoints fell 5× (η = 1.5) to 4× (η = 2)
 //! against interpolating R itself. The generator measures it at every
 //! x midpoint with the same walks, and at η midpoints (header of the data
@@ -33,11 +33,11 @@
 //!
 //! **Range.** η outside [1, 2] is outside the table: [`AlbedoTable::reflectance`]
 //! returns None and the caller falls back to the classical dipole
-//! (`params::dipole_reflectance`).
+//! (`dipole::dipole_reflectance`).
 
 use std::sync::OnceLock;
 
-use super::params::dipole_reflectance;
+use super::dipole::dipole_reflectance;
 
 /// ρ = R / R_dipole at the equally spaced x nodes of one row (η fixed);
 /// at x = 1, where both vanish, ρ of the node before.
@@ -107,7 +107,14 @@ pub struct AlbedoTable {
     pub max_se: f64,
 }
 
-const COLUMNS: [&str; 6] = ["eta", "x", "r_diffuse", "se_diffuse", "r_normal", "se_normal"];
+const COLUMNS: [&str; 6] = [
+    "eta",
+    "x",
+    "r_diffuse",
+    "se_diffuse",
+    "r_normal",
+    "se_normal",
+];
 
 impl AlbedoTable {
     /// The embedded table, parsed once.
@@ -180,7 +187,11 @@ impl AlbedoTable {
             return Err(err(
                 rows.last().map_or(hl, |r| r.0),
                 "row",
-                format!("{} rows do not form a grid over {} eta", rows.len(), etas.len()),
+                format!(
+                    "{} rows do not form a grid over {} eta",
+                    rows.len(),
+                    etas.len()
+                ),
             ));
         }
         let xs: Vec<f64> = rows[..nx].iter().map(|r| r.1[1]).collect();
@@ -200,11 +211,19 @@ impl AlbedoTable {
             let block = &rows[i * nx..(i + 1) * nx];
             for (j, (ln, v)) in block.iter().enumerate() {
                 if v[0] != eta {
-                    return Err(err(*ln, "eta", format!("expected {eta} ({nx} rows per eta)")));
+                    return Err(err(
+                        *ln,
+                        "eta",
+                        format!("expected {eta} ({nx} rows per eta)"),
+                    ));
                 }
                 let want = j as f64 / (nx - 1) as f64;
                 if (v[1] - xs[j]).abs() > 1e-9 || (v[1] - want).abs() > 1e-3 {
-                    return Err(err(*ln, "x", format!("expected {want:.4} (a regular grid on [0, 1])")));
+                    return Err(err(
+                        *ln,
+                        "x",
+                        format!("expected {want:.4} (a regular grid on [0, 1])"),
+                    ));
                 }
                 t.max_se = t.max_se.max(v[3]).max(v[5]);
             }
@@ -225,7 +244,7 @@ impl AlbedoTable {
     /// ρ bilinearly in (x, η), times the dipole.
     fn lerp(&self, rho: &[Vec<f64>], alpha_reduced: f64, eta: f64) -> Option<f64> {
         let (lo, hi) = self.eta_range();
-        if !(eta >= lo && eta <= hi) || !alpha_reduced.is_finite() {
+        if !(lo..=hi).contains(&eta) || !alpha_reduced.is_finite() {
             return None;
         }
         let a = alpha_reduced.clamp(0.0, 1.0);
@@ -274,7 +293,6 @@ fn cell(nodes: &[f64], v: f64) -> (usize, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bssrdf::params::dipole_reflectance;
 
     #[test]
     fn embedded_table_parses_and_is_monotone() {
@@ -294,7 +312,11 @@ mod tests {
             }
             // normal entry goes deeper, so less comes back
             for j in 1..t.xs.len() - 1 {
-                assert!(t.normal[i][j] < t.diffuse[i][j] + 3.0 * t.max_se, "eta {eta} x {}", t.xs[j]);
+                assert!(
+                    t.normal[i][j] < t.diffuse[i][j] + 3.0 * t.max_se,
+                    "eta {eta} x {}",
+                    t.xs[j]
+                );
             }
         }
     }
@@ -323,7 +345,10 @@ mod tests {
             for a in [0.0, 0.05, 0.3, 0.7, 0.95, 0.999] {
                 let ap = t.invert(a, eta).unwrap();
                 let back = t.reflectance(ap, eta).unwrap();
-                assert!((back - a).abs() < 1e-9, "η {eta} A {a}: α' {ap} gives {back}");
+                assert!(
+                    (back - a).abs() < 1e-9,
+                    "η {eta} A {a}: α' {ap} gives {back}"
+                );
             }
         }
     }

@@ -8,6 +8,7 @@
 //! - [`params`]: presets, measured and artist parameters → per-channel (A, d);
 //! - [`albedo_table`]: what a medium behind its boundary reflects, R(α', η),
 //!   the A that `params` uses by default;
+//! - [`dipole`]: the classical dipole's total diffuse reflectance;
 //! - [`radius`]: the four radius samplers with their disk pdfs;
 //! - [`probe`]: the probe-ray estimator: samples probe segments and weighs
 //!   the hits the integrator finds on them;
@@ -39,6 +40,7 @@
 
 pub mod albedo_table;
 pub mod density;
+pub mod dipole;
 pub mod fresnel_moment;
 pub mod params;
 pub mod probe;

@@ -48,6 +48,7 @@
 //! relation, with the A in use.
 
 use super::albedo_table::AlbedoTable;
+pub use super::dipole::dipole_reflectance;
 use super::profile::Fit;
 use crate::error::{Constraint, Param, ParamError};
 
@@ -320,27 +321,6 @@ impl Medium {
         }
         m
     }
-}
-
-/// Diffuse Fresnel reflectance Fdr(η), the Egan & Hilgeman polynomial fit
-/// the dipole's boundary condition uses (Jensen et al. 2001, §2.4).
-fn fdr(eta: f64) -> f64 {
-    if eta >= 1.0 {
-        -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
-    } else {
-        -0.4399 + 0.7099 / eta - 0.3319 / (eta * eta) + 0.0636 / (eta * eta * eta)
-    }
-}
-
-/// Total diffuse reflectance of the classical dipole for reduced albedo α'
-/// at relative index η (Jensen et al. 2001, eq. 5 integrated; Jensen &
-/// Buhler 2002 eq. 2): Rd = α'/2 (1 + e^{−4/3 A √(3(1−α'))}) e^{−√(3(1−α'))},
-/// A = (1 + Fdr)/(1 − Fdr). Increasing in α' from 0 to Rd(1) = 1.
-pub fn dipole_reflectance(alpha: f64, eta: f64) -> f64 {
-    let fd = fdr(eta);
-    let big_a = (1.0 + fd) / (1.0 - fd);
-    let s = (3.0 * (1.0 - alpha).max(0.0)).sqrt();
-    0.5 * alpha * (1.0 + (-4.0 / 3.0 * big_a * s).exp()) * (-s).exp()
 }
 
 /// The α' with `dipole_reflectance(α', η) = rd` (bisection to f64 precision),
@@ -690,7 +670,10 @@ mod tests {
             eta: 1.3,
         };
         let p = SubsurfaceParams::from_measured(&m, 1.0, Fit::Searchlight).unwrap();
-        assert!(p.albedo[0] < p.albedo[1] && p.albedo[1] < p.albedo[2], "{p:?}");
+        assert!(
+            p.albedo[0] < p.albedo[1] && p.albedo[1] < p.albedo[2],
+            "{p:?}"
+        );
         // artist form: the derived medium reflects A by the table, and
         // differs from the dipole's medium
         let a = [0.2, 0.5, 0.9];
@@ -718,7 +701,18 @@ mod tests {
         }
         // outside the table's η range: the dipole
         let out = SubsurfaceParams::from_artist(a, [1.0; 3], 2.4, Fit::Searchlight).unwrap();
-        assert_eq!(out.medium, SubsurfaceParams::from_artist_with(a, [1.0; 3], 2.4, Fit::Searchlight, AlbedoSource::Given).unwrap().medium);
+        assert_eq!(
+            out.medium,
+            SubsurfaceParams::from_artist_with(
+                a,
+                [1.0; 3],
+                2.4,
+                Fit::Searchlight,
+                AlbedoSource::Given
+            )
+            .unwrap()
+            .medium
+        );
         assert!(AlbedoSource::parse("TABLE") == Ok(AlbedoSource::Table));
         let e = AlbedoSource::parse("dipole").unwrap_err();
         assert!(e.to_string().starts_with("albedo_source:"), "{e}");
@@ -755,7 +749,10 @@ mod tests {
         assert!(k.d[2].is_finite());
         assert_eq!(k.max_active_d(), k.d[0].max(k.d[1]));
         let t = SubsurfaceParams::from_preset("ketchup", 1.0, Fit::Searchlight).unwrap();
-        assert!(t.active(2) && t.albedo[2] > 0.0 && t.albedo[2] < 0.02, "{t:?}");
+        assert!(
+            t.active(2) && t.albedo[2] > 0.0 && t.albedo[2] < 0.02,
+            "{t:?}"
+        );
     }
 
     #[test]

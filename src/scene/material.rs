@@ -14,7 +14,8 @@ use super::checked::{Cx, Res};
 use super::format::{MaterialDef, MaterialKind, Spanned, Triple3};
 use super::MAX_SUBSURFACE_RADIUS;
 use crate::bssrdf::{
-    AlbedoSource, ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler, SubsurfaceParams,
+    AlbedoSource, ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler,
+    SubsurfaceParams,
 };
 use crate::error::{Constraint, InputError, Param, ParamError};
 use crate::materials::{Material, Subsurface};

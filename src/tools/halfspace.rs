@@ -208,6 +208,16 @@ impl Default for TableSettings {
 }
 
 impl TableSettings {
+    /// `walks` walks with these settings' cap and streams.
+    pub fn batch(&self, walks: u64) -> Batch {
+        Batch {
+            walks,
+            cap: self.cap,
+            seed: self.seed,
+            chunk: self.chunk,
+        }
+    }
+
     /// The x = √(1 − α') nodes, and the midpoints between them (the
     /// interpolation check), in one list: nodes first.
     pub fn xs(&self) -> (Vec<f64>, Vec<f64>) {
@@ -218,20 +228,27 @@ impl TableSettings {
     }
 }
 
-/// The tally of `walks` walks at (η, g, entry) for the single-scattering
-/// albedos `albedos`. Chunk k draws from the stream (seed, entry, k), the
-/// same for every η and g: common random numbers, so differences between
-/// neighbouring η (the interpolation check) carry little noise.
-pub fn run(
-    eta: f64,
-    g: f64,
-    entry: Entry,
-    albedos: &[f64],
-    walks: u64,
-    cap: u32,
-    seed: u64,
-    chunk: u64,
-) -> Tally {
+/// How many walks to run and how: the event cap, and the random streams
+/// (chunk k of `chunk` walks draws from the stream (seed, entry, k)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Batch {
+    pub walks: u64,
+    pub cap: u32,
+    pub seed: u64,
+    pub chunk: u64,
+}
+
+/// The tally of `b.walks` walks at (η, g, entry) for the single-scattering
+/// albedos `albedos`. The streams are the same for every η and g: common
+/// random numbers, so differences between neighbouring η (the
+/// interpolation check) carry little noise.
+pub fn run(eta: f64, g: f64, entry: Entry, albedos: &[f64], b: &Batch) -> Tally {
+    let Batch {
+        walks,
+        cap,
+        seed,
+        chunk,
+    } = *b;
     use crate::sampling::Rng;
     use rayon::prelude::*;
     let chunks = walks.div_ceil(chunk);
@@ -297,8 +314,14 @@ pub fn generate(s: &TableSettings, mut progress: impl FnMut(&str)) -> Table {
     };
     let mut rows_by_eta: Vec<Vec<f64>> = Vec::new();
     for &eta in &s.etas {
-        let d = run(eta, 0.0, Entry::Diffuse, &albedos, s.walks_diffuse, s.cap, s.seed, s.chunk);
-        let n = run(eta, 0.0, Entry::Normal, &albedos, s.walks_normal, s.cap, s.seed, s.chunk);
+        let d = run(
+            eta,
+            0.0,
+            Entry::Diffuse,
+            &albedos,
+            &s.batch(s.walks_diffuse),
+        );
+        let n = run(eta, 0.0, Entry::Normal, &albedos, &s.batch(s.walks_normal));
         t.walk_events += d.events + n.events;
         let mut ys = Vec::new();
         for (i, &x) in nodes.iter().enumerate() {
@@ -342,9 +365,21 @@ pub fn generate(s: &TableSettings, mut progress: impl FnMut(&str)) -> Table {
     }
     // η midpoints: ρ linear in η between the two rows, times the dipole.
     for &eta in &s.eta_checks {
-        let d = run(eta, 0.0, Entry::Diffuse, &albedos, s.walks_diffuse / 3, s.cap, s.seed, s.chunk);
+        let d = run(
+            eta,
+            0.0,
+            Entry::Diffuse,
+            &albedos,
+            &s.batch(s.walks_diffuse / 3),
+        );
         t.walk_events += d.events;
-        let i = s.etas.iter().position(|&e| e > eta).unwrap_or(s.etas.len() - 1).max(1) - 1;
+        let i = s
+            .etas
+            .iter()
+            .position(|&e| e > eta)
+            .unwrap_or(s.etas.len() - 1)
+            .max(1)
+            - 1;
         let w = (eta - s.etas[i]) / (s.etas[i + 1] - s.etas[i]);
         for (j, &x) in nodes.iter().enumerate().skip(1) {
             let dip = crate::bssrdf::params::dipole_reflectance(1.0 - x * x, eta);
@@ -353,7 +388,7 @@ pub fn generate(s: &TableSettings, mut progress: impl FnMut(&str)) -> Table {
                 interpolate_row(&rows_by_eta[k], x, e)
                     / crate::bssrdf::params::dipole_reflectance(1.0 - x * x, e)
             };
-            if !(dip > 0.0) {
+            if dip.is_nan() || dip <= 0.0 {
                 continue;
             }
             let r = (rho(i) * (1.0 - w) + rho(i + 1) * w) * dip;
@@ -393,8 +428,15 @@ mod tests {
             }
             for i in 0..2 {
                 let (r, se) = t.estimate(i);
-                println!("{entry:?} α {}: R {r} ± {se}, H function {}", alphas[i], expect[i]);
-                assert!(se < 1e-3 && (r - expect[i]).abs() < 4.0 * se, "{r} vs {}", expect[i]);
+                println!(
+                    "{entry:?} α {}: R {r} ± {se}, H function {}",
+                    alphas[i], expect[i]
+                );
+                assert!(
+                    se < 1e-3 && (r - expect[i]).abs() < 4.0 * se,
+                    "{r} vs {}",
+                    expect[i]
+                );
             }
         }
     }
