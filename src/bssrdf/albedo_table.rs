@@ -95,7 +95,7 @@ pub struct TableError {
 pub struct AlbedoTable {
     pub etas: Vec<f64>,
     pub xs: Vec<f64>,
-    /// r_diffuse[i_eta][i_x]
+    /// `r_diffuse`, indexed `[i_eta][i_x]`.
     pub diffuse: Vec<Vec<f64>>,
     /// Light entering along the normal instead (what a camera straight
     /// above a slab sees).
@@ -107,7 +107,8 @@ pub struct AlbedoTable {
     pub max_se: f64,
 }
 
-const COLUMNS: [&str; 6] = [
+/// The data file's columns, in order.
+pub const COLUMNS: [&str; 6] = [
     "eta",
     "x",
     "r_diffuse",

@@ -8,8 +8,8 @@
 //! boundary z = 0 has relative index η (inside / outside). A walk is what
 //! `integrator::randomwalk` does inside a mesh, with the mesh replaced by
 //! the analytic plane: the same free-flight sampler
-//! ([`randomwalk::free_flight`]), phase-function sampler
-//! ([`randomwalk::sample_hg`]) and boundary ([`dielectric::sample`], which
+//! ([`free_flight`]), phase-function sampler
+//! ([`sample_hg`]) and boundary ([`dielectric::sample`], which
 //! reflects with probability Fr, refracts otherwise, and reflects totally
 //! beyond the critical angle).
 //!
