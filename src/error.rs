@@ -142,6 +142,8 @@ pub enum Param {
     UnitsPerMm,
     Preset,
     Fit,
+    /// Where the surface albedo comes from (`bssrdf::params::AlbedoSource`).
+    AlbedoSource,
     RadiusSampler,
     /// The cell count of a tabulated radius sampler.
     TableSize,
@@ -163,6 +165,7 @@ impl Param {
             Param::UnitsPerMm => "units_per_mm",
             Param::Preset => "preset",
             Param::Fit => "fit",
+            Param::AlbedoSource => "albedo_source",
             Param::RadiusSampler => "radius_sampler",
             Param::TableSize => "radius_sampler.table_size",
             Param::Rmax => "rmax",

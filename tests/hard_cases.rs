@@ -270,14 +270,23 @@ fn sigma_a_zero_spectralon_is_white_and_at_most_a() {
     }
 }
 
-/// A = 0 in a channel (Ketchup blue, A = 0.00): the channel is inactive —
+/// A = 0 in a channel (Ketchup blue, A = 0.00 in the Jensen table, kept
+/// with `albedo_source = "given"`; the albedo table gives it A ≈ 0.005):
+/// the channel is inactive —
 /// never sampled, never divided by. With no specular layer (which would
 /// reflect the white environment in every channel) every pixel of the slab
 /// must be exactly 0 in blue, for the recommended and the seed's sampling
 /// options, while red is lit and finite.
 #[test]
 fn zero_albedo_channel_ketchup_blue_is_exactly_zero() {
-    let p = SubsurfaceParams::from_preset("ketchup", 1.0, Fit::Searchlight).unwrap();
+    let p = SubsurfaceParams::from_preset_with(
+        "ketchup",
+        1.0,
+        Fit::Searchlight,
+        lucent::bssrdf::AlbedoSource::Given,
+        None,
+    )
+    .unwrap();
     assert_eq!(p.albedo[2], 0.0);
     for opts in [
         ProbeOptions::default(),

@@ -6,6 +6,9 @@
 //!
 //! - [`profile`]: R(r), its CDF and closed-form inverse, the s(A) fits;
 //! - [`params`]: presets, measured and artist parameters → per-channel (A, d);
+//! - [`albedo_table`]: what a medium behind its boundary reflects, R(α', η),
+//!   the A that `params` uses by default;
+//! - [`dipole`]: the classical dipole's total diffuse reflectance;
 //! - [`radius`]: the four radius samplers with their disk pdfs;
 //! - [`probe`]: the probe-ray estimator: samples probe segments and weighs
 //!   the hits the integrator finds on them;
@@ -36,7 +39,9 @@
 //! This module imports nothing from the accel, the integrator or the
 //! materials: the integrator's `probe` module runs the query.
 
+pub mod albedo_table;
 pub mod density;
+pub mod dipole;
 pub mod fresnel_moment;
 pub mod params;
 pub mod probe;
@@ -44,7 +49,7 @@ pub mod profile;
 pub mod radius;
 
 pub use fresnel_moment::{sw, sw_normalization, transmittance};
-pub use params::{Measured, Preset, SubsurfaceParams, PRESETS};
+pub use params::{AlbedoSource, Measured, Preset, SubsurfaceParams, PRESETS};
 pub use probe::{
     pick_hit, ChannelStrategy, ProbeAxes, ProbeEntry, ProbeOptions, ProbeRandoms, ProbeSampler,
     ProbeSegment,

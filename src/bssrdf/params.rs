@@ -18,7 +18,7 @@
 //!   1 − α' = 2.7e-5); Spectralon gets ℓd ≈ 50/28/39 mm: finite, white, and
 //!   the energy stays A·CDF(Rmax) ≤ A. A material with σs' = σa = 0 is an
 //!   error (no medium).
-//! - **A = 0** (Ketchup blue): the channel is inactive ([`SubsurfaceParams::active`]);
+//! - **A = 0** (Ketchup blue with [`AlbedoSource::Given`]): the channel is inactive ([`SubsurfaceParams::active`]);
 //!   samplers never pick it and never divide by its pdf; its d is still
 //!   computed (finite) but unused. d = 0 (artist ℓ = 0) is inactive too.
 //! - **Units**: the table is in mm⁻¹; `units_per_mm` converts lengths to
@@ -28,14 +28,87 @@
 //! scene units) that the brute-force random walk
 //! (`integrator::randomwalk`, which builds on this module) simulates. The preset and measured
 //! forms carry it directly (unfloored: the walk handles σa = 0 exactly).
-//! The artist form has none, so one is derived by inverting the classical
-//! dipole's total diffuse reflectance (Jensen et al. 2001, eq. 5; the same
-//! relation the Jensen table's Rd column follows, `docs/bssrdf.md` §3):
-//! α' is found by bisection so that Rd(α', η) = A, then σt' from the given
-//! length (σtr = 1/ℓd, or σt' = 1/ℓ for [`Fit::VolumeMfp`]), with g = 0.
+//! The artist form has none, so one is derived by inverting a total
+//! diffuse reflectance R(α', η): α' is found by bisection so that
+//! R(α', η) = A, then σt' from the given length (σtr = 1/ℓd, or σt' = 1/ℓ
+//! for [`Fit::VolumeMfp`]), with g = 0.
+//!
+//! **Where A comes from** ([`AlbedoSource`], `docs/bssrdf.md` §9). By
+//! default ([`AlbedoSource::Table`]) A is what the medium with its boundary
+//! reflects, R(α', η) from [`super::albedo_table`] (computed by the random
+//! walk's physics): for presets and measured media A = R(α', η) with
+//! α' = σs(1 − g) / (σs(1 − g) + σa) (the given `albedo` / the Jensen
+//! table's Rd column is not used), and the artist form inverts R. So the
+//! diffusion model and the random walk describe the same material. With
+//! [`AlbedoSource::Given`] (the behaviour before the table) presets and
+//! measured media use the given A and the artist form inverts the classical
+//! dipole's Rd (Jensen et al. 2001, eq. 5; the relation the Jensen table's
+//! Rd column follows, `docs/bssrdf.md` §3). η outside the table's [1, 2]
+//! falls back to the dipole in both places. d = ℓd / s(A) keeps its
+//! relation, with the A in use.
 
+use super::albedo_table::AlbedoTable;
+pub use super::dipole::dipole_reflectance;
 use super::profile::Fit;
 use crate::error::{Constraint, Param, ParamError};
+
+/// Where a material's surface albedo A comes from; see the module docs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AlbedoSource {
+    /// What the medium and its boundary reflect: R(α', η) from the albedo
+    /// table (the artist form inverts it).
+    #[default]
+    Table,
+    /// The A given (preset Rd column, measured `albedo`); the artist form
+    /// inverts the classical dipole.
+    Given,
+}
+
+impl AlbedoSource {
+    /// Parses "table" or "given" (case-insensitive).
+    pub fn parse(name: &str) -> Result<AlbedoSource, ParamError> {
+        match name.to_ascii_lowercase().as_str() {
+            "table" => Ok(AlbedoSource::Table),
+            "given" => Ok(AlbedoSource::Given),
+            other => Err(ParamError::new(
+                Param::AlbedoSource,
+                format!("\"{other}\""),
+                Constraint::Named {
+                    what: "albedo source",
+                    names: "expected table or given".into(),
+                },
+            )),
+        }
+    }
+}
+
+/// The embedded albedo table. It is compiled in and checked by the unit
+/// tests of `albedo_table`, so a failure here is a build defect, not bad
+/// input; the message names the file, line and field.
+fn table() -> &'static AlbedoTable {
+    AlbedoTable::get().unwrap_or_else(|e| panic!("embedded albedo table: {e}"))
+}
+
+/// The total diffuse reflectance of a semi-infinite medium of reduced
+/// albedo α' behind a boundary of index η: the albedo table, or the dipole
+/// outside its η range.
+pub fn medium_reflectance(alpha_reduced: f64, eta: f64) -> f64 {
+    table()
+        .reflectance(alpha_reduced, eta)
+        .unwrap_or_else(|| dipole_reflectance(alpha_reduced, eta))
+}
+
+/// The α' whose reflectance is `a` under `source` (table or dipole), capped
+/// at 1 − [`MIN_ABSORPTION_FRACTION`].
+pub fn invert_reflectance(a: f64, eta: f64, source: AlbedoSource) -> f64 {
+    match source {
+        AlbedoSource::Table => table()
+            .invert(a, eta)
+            .map(|x| x.min(1.0 - MIN_ABSORPTION_FRACTION))
+            .unwrap_or_else(|| invert_dipole_reflectance(a, eta)),
+        AlbedoSource::Given => invert_dipole_reflectance(a, eta),
+    }
+}
 
 /// Lower bound on σa / σt' used for σa = 0 media; see the module docs.
 pub const MIN_ABSORPTION_FRACTION: f64 = 1e-6;
@@ -205,10 +278,17 @@ impl Medium {
         std::array::from_fn(|c| self.sigma_s[c] + self.sigma_a[c])
     }
 
-    /// The medium whose dipole diffuse reflectance is `albedo` and whose
-    /// diffuse mean free path (or, with `volume_mfp`, volume mean free path
-    /// 1/σt') is `mfp` (scene units), g = 0. See the module docs.
-    pub fn from_reflectance(albedo: [f64; 3], mfp: [f64; 3], eta: f32, volume_mfp: bool) -> Medium {
+    /// The medium whose total diffuse reflectance (under `source`: the
+    /// albedo table or the dipole) is `albedo` and whose diffuse mean free
+    /// path (or, with `volume_mfp`, volume mean free path 1/σt') is `mfp`
+    /// (scene units), g = 0. See the module docs.
+    pub fn from_reflectance(
+        albedo: [f64; 3],
+        mfp: [f64; 3],
+        eta: f32,
+        volume_mfp: bool,
+        source: AlbedoSource,
+    ) -> Medium {
         let shortest = mfp
             .iter()
             .copied()
@@ -229,7 +309,7 @@ impl Medium {
                 m.sigma_a[c] = dense;
                 continue;
             }
-            let a = invert_dipole_reflectance(albedo[c], eta as f64);
+            let a = invert_reflectance(albedo[c], eta as f64, source);
             let st = if volume_mfp {
                 1.0 / mfp[c]
             } else {
@@ -241,27 +321,6 @@ impl Medium {
         }
         m
     }
-}
-
-/// Diffuse Fresnel reflectance Fdr(η), the Egan & Hilgeman polynomial fit
-/// the dipole's boundary condition uses (Jensen et al. 2001, §2.4).
-fn fdr(eta: f64) -> f64 {
-    if eta >= 1.0 {
-        -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
-    } else {
-        -0.4399 + 0.7099 / eta - 0.3319 / (eta * eta) + 0.0636 / (eta * eta * eta)
-    }
-}
-
-/// Total diffuse reflectance of the classical dipole for reduced albedo α'
-/// at relative index η (Jensen et al. 2001, eq. 5 integrated; Jensen &
-/// Buhler 2002 eq. 2): Rd = α'/2 (1 + e^{−4/3 A √(3(1−α'))}) e^{−√(3(1−α'))},
-/// A = (1 + Fdr)/(1 − Fdr). Increasing in α' from 0 to Rd(1) = 1.
-pub fn dipole_reflectance(alpha: f64, eta: f64) -> f64 {
-    let fd = fdr(eta);
-    let big_a = (1.0 + fd) / (1.0 - fd);
-    let s = (3.0 * (1.0 - alpha).max(0.0)).sqrt();
-    0.5 * alpha * (1.0 + (-4.0 / 3.0 * big_a * s).exp()) * (-s).exp()
 }
 
 /// The α' with `dipole_reflectance(α', η) = rd` (bisection to f64 precision),
@@ -328,6 +387,19 @@ impl SubsurfaceParams {
     /// A named Jensen 2001 preset (case-insensitive), lengths converted with
     /// `units_per_mm`, d from the chosen fit.
     pub fn from_preset(name: &str, units_per_mm: f64, fit: Fit) -> Result<Self, ParamError> {
+        Self::from_preset_with(name, units_per_mm, fit, AlbedoSource::default(), None)
+    }
+
+    /// [`Self::from_preset`] with the albedo taken from `source`, and the
+    /// preset's η replaced by `eta` if given (before A is derived: under
+    /// [`AlbedoSource::Table`] A depends on η).
+    pub fn from_preset_with(
+        name: &str,
+        units_per_mm: f64,
+        fit: Fit,
+        source: AlbedoSource,
+        eta: Option<f32>,
+    ) -> Result<Self, ParamError> {
         let pr = preset(name).ok_or_else(|| {
             let names: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
             ParamError::new(
@@ -339,22 +411,34 @@ impl SubsurfaceParams {
                 },
             )
         })?;
-        Self::from_measured(
+        Self::from_measured_with(
             &Measured {
                 sigma_s: pr.sigma_s_reduced,
                 sigma_a: pr.sigma_a,
                 g: 0.0,
                 albedo: pr.albedo,
-                eta: pr.eta,
+                eta: eta.unwrap_or(pr.eta),
             },
             units_per_mm,
             fit,
+            source,
         )
     }
 
     /// Measured coefficients (mm⁻¹) → per-channel (A, d). The length fed to
-    /// the fit is ℓd = 1/σtr, or 1/σt' for [`Fit::VolumeMfp`].
+    /// the fit is ℓd = 1/σtr, or 1/σt' for [`Fit::VolumeMfp`]. A is the
+    /// albedo table's R(α', η) (see the module docs).
     pub fn from_measured(m: &Measured, units_per_mm: f64, fit: Fit) -> Result<Self, ParamError> {
+        Self::from_measured_with(m, units_per_mm, fit, AlbedoSource::default())
+    }
+
+    /// [`Self::from_measured`] with the albedo taken from `source`.
+    pub fn from_measured_with(
+        m: &Measured,
+        units_per_mm: f64,
+        fit: Fit,
+        source: AlbedoSource,
+    ) -> Result<Self, ParamError> {
         check_finite_nonneg(Param::SigmaS, m.sigma_s)?;
         check_finite_nonneg(Param::SigmaA, m.sigma_a)?;
         check_albedo(m.albedo)?;
@@ -364,25 +448,29 @@ impl SubsurfaceParams {
             return Err(ParamError::new(Param::G, m.g, Constraint::Open(-1.0, 1.0)));
         }
         let mut d = [0.0; 3];
+        let mut albedo = m.albedo;
         for (c, dc) in d.iter_mut().enumerate() {
             let ss = m.sigma_s[c] * (1.0 - m.g);
             let sa = m.sigma_a[c];
             if ss + sa <= 0.0 {
                 return Err(ParamError::new(Param::SigmaS, 0, Constraint::SomeMedium).channel(c));
             }
+            if source == AlbedoSource::Table {
+                albedo[c] = medium_reflectance(ss / (ss + sa), m.eta as f64);
+            }
             let len_mm = if fit.uses_volume_mfp() {
                 1.0 / (ss + sa)
             } else {
                 diffuse_mfp(ss, sa)
             };
-            *dc = len_mm * units_per_mm / fit.s(m.albedo[c]);
+            *dc = len_mm * units_per_mm / fit.s(albedo[c]);
         }
         let medium = Medium {
             sigma_s: m.sigma_s.map(|s| s / units_per_mm),
             sigma_a: m.sigma_a.map(|s| s / units_per_mm),
             g: m.g,
         };
-        Self::checked(m.albedo, d, m.eta, medium)
+        Self::checked(albedo, d, m.eta, medium)
     }
 
     /// Artist form: albedo A and mean free path ℓ (scene units; diffuse mean
@@ -394,11 +482,23 @@ impl SubsurfaceParams {
         eta: f32,
         fit: Fit,
     ) -> Result<Self, ParamError> {
+        Self::from_artist_with(albedo, mfp, eta, fit, AlbedoSource::default())
+    }
+
+    /// [`Self::from_artist`] with the random-walk medium derived by
+    /// inverting `source`'s reflectance (the table, or the dipole).
+    pub fn from_artist_with(
+        albedo: [f64; 3],
+        mfp: [f64; 3],
+        eta: f32,
+        fit: Fit,
+        source: AlbedoSource,
+    ) -> Result<Self, ParamError> {
         check_albedo(albedo)?;
         check_finite_nonneg(Param::Mfp, mfp)?;
         check_eta(eta)?;
         let d = std::array::from_fn(|c| mfp[c] / fit.s(albedo[c]));
-        let medium = Medium::from_reflectance(albedo, mfp, eta, fit.uses_volume_mfp());
+        let medium = Medium::from_reflectance(albedo, mfp, eta, fit.uses_volume_mfp(), source);
         Self::checked(albedo, d, eta, medium)
     }
 
@@ -488,10 +588,16 @@ mod tests {
         );
     }
 
+    /// A preset with the table's own A (the behaviour before the albedo
+    /// table), so the formulas can be checked with the tabulated numbers.
+    fn given(name: &str, units: f64, fit: Fit) -> SubsurfaceParams {
+        SubsurfaceParams::from_preset_with(name, units, fit, AlbedoSource::Given, None).unwrap()
+    }
+
     #[test]
     fn measured_form_follows_the_formulas() {
         // Marble red by hand: σtr = √(3 σa (σs' + σa)), d = ℓd / s(A).
-        let m = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
+        let m = given("marble", 1.0, Fit::Searchlight);
         let (ss, sa, a) = (2.19f64, 0.0021f64, 0.83f64);
         let ld = 1.0 / (3.0 * sa * (ss + sa)).sqrt();
         let d = ld / (3.5 + 100.0 * (a - 0.33f64).powi(4));
@@ -499,10 +605,10 @@ mod tests {
         assert_eq!(m.albedo, [0.83, 0.79, 0.75]);
         assert_eq!(m.eta, 1.5);
         // units: a scene in metres
-        let mm = SubsurfaceParams::from_preset("marble", 1e-3, Fit::Searchlight).unwrap();
+        let mm = given("marble", 1e-3, Fit::Searchlight);
         assert!((mm.d[0] - d * 1e-3).abs() < 1e-15);
         // g: σs = σs'/(1 − g) gives the same result
-        let g = SubsurfaceParams::from_measured(
+        let g = SubsurfaceParams::from_measured_with(
             &Measured {
                 sigma_s: [2.19 / 0.2, 2.62 / 0.2, 3.0 / 0.2],
                 sigma_a: [0.0021, 0.0041, 0.0071],
@@ -512,16 +618,104 @@ mod tests {
             },
             1.0,
             Fit::Searchlight,
+            AlbedoSource::Given,
         )
         .unwrap();
         for c in 0..3 {
             assert!((g.d[c] - m.d[c]).abs() < 1e-9 * m.d[c]);
         }
         // volume mfp fit uses 1/σt'
-        let v = SubsurfaceParams::from_preset("marble", 1.0, Fit::VolumeMfp).unwrap();
+        let v = given("marble", 1.0, Fit::VolumeMfp);
         assert!((v.d[0] - 1.0 / (ss + sa) / Fit::VolumeMfp.s(a)).abs() < 1e-12);
-        let t = SubsurfaceParams::from_preset("marble", 1.0, Fit::DiffuseTransmission).unwrap();
+        let t = given("marble", 1.0, Fit::DiffuseTransmission);
         assert!((t.d[0] - ld / Fit::DiffuseTransmission.s(a)).abs() < 1e-12 * ld);
+    }
+
+    /// The default albedo source: A = R(α', η) of the albedo table for
+    /// presets and measured media (whatever `albedo` says), d = ℓd / s(A)
+    /// with that A, η overrides applied before A; the artist form's medium
+    /// reflects the A asked for; `given` keeps the old numbers.
+    #[test]
+    fn table_albedo_replaces_the_given_one() {
+        let t = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
+        let old = given("marble", 1.0, Fit::Searchlight);
+        let pr = preset("marble").unwrap();
+        for c in 0..3 {
+            let (ss, sa) = (pr.sigma_s_reduced[c], pr.sigma_a[c]);
+            let a = medium_reflectance(ss / (ss + sa), 1.5);
+            assert_eq!(t.albedo[c], a);
+            assert_ne!(t.albedo[c], old.albedo[c]);
+            let ld = diffuse_mfp(ss, sa);
+            assert!((t.d[c] - ld / Fit::Searchlight.s(a)).abs() < 1e-12 * ld);
+        }
+        assert_eq!(t.medium, old.medium);
+        assert_eq!(old.albedo, [0.83, 0.79, 0.75]);
+        // η = 1.0 lets more light out than η = 1.5
+        let e1 = SubsurfaceParams::from_preset_with(
+            "marble",
+            1.0,
+            Fit::Searchlight,
+            AlbedoSource::Table,
+            Some(1.0),
+        )
+        .unwrap();
+        assert_eq!(e1.eta, 1.0);
+        assert!((0..3).all(|c| e1.albedo[c] > t.albedo[c]), "{e1:?} {t:?}");
+        // the measured form ignores `albedo` under the table
+        let m = Measured {
+            sigma_s: [1.0, 2.0, 3.0],
+            sigma_a: [0.1, 0.01, 0.001],
+            g: 0.0,
+            albedo: [0.5; 3],
+            eta: 1.3,
+        };
+        let p = SubsurfaceParams::from_measured(&m, 1.0, Fit::Searchlight).unwrap();
+        assert!(
+            p.albedo[0] < p.albedo[1] && p.albedo[1] < p.albedo[2],
+            "{p:?}"
+        );
+        // artist form: the derived medium reflects A by the table, and
+        // differs from the dipole's medium
+        let a = [0.2, 0.5, 0.9];
+        let art = SubsurfaceParams::from_artist(a, [1.0; 3], 1.4, Fit::Searchlight).unwrap();
+        let dip = SubsurfaceParams::from_artist_with(
+            a,
+            [1.0; 3],
+            1.4,
+            Fit::Searchlight,
+            AlbedoSource::Given,
+        )
+        .unwrap();
+        let (mt, md) = (art.medium.unwrap(), dip.medium.unwrap());
+        let eta = 1.4f32 as f64; // η is stored as f32
+        for c in 0..3 {
+            let alpha = mt.sigma_s[c] / mt.sigma_t()[c];
+            let r = medium_reflectance(alpha, eta);
+            assert!((r - a[c]).abs() < 1e-9, "{c}: {r} vs {}", a[c]);
+            let alpha_d = md.sigma_s[c] / md.sigma_t()[c];
+            assert!((dipole_reflectance(alpha_d, eta) - a[c]).abs() < 1e-9);
+            assert_ne!(alpha, alpha_d);
+            // σtr = 1/ℓd in both
+            let st = mt.sigma_t()[c];
+            assert!(((3.0 * mt.sigma_a[c] * st).sqrt() - 1.0).abs() < 1e-9);
+        }
+        // outside the table's η range: the dipole
+        let out = SubsurfaceParams::from_artist(a, [1.0; 3], 2.4, Fit::Searchlight).unwrap();
+        assert_eq!(
+            out.medium,
+            SubsurfaceParams::from_artist_with(
+                a,
+                [1.0; 3],
+                2.4,
+                Fit::Searchlight,
+                AlbedoSource::Given
+            )
+            .unwrap()
+            .medium
+        );
+        assert!(AlbedoSource::parse("TABLE") == Ok(AlbedoSource::Table));
+        let e = AlbedoSource::parse("dipole").unwrap_err();
+        assert!(e.to_string().starts_with("albedo_source:"), "{e}");
     }
 
     #[test]
@@ -544,12 +738,21 @@ mod tests {
         }
     }
 
+    /// Ketchup blue: the Jensen table's A = 0 makes the channel inactive
+    /// (`given`). The albedo table gives what the medium reflects instead,
+    /// α' = 0.02 → A ≈ 0.005 (single scattering out of a strong absorber),
+    /// small but not 0, so the channel is active by default.
     #[test]
     fn ketchup_blue_is_inactive() {
-        let k = SubsurfaceParams::from_preset("ketchup", 1.0, Fit::Searchlight).unwrap();
+        let k = given("ketchup", 1.0, Fit::Searchlight);
         assert!(k.active(0) && k.active(1) && !k.active(2));
         assert!(k.d[2].is_finite());
         assert_eq!(k.max_active_d(), k.d[0].max(k.d[1]));
+        let t = SubsurfaceParams::from_preset("ketchup", 1.0, Fit::Searchlight).unwrap();
+        assert!(
+            t.active(2) && t.albedo[2] > 0.0 && t.albedo[2] < 0.02,
+            "{t:?}"
+        );
     }
 
     #[test]

@@ -391,8 +391,15 @@ mod tests {
 
     #[test]
     fn ketchup_blue_is_exactly_zero() {
-        let params =
-            SubsurfaceParams::from_preset("Ketchup", 1.0, profile::Fit::Searchlight).unwrap();
+        // The Jensen table's A = 0 in blue (the albedo table gives ≈ 0.002).
+        let params = SubsurfaceParams::from_preset_with(
+            "Ketchup",
+            1.0,
+            profile::Fit::Searchlight,
+            crate::bssrdf::AlbedoSource::Given,
+            None,
+        )
+        .unwrap();
         let accel = Brute {
             meshes: vec![planes(2000.0, &[0.0])],
         };

@@ -140,11 +140,7 @@ pub fn walk(
         }
         let q = beta.map(|b| b / total);
         let c = pick_channel(&q, rng.uniform_f64());
-        let t = if sigma_t[c] > 0.0 {
-            -(1.0 - rng.uniform_f64()).ln() / sigma_t[c]
-        } else {
-            f64::INFINITY
-        };
+        let t = free_flight(sigma_t[c], rng.uniform_f64());
 
         if t < t_max {
             // A real scattering event at distance t.
@@ -212,6 +208,16 @@ fn cross_boundary(
     let wi = frame.to_world(s.wi).normalize();
     // spawn offsets to the side wi goes: outside on exit, inside on reflection.
     (s.transmitted, si.spawn(wi, ctx.ray_epsilon), s.weight)
+}
+
+/// A free-flight distance t ~ σt e^{−σt t} from one uniform `u` ∈ [0, 1)
+/// (inverted CDF); infinite when σt = 0.
+pub fn free_flight(sigma_t: f64, u: f64) -> f64 {
+    if sigma_t > 0.0 {
+        -(1.0 - u).ln() / sigma_t
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// The channel whose cumulative probability interval holds `u`.

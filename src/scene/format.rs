@@ -146,6 +146,7 @@ pub struct MaterialDef {
     pub g: Option<Spanned<f64>>,
     pub dmfp: Option<Spanned<Triple3>>,
     pub fit: Option<Spanned<String>>,
+    pub albedo_source: Option<Spanned<String>>,
     // subsurface: sampling options
     pub radius: Option<Spanned<String>>,
     pub rmax_quantile: Option<Spanned<f64>>,
@@ -176,6 +177,10 @@ impl MaterialDef {
         add("g", self.g.as_ref().map(|x| x.span()));
         add("dmfp", self.dmfp.as_ref().map(|x| x.span()));
         add("fit", self.fit.as_ref().map(|x| x.span()));
+        add(
+            "albedo_source",
+            self.albedo_source.as_ref().map(|x| x.span()),
+        );
         add("radius", self.radius.as_ref().map(|x| x.span()));
         add(
             "rmax_quantile",

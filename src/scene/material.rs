@@ -14,7 +14,8 @@ use super::checked::{Cx, Res};
 use super::format::{MaterialDef, MaterialKind, Spanned, Triple3};
 use super::MAX_SUBSURFACE_RADIUS;
 use crate::bssrdf::{
-    ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler, SubsurfaceParams,
+    AlbedoSource, ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler,
+    SubsurfaceParams,
 };
 use crate::error::{Constraint, InputError, Param, ParamError};
 use crate::materials::{Material, Subsurface};
@@ -29,6 +30,7 @@ const SUBSURFACE_KEYS: &[&str] = &[
     "dmfp",
     "eta",
     "fit",
+    "albedo_source",
     "radius",
     "rmax_quantile",
     "axes",
@@ -179,6 +181,7 @@ fn key_of(p: Param, m: &Spanned<MaterialDef>) -> Option<(&'static str, std::ops:
         Param::Eta => "eta",
         Param::Preset => "preset",
         Param::Fit => "fit",
+        Param::AlbedoSource => "albedo_source",
         Param::RadiusSampler | Param::TableSize => "radius",
         Param::RmaxQuantile => "rmax_quantile",
         Param::D | Param::Rmax | Param::UnitsPerMm => return None,
@@ -251,6 +254,10 @@ fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res
         Some((s, _)) => Fit::parse(s).map_err(located)?,
         None => Fit::Searchlight,
     };
+    let source = match text(&d.albedo_source) {
+        Some((s, _)) => AlbedoSource::parse(s).map_err(located)?,
+        None => AlbedoSource::default(),
+    };
     let eta = d
         .eta
         .as_ref()
@@ -272,11 +279,7 @@ fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res
     };
     match (text(&d.preset), sigma_s.or(sigma_a), dmfp) {
         (Some((name, _)), None, None) if albedo.is_none() && d.g.is_none() => {
-            let mut p = SubsurfaceParams::from_preset(name, units, fit).map_err(located)?;
-            if let Some(eta) = eta {
-                p.eta = eta;
-            }
-            Ok(p)
+            SubsurfaceParams::from_preset_with(name, units, fit, source, eta).map_err(located)
         }
         (None, Some(_), None) => {
             let (Some(ss), Some(sa)) = (sigma_s, sigma_a) else {
@@ -294,13 +297,19 @@ fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res
             let albedo = albedo.ok_or_else(|| missing_albedo("measured parameters"))?;
             let measured = measured(ss, sa, d.g.as_ref().map(|g| *g.get_ref()), albedo, eta);
             measured
-                .and_then(|ms| SubsurfaceParams::from_measured(&ms, units, fit))
+                .and_then(|ms| SubsurfaceParams::from_measured_with(&ms, units, fit, source))
                 .map_err(located)
         }
         (None, None, Some(mfp)) if d.g.is_none() => {
             let albedo = albedo.ok_or_else(|| missing_albedo("the artist form"))?;
-            SubsurfaceParams::from_artist(albedo, mfp.map(|x| x * units), eta.unwrap_or(1.3), fit)
-                .map_err(located)
+            SubsurfaceParams::from_artist_with(
+                albedo,
+                mfp.map(|x| x * units),
+                eta.unwrap_or(1.3),
+                fit,
+                source,
+            )
+            .map_err(located)
         }
         _ => Err(cx.err(m.span(), field, format!("subsurface parameters: {FORMS}"))),
     }

@@ -7,6 +7,8 @@
 //! - [`study`] (`lucent study`): the subsurface estimator's sampling
 //!   choices rendered at a ladder of sample counts against a long
 //!   reference: error against time.
+//! - [`halfspace`]: the albedo table's generator — the random walk's
+//!   physics in a plane-parallel half-space (`docs/bssrdf.md` §9).
 //! - [`plot`]: the PNG canvas, font, palette and log axes both draw with.
 //!
 //! The rule: the tools use the renderer, never the other way round. No
@@ -15,5 +17,6 @@
 //! it and names the offending file and line.
 
 pub mod bench;
+pub mod halfspace;
 pub mod plot;
 pub mod study;
