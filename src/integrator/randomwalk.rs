@@ -46,6 +46,7 @@
 //! around it, so the walk ends there with zero radiance (counted in
 //! [`Counters::walks_escaped`]) instead of scattering through infinite space.
 
+use super::interaction::offset_along;
 use super::path::{trace, Scatter, Scratch};
 use super::{Context, Counters};
 use crate::accel::Hit;
@@ -111,6 +112,16 @@ pub fn radiance(
 /// medium until it refracts out. Returns the ray leaving the object and the
 /// walk's throughput (per channel, including the exit refraction), or None
 /// when the walk was absorbed (Russian roulette), capped or escaped.
+///
+/// **Scattering points stay inside.** A scattering point sampled closer to
+/// the boundary than float rounding resolves can round to the outside;
+/// the next flight from there in an outward direction then meets no
+/// surface, and a closed mesh reported escaped walks (a few per million
+/// walks in a dense medium). A point closer to the boundary plane than the
+/// spawn offset of [`offset_along`] is therefore pushed inwards, along the
+/// normal of the triangle the flight was heading for, to that offset: the
+/// same margin every spawned ray keeps (a displacement ≤ 4·10⁻⁶ |p|, far
+/// below any mean free path the supported ranges allow).
 pub fn walk(
     ctx: &Context,
     m: &Medium,
@@ -156,7 +167,7 @@ pub fn walk(
             for k in 0..3 {
                 beta[k] *= m.sigma_s[k] * tr[k] / pdf;
             }
-            let p = ray.at(t as f32);
+            let p = inside_point(ctx, &ray, &hit, t, t_max);
             // The phase function is sampled exactly: its weight is 1.
             let d = sample_hg(ray.d, m.g, rng.uniform2());
             ray = Ray::new(p, d);
@@ -188,6 +199,24 @@ pub fn walk(
     }
     counters.walks_capped += 1;
     None
+}
+
+/// The scattering point at distance `t` < `t_max` along `ray`, whose flight
+/// was heading for `hit` at `t_max`, kept at least the spawn offset inside
+/// the plane of the hit triangle (see [`walk`]).
+#[inline]
+fn inside_point(ctx: &Context, ray: &Ray, hit: &Hit, t: f64, t_max: f64) -> Vec3 {
+    let p = ray.at(t as f32);
+    let ng = ctx.scene.meshes[hit.geom as usize].face_normals()[hit.prim as usize];
+    let cos = ray.d.dot(ng);
+    let gap = (t_max - t) as f32 * cos.abs();
+    let margin = ctx.ray_epsilon.max(p.abs().max_element() * 4e-6);
+    if gap < margin {
+        let n_out = if cos > 0.0 { ng } else { -ng };
+        p - n_out * (margin - gap)
+    } else {
+        p
+    }
 }
 
 /// Fresnel at the boundary seen from inside: refract out (true) or reflect
