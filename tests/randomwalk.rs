@@ -723,3 +723,33 @@ fn diffuse_boundary_is_deterministic_across_thread_counts() {
         .iter()
         .all(|p| p.is_finite() && p.min_element() >= 0.0));
 }
+
+/// The study compares both boundaries: the full matrix has a `boundary`
+/// row rendering the random walk with the other boundary than the scene's,
+/// and applying its overrides sets it on every subsurface material.
+#[test]
+fn study_matrix_has_the_other_boundary() {
+    use lucent::tools::study::config::{apply, matrix};
+    use lucent::tools::study::Axis;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slab-uniform.toml");
+    let s = lucent::scene::load(&path).unwrap();
+    let full = matrix(&s, false, &[Backend::Bvh]).unwrap();
+    let rows: Vec<_> = full.iter().filter(|c| c.axis == Axis::Boundary).collect();
+    assert_eq!(rows.len(), 1);
+    let row = rows[0];
+    assert_eq!(row.integrator, IntegratorKind::RandomWalk);
+    assert_eq!(
+        (row.name.as_str(), row.value.as_str()),
+        ("boundary=diffuse", "diffuse")
+    );
+    let applied = apply(&s, &row.overrides).unwrap();
+    for m in &applied.materials {
+        if let Material::Subsurface(ss) = m {
+            assert_eq!(ss.boundary, WalkBoundary::Diffuse { exit_nee: true });
+        }
+    }
+    assert!(!matrix(&s, true, &[Backend::Bvh])
+        .unwrap()
+        .iter()
+        .any(|c| c.axis == Axis::Boundary));
+}
