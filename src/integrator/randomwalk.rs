@@ -43,11 +43,11 @@
 //! **Light sampling.** Through the dielectric boundary light reaches the
 //! medium only by the walk refracting out and the path finding the light:
 //! a refracted direction is a delta, so no light can be sampled there, and
-//! small lights are noisy (relMSE×spp ≥ 22 on a 10 mm marble sphere under
+//! small lights are noisy (relMSE×spp ≈ 87 on a 10 mm marble sphere under
 //! an 8 mm light, `docs/bssrdf.md` §7). Through the diffuse boundary the
 //! exit point is a path vertex with the exit lobe (`path::Lobe::WalkExit`),
-//! where the shared bounce loop samples the lights with MIS (0.48 on the
-//! same scene, for its own model). Inside, Russian
+//! where the shared bounce loop samples the lights with MIS (≈ 0.5 on the
+//! same scene, for its own model, at the same cost per sample). Inside, Russian
 //! roulette on the walk's throughput ends absorbed walks early; walks longer
 //! than [`MAX_WALK_EVENTS`] are stopped (counted in
 //! [`Counters::walks_capped`]). On an open mesh a walk may leave through a
