@@ -12,7 +12,7 @@ use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
 use lucent::error::{Param, ParamError};
 use lucent::film::ToneMap;
 use lucent::integrator::IntegratorKind;
-use lucent::materials::SubsurfaceOverrides;
+use lucent::materials::{SubsurfaceOverrides, WalkBoundary};
 use lucent::render::{self, RenderOptions};
 use lucent::scene;
 use lucent::Error;
@@ -126,6 +126,16 @@ struct SubsurfaceArgs {
     /// Specular reflection layer on top.
     #[arg(long)]
     specular: Option<bool>,
+    /// Random-walk boundary: dielectric (exact, smooth) | diffuse (diffuse
+    /// Fresnel transmission with light sampling at the exit; another model).
+    #[arg(long, value_enum)]
+    boundary: Option<BoundaryArg>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum BoundaryArg {
+    Dielectric,
+    Diffuse,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -162,6 +172,10 @@ impl SubsurfaceArgs {
             renormalize: self.renormalize,
             exit_sw: self.exit_sw,
             specular: self.specular,
+            boundary: self.boundary.map(|b| match b {
+                BoundaryArg::Dielectric => WalkBoundary::Dielectric,
+                BoundaryArg::Diffuse => WalkBoundary::Diffuse { exit_nee: true },
+            }),
         }
     }
 }
@@ -361,7 +375,8 @@ struct StudyArgs {
     #[arg(long, default_value_t = 10.0)]
     firefly_k: f64,
     /// Only these axes (comma separated: radius, rmax, axes, channel,
-    /// renormalize, exit_sw, specular, backend, integrator); the baseline always runs.
+    /// renormalize, exit_sw, specular, backend, integrator, boundary); the baseline
+    /// always runs.
     #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
     only: Vec<lucent::tools::study::Axis>,
     /// No progress bars.

@@ -428,6 +428,13 @@ fn cases() -> Vec<Case> {
             Some("materials.skin.channel"),
         ),
         case(
+            "subsurface unknown random-walk boundary",
+            format!("{CAM}{SSS}preset = \"skin1\"\nboundary = \"lambertian\"\n"),
+            "expected \"dielectric\" or \"diffuse\", found \"lambertian\"",
+            Some("lambertian"),
+            Some("materials.skin.boundary"),
+        ),
+        case(
             "subsurface unknown fit",
             format!("{CAM}{SSS}preset = \"skin1\"\nfit = \"dipole\"\n"),
             "unknown fit \"dipole\"",
@@ -659,6 +666,11 @@ fn cli_exits_2_on_scene_errors_without_writing_output() {
             "unknown material \"gold\"",
         ),
         ("[camera\n".to_string(), None, "invalid table header"),
+        (
+            format!("{CAM}{SSS}preset = \"skin1\"\nboundary = \"rough\"\n"),
+            None,
+            "scene.toml:8: field `materials.skin.boundary`: expected \"dielectric\" or \"diffuse\"",
+        ),
         (
             format!(
                 "{CAM}{MAT}[[shapes]]\ntype = \"obj\"\nfile = \"mesh.obj\"\nmaterial = \"white\"\n"

@@ -7,8 +7,10 @@
 //! [`probe`] runs the BSSRDF's probe query: the BSSRDF samples the segment
 //! and weighs the hit, the integrator queries the accel.
 //! [`randomwalk`] is the brute-force volumetric reference for subsurface
-//! materials, selected with [`IntegratorKind`].
+//! materials, selected with [`IntegratorKind`]; [`diffuse_boundary`] is
+//! its optional diffuse Fresnel boundary model.
 
+pub mod diffuse_boundary;
 pub mod interaction;
 pub mod path;
 pub mod plan;

@@ -43,6 +43,9 @@ pub(crate) enum Lobe<'a> {
     /// The entry-point lobe of a subsurface material (Sw or 1/π), outward
     /// side only; its spectral weight was already applied by the probe.
     SubsurfaceEntry(&'a Subsurface),
+    /// Where a random walk left the medium through a diffuse Fresnel
+    /// boundary ([`super::diffuse_boundary::ExitLobe`]).
+    WalkExit(super::diffuse_boundary::ExitLobe),
 }
 
 impl Lobe<'_> {
@@ -51,12 +54,14 @@ impl Lobe<'_> {
         match self {
             Lobe::Diffuse(albedo) => diffuse::eval(*albedo, wo, wi),
             Lobe::SubsurfaceEntry(ss) => Vec3::splat(ss.lobe(wi.z)),
+            Lobe::WalkExit(exit) => Vec3::splat(exit.eval(wi)),
         }
     }
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             Lobe::Diffuse(_) => diffuse::pdf(wo, wi),
             Lobe::SubsurfaceEntry(_) => cosine_hemisphere_pdf(wi.z),
+            Lobe::WalkExit(exit) => exit.pdf(wi),
         }
     }
     /// Samples ωi; returns (ωi, f |cos| / pdf, pdf).
@@ -68,6 +73,7 @@ impl Lobe<'_> {
                 let pdf = cosine_hemisphere_pdf(wi.z);
                 (pdf > 0.0).then(|| (wi, Vec3::splat(ss.lobe(wi.z) * wi.z / pdf), pdf))
             }
+            Lobe::WalkExit(exit) => exit.sample(u).map(|(wi, w, pdf)| (wi, Vec3::splat(w), pdf)),
         }
     }
 }

@@ -10,7 +10,7 @@ pub mod subsurface;
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
-pub use subsurface::{Subsurface, SubsurfaceOverrides};
+pub use subsurface::{Subsurface, SubsurfaceOverrides, WalkBoundary};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {

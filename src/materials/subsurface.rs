@@ -26,6 +26,9 @@ pub struct Subsurface {
     /// Put a specular reflection layer (probability Fr) on top at xo; else
     /// the path is weighted by Ft = 1 − Fr and the reflected part is lost.
     pub specular: bool,
+    /// The boundary the random-walk integrator simulates (the diffusion
+    /// estimator ignores it).
+    pub boundary: WalkBoundary,
     /// c = 1 − 2 FM1(1/η), Sw's normalization.
     sw_c: f32,
 }
@@ -36,6 +39,7 @@ impl PartialEq for Subsurface {
             && self.probe.options() == o.probe.options()
             && self.exit_sw == o.exit_sw
             && self.specular == o.specular
+            && self.boundary == o.boundary
     }
 }
 
@@ -53,6 +57,7 @@ impl Subsurface {
             probe,
             exit_sw,
             specular,
+            boundary: WalkBoundary::Dielectric,
         })
     }
 
@@ -80,6 +85,41 @@ impl Subsurface {
     }
 }
 
+/// The boundary of a subsurface object in the random walk
+/// (`docs/bssrdf.md` §7, `crate::integrator::randomwalk`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WalkBoundary {
+    /// The exact smooth dielectric: Fresnel reflection or refraction along
+    /// Snell's direction.
+    #[default]
+    Dielectric,
+    /// The same Fresnel probabilities, but transmission forgets the
+    /// direction (`crate::integrator::diffuse_boundary`): a different model,
+    /// whose exit point is a vertex where lights are sampled.
+    /// `exit_nee: false` renders the same model without light sampling at
+    /// the exit (for tests and measurements; not in the scene format).
+    Diffuse { exit_nee: bool },
+}
+
+impl WalkBoundary {
+    /// "dielectric" or "diffuse" (case-insensitive).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "dielectric" => Some(WalkBoundary::Dielectric),
+            "diffuse" => Some(WalkBoundary::Diffuse { exit_nee: true }),
+            _ => None,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            WalkBoundary::Dielectric => "dielectric",
+            WalkBoundary::Diffuse { exit_nee: true } => "diffuse",
+            WalkBoundary::Diffuse { exit_nee: false } => "diffuse-no-nee",
+        }
+    }
+}
+
 /// Sampling choices that replace a material's own (from the command line
 /// or a study configuration); `None` keeps the material's setting.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -91,6 +131,7 @@ pub struct SubsurfaceOverrides {
     pub renormalize: Option<bool>,
     pub exit_sw: Option<bool>,
     pub specular: Option<bool>,
+    pub boundary: Option<WalkBoundary>,
 }
 
 impl SubsurfaceOverrides {
@@ -106,12 +147,14 @@ impl SubsurfaceOverrides {
         opts.axes = self.axes.unwrap_or(opts.axes);
         opts.channel = self.channel.unwrap_or(opts.channel);
         opts.renormalize = self.renormalize.unwrap_or(opts.renormalize);
-        Subsurface::new(
+        let mut out = Subsurface::new(
             ss.params,
             &opts,
             self.exit_sw.unwrap_or(ss.exit_sw),
             self.specular.unwrap_or(ss.specular),
-        )
+        )?;
+        out.boundary = self.boundary.unwrap_or(ss.boundary);
+        Ok(out)
     }
 
     /// Applies the overrides to every subsurface material of `materials`.
@@ -144,6 +187,16 @@ mod tests {
         assert_eq!(out.probe.options().radius, RadiusSampler::Analytic);
         assert!(out.exit_sw && !out.specular);
         assert_eq!(out.params, ss.params);
+        assert_eq!(out.boundary, WalkBoundary::Dielectric);
+        let walk = SubsurfaceOverrides {
+            boundary: WalkBoundary::parse("Diffuse"),
+            ..Default::default()
+        }
+        .apply(&out)
+        .unwrap();
+        assert_eq!(walk.boundary, WalkBoundary::Diffuse { exit_nee: true });
+        assert!(walk != out && walk.exit_sw && !walk.specular);
+        assert_eq!(WalkBoundary::parse("lambert"), None);
         let bad = SubsurfaceOverrides {
             rmax_quantile: Some(1.5),
             ..Default::default()

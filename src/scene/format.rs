@@ -155,6 +155,8 @@ pub struct MaterialDef {
     pub renormalize: Option<Spanned<bool>>,
     pub exit_sw: Option<Spanned<bool>>,
     pub specular: Option<Spanned<bool>>,
+    // subsurface: the random walk's boundary model
+    pub boundary: Option<Spanned<String>>,
 }
 
 impl MaterialDef {
@@ -191,6 +193,7 @@ impl MaterialDef {
         add("renormalize", self.renormalize.as_ref().map(|x| x.span()));
         add("exit_sw", self.exit_sw.as_ref().map(|x| x.span()));
         add("specular", self.specular.as_ref().map(|x| x.span()));
+        add("boundary", self.boundary.as_ref().map(|x| x.span()));
         v
     }
 }

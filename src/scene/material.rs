@@ -18,7 +18,7 @@ use crate::bssrdf::{
     SubsurfaceParams,
 };
 use crate::error::{Constraint, InputError, Param, ParamError};
-use crate::materials::{Material, Subsurface};
+use crate::materials::{Material, Subsurface, WalkBoundary};
 
 /// The keys a `type = "subsurface"` material accepts.
 const SUBSURFACE_KEYS: &[&str] = &[
@@ -38,6 +38,7 @@ const SUBSURFACE_KEYS: &[&str] = &[
     "renormalize",
     "exit_sw",
     "specular",
+    "boundary",
 ];
 
 /// The parameter forms, for messages.
@@ -85,13 +86,22 @@ pub(super) fn material(
         }
         MaterialKind::Subsurface => {
             cx.only_keys(&field, kind.name(), d.present_keys(), SUBSURFACE_KEYS)?;
-            let ss = Subsurface::new(
+            let mut ss = Subsurface::new(
                 parameters(cx, &field, m, units_per_mm as f64)?,
                 &sampling_options(cx, &field, m)?,
                 flag(&d.exit_sw),
                 flag(&d.specular),
             )
             .map_err(|e| locate_param(cx, &field, m, &e))?;
+            if let Some((s, span)) = text(&d.boundary) {
+                ss.boundary = WalkBoundary::parse(s).ok_or_else(|| {
+                    cx.err(
+                        span,
+                        &format!("{field}.boundary"),
+                        format!("expected \"dielectric\" or \"diffuse\", found \"{s}\""),
+                    )
+                })?;
+            }
             check_rmax(cx, &field, m, &ss, units_per_mm, units_def)?;
             Ok(Material::Subsurface(Arc::new(ss)))
         }

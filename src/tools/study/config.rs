@@ -12,7 +12,7 @@
 use crate::accel::Backend;
 use crate::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, RadiusSampler, TableSpacing};
 use crate::integrator::IntegratorKind;
-use crate::materials::Material;
+use crate::materials::{Material, WalkBoundary};
 use crate::scene::Scene;
 
 /// Which choice a configuration varies from the baseline.
@@ -28,10 +28,12 @@ pub enum Axis {
     Specular,
     Backend,
     Integrator,
+    /// The random walk with the diffuse Fresnel boundary (another model).
+    Boundary,
 }
 
 impl Axis {
-    pub const ALL: [Axis; 10] = [
+    pub const ALL: [Axis; 11] = [
         Axis::Baseline,
         Axis::Radius,
         Axis::RmaxQuantile,
@@ -42,6 +44,7 @@ impl Axis {
         Axis::Specular,
         Axis::Backend,
         Axis::Integrator,
+        Axis::Boundary,
     ];
 
     /// The name used in configuration names and the CSV.
@@ -57,6 +60,7 @@ impl Axis {
             Axis::Specular => "specular",
             Axis::Backend => "backend",
             Axis::Integrator => "integrator",
+            Axis::Boundary => "boundary",
         }
     }
 
@@ -146,6 +150,7 @@ fn full_probe(o: ProbeOptions) -> Overrides {
         renormalize: Some(o.renormalize),
         exit_sw: None,
         specular: None,
+        boundary: None,
     }
 }
 
@@ -166,6 +171,18 @@ fn scene_fresnel(scene: &Scene) -> Option<(bool, bool)> {
         Material::Subsurface(ss) => Some((ss.exit_sw, ss.specular)),
         _ => None,
     })
+}
+
+/// The first subsurface material's random-walk boundary.
+fn scene_boundary(scene: &Scene) -> WalkBoundary {
+    scene
+        .materials
+        .iter()
+        .find_map(|m| match m {
+            Material::Subsurface(ss) => Some(ss.boundary),
+            _ => None,
+        })
+        .unwrap_or_default()
 }
 
 /// The configurations being built: the baseline first, then one per value
@@ -352,6 +369,26 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
         base_backend,
         IntegratorKind::RandomWalk,
     );
+    if !quick {
+        // The random walk with the other boundary model (the scene's own is
+        // in the integrator row): a different model, so its "bias" against
+        // a random-walk reference of the scene's boundary is the models'
+        // difference.
+        let other = match scene_boundary(scene) {
+            WalkBoundary::Dielectric => WalkBoundary::Diffuse { exit_nee: true },
+            WalkBoundary::Diffuse { .. } => WalkBoundary::Dielectric,
+        };
+        m.add(
+            Axis::Boundary,
+            other.name().into(),
+            Overrides {
+                boundary: Some(other),
+                ..base_ov
+            },
+            base_backend,
+            IntegratorKind::RandomWalk,
+        );
+    }
     Ok(m.out)
 }
 
@@ -386,6 +423,9 @@ pub fn describe(ov: &Overrides) -> String {
     }
     if let Some(s) = ov.specular {
         parts.push(format!("specular {s}"));
+    }
+    if let Some(b) = ov.boundary {
+        parts.push(format!("random-walk boundary {}", b.name()));
     }
     parts.join(", ")
 }
