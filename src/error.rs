@@ -147,6 +147,8 @@ pub enum Param {
     TableSize,
     Rmax,
     RmaxQuantile,
+    /// The roughness of a subsurface material's coat.
+    Roughness,
 }
 
 impl Param {
@@ -167,6 +169,7 @@ impl Param {
             Param::TableSize => "radius_sampler.table_size",
             Param::Rmax => "rmax",
             Param::RmaxQuantile => "rmax_quantile",
+            Param::Roughness => "roughness",
         }
     }
 }

@@ -125,6 +125,9 @@ struct SubsurfaceArgs {
     /// Specular reflection layer on top.
     #[arg(long)]
     specular: Option<bool>,
+    /// Roughness of that layer in [0, 1] (0: a mirror; GGX with α = roughness²).
+    #[arg(long)]
+    roughness: Option<f32>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -159,6 +162,7 @@ impl SubsurfaceArgs {
             renormalize: self.renormalize,
             exit_sw: self.exit_sw,
             specular: self.specular,
+            roughness: self.roughness,
         }
     }
 }

@@ -154,6 +154,7 @@ pub struct MaterialDef {
     pub renormalize: Option<Spanned<bool>>,
     pub exit_sw: Option<Spanned<bool>>,
     pub specular: Option<Spanned<bool>>,
+    pub roughness: Option<Spanned<f64>>,
 }
 
 impl MaterialDef {
@@ -186,6 +187,7 @@ impl MaterialDef {
         add("renormalize", self.renormalize.as_ref().map(|x| x.span()));
         add("exit_sw", self.exit_sw.as_ref().map(|x| x.span()));
         add("specular", self.specular.as_ref().map(|x| x.span()));
+        add("roughness", self.roughness.as_ref().map(|x| x.span()));
         v
     }
 }

@@ -36,6 +36,7 @@ const SUBSURFACE_KEYS: &[&str] = &[
     "renormalize",
     "exit_sw",
     "specular",
+    "roughness",
 ];
 
 /// The parameter forms, for messages.
@@ -89,6 +90,9 @@ pub(super) fn material(
                 flag(&d.exit_sw),
                 flag(&d.specular),
             )
+            .and_then(|ss| {
+                ss.with_roughness(d.roughness.as_ref().map_or(0.0, |r| *r.get_ref() as f32))
+            })
             .map_err(|e| locate_param(cx, &field, m, &e))?;
             check_rmax(cx, &field, m, &ss, units_per_mm, units_def)?;
             Ok(Material::Subsurface(Arc::new(ss)))
@@ -181,6 +185,7 @@ fn key_of(p: Param, m: &Spanned<MaterialDef>) -> Option<(&'static str, std::ops:
         Param::Fit => "fit",
         Param::RadiusSampler | Param::TableSize => "radius",
         Param::RmaxQuantile => "rmax_quantile",
+        Param::Roughness => "roughness",
         Param::D | Param::Rmax | Param::UnitsPerMm => return None,
     };
     let present = m.get_ref().present_keys();

@@ -149,6 +149,7 @@ fn full_probe(o: ProbeOptions) -> Overrides {
         renormalize: Some(o.renormalize),
         exit_sw: None,
         specular: None,
+        roughness: None,
     }
 }
 
