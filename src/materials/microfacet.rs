@@ -206,10 +206,7 @@ impl RoughCoat {
         let mut sum = 0.0f64;
         for i in 0..n {
             for j in 0..n {
-                let u = [
-                    (i as f32 + 0.5) / n as f32,
-                    (j as f32 + 0.5) / n as f32,
-                ];
+                let u = [(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32];
                 if let Some((_, w, _)) = self.sample(wo, u) {
                     sum += w as f64;
                 }
@@ -339,9 +336,7 @@ mod tests {
             for theta in [0.2f64, 1.0, 1.4] {
                 let wo = dir(theta, 0.3);
                 let s = g.g1(wo) as f64
-                    * hemisphere(1500, 600, |m| {
-                        g.d(m) as f64 * (wo.dot(m).max(0.0)) as f64
-                    })
+                    * hemisphere(1500, 600, |m| g.d(m) as f64 * (wo.dot(m).max(0.0)) as f64)
                     / wo.z as f64;
                 assert!((s - 1.0).abs() < 3e-3, "α {alpha} θo {theta}: {s}");
             }
@@ -391,7 +386,9 @@ mod tests {
                 match coat.sample(wo, rng.uniform2()) {
                     Some((wi, _, _)) => {
                         let i = ((wi.z as f64 * nt as f64) as usize).min(nt - 1);
-                        let phi = (wi.y as f64).atan2(wi.x as f64).rem_euclid(std::f64::consts::TAU);
+                        let phi = (wi.y as f64)
+                            .atan2(wi.x as f64)
+                            .rem_euclid(std::f64::consts::TAU);
                         let j = ((phi / std::f64::consts::TAU * np as f64) as usize).min(np - 1);
                         counts[i * np + j] += 1.0;
                     }
@@ -410,7 +407,8 @@ mod tests {
                             let p = (j as f64 + (b as f64 + 0.5) / sub as f64) / np as f64
                                 * std::f64::consts::TAU;
                             let r = (1.0 - z * z).sqrt();
-                            let wi = Vec3::new((r * p.cos()) as f32, (r * p.sin()) as f32, z as f32);
+                            let wi =
+                                Vec3::new((r * p.cos()) as f32, (r * p.sin()) as f32, z as f32);
                             s += coat.pdf(wo, wi) as f64;
                         }
                     }
@@ -451,8 +449,7 @@ mod tests {
             let coat = RoughCoat::new(alpha, 1.5);
             for mu in [0.15f32, 0.5, 0.95] {
                 let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
-                let direct =
-                    hemisphere(1200, 600, |wi| (coat.eval(wo, wi) * wi.z) as f64);
+                let direct = hemisphere(1200, 600, |wi| (coat.eval(wo, wi) * wi.z) as f64);
                 assert!(direct <= 1.0);
                 let table = coat.albedo(mu) as f64;
                 assert!(
