@@ -14,9 +14,11 @@
 //! E differ from Fr by several per cent for rough coats, so weighting the
 //! medium by 1 − Fr instead of 1 − E would fail the furnace.
 //!
-//! The camera vertex splits the coated hit (coat and medium both
-//! followed); deeper hits choose one. A second furnace looks at a white
-//! diffuse panel above the slab, so every coated hit there is at depth ≥ 1.
+//! At the camera vertex the smooth coat is split (mirror and medium both
+//! followed); deeper hits, and rough coats everywhere, choose one (the
+//! rough coat with light sampling at xo). A second furnace looks at a
+//! white diffuse panel above the slab, so every coated hit there is at
+//! depth ≥ 1.
 
 mod common;
 
@@ -167,8 +169,8 @@ fn coated_slab_reflects_coat_albedo_plus_the_transmitted_part_times_a() {
     assert!(e < 0.9 * fr, "E {e} vs Fr {fr}");
 }
 
-/// Every coated hit here is at depth ≥ 1, where the coat and the medium are
-/// chosen between instead of split.
+/// Every coated hit here is at depth ≥ 1, where even the smooth coat and
+/// the medium are chosen between instead of split.
 #[test]
 fn white_furnace_holds_where_coated_hits_choose() {
     for roughness in [0.0, 0.4] {
