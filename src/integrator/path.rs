@@ -18,7 +18,7 @@
 //! **Coated subsurface hits.** The coat at xo reflects a fraction (Fr for
 //! the smooth coat, E(μo) for the rough one) and passes the rest into the
 //! medium. For the smooth coat, at vertices shallower than
-//! [`COAT_SPLIT_DEPTH`] both parts are followed (splitting: the mirror
+//! `COAT_SPLIT_DEPTH` both parts are followed (splitting: the mirror
 //! reflection becomes a second path, kept on a small stack, so the
 //! reflection of a small light is no longer a rare event); deeper, one of
 //! them is chosen with probability Fr. A rough coat is a lobe with
@@ -27,7 +27,7 @@
 //! E of choosing it (so the emission weight at the next hit agrees); the
 //! path then goes on by the coat with probability E, else into the medium.
 //! Light sampling already finds the highlight there, and splitting the
-//! rough coat measured worse per unit time (see [`COAT_SPLIT_DEPTH`]).
+//! rough coat measured worse per unit time (see `COAT_SPLIT_DEPTH`).
 
 use super::interaction::offset_along;
 use super::probe::{sample_entry, ProbeTarget};

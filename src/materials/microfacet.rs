@@ -44,7 +44,7 @@
 //! **Directional albedo** E(μo) = ∫ f cos θi dωi, the fraction of light
 //! arriving with cosine μo that the coat reflects. [`RoughCoat`] tabulates it
 //! on [`ALBEDO_NODES`] + 1 cosines by a midpoint rule over the sampling
-//! square: with the VNDF map u ↦ ωi, E(μo) = ∫[0,1]² Fr G2/G1 du, an
+//! square: with the VNDF map u ↦ ωi, E(μo) = ∫ over [0, 1)² of Fr G2/G1 du, an
 //! integrand bounded by 1 that falls to 0 at the horizon (G2 → 0), though
 //! for narrow lobes so steeply that the rule sees an edge. Measured against a
 //! 256² rule on 200 cosines per α, the table (64² points per node, linear
