@@ -149,6 +149,8 @@ pub enum Param {
     TableSize,
     Rmax,
     RmaxQuantile,
+    /// The roughness of a subsurface material's coat.
+    Roughness,
 }
 
 impl Param {
@@ -170,6 +172,7 @@ impl Param {
             Param::TableSize => "radius_sampler.table_size",
             Param::Rmax => "rmax",
             Param::RmaxQuantile => "rmax_quantile",
+            Param::Roughness => "roughness",
         }
     }
 }

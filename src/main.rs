@@ -126,6 +126,9 @@ struct SubsurfaceArgs {
     /// Specular reflection layer on top.
     #[arg(long)]
     specular: Option<bool>,
+    /// Roughness of that layer in [0, 1] (0: a mirror; GGX with α = roughness²).
+    #[arg(long)]
+    roughness: Option<f32>,
     /// Random-walk boundary: dielectric (exact, smooth) | diffuse (diffuse
     /// Fresnel transmission with light sampling at the exit; another model).
     #[arg(long, value_enum)]
@@ -176,6 +179,7 @@ impl SubsurfaceArgs {
                 BoundaryArg::Dielectric => WalkBoundary::Dielectric,
                 BoundaryArg::Diffuse => WalkBoundary::Diffuse { exit_nee: true },
             }),
+            roughness: self.roughness,
         }
     }
 }

@@ -393,6 +393,34 @@ fn cases() -> Vec<Case> {
             Some("materials.skin.rmax_quantile"),
         ),
         case(
+            "subsurface roughness above 1",
+            format!("{CAM}{SSS}preset = \"skin1\"\nroughness = 1.5\n"),
+            "roughness: 1.5 must be in [0, 1]",
+            Some("roughness"),
+            Some("materials.skin.roughness"),
+        ),
+        case(
+            "subsurface roughness negative",
+            format!("{CAM}{SSS}preset = \"skin1\"\nroughness = -0.1\n"),
+            "roughness: -0.1 must be in [0, 1]",
+            Some("roughness"),
+            Some("materials.skin.roughness"),
+        ),
+        case(
+            "subsurface roughness nan",
+            format!("{CAM}{SSS}preset = \"skin1\"\nroughness = nan\n"),
+            "roughness: NaN must be in [0, 1]",
+            Some("roughness"),
+            Some("materials.skin.roughness"),
+        ),
+        case(
+            "subsurface roughness not a number",
+            format!("{CAM}{SSS}preset = \"skin1\"\nroughness = \"rough\"\n"),
+            "invalid type: string \"rough\", expected f64",
+            Some("roughness"),
+            Some("materials.skin.roughness"),
+        ),
+        case(
             "subsurface unknown radius sampler",
             format!("{CAM}{SSS}preset = \"skin1\"\nradius = \"gauss\"\n"),
             "unknown sampler \"gauss\" (expected uniform, table[:N], table-uniform[:N], analytic or mixture)",
@@ -670,6 +698,11 @@ fn cli_exits_2_on_scene_errors_without_writing_output() {
             format!("{CAM}{SSS}preset = \"skin1\"\nboundary = \"rough\"\n"),
             None,
             "scene.toml:8: field `materials.skin.boundary`: expected \"dielectric\" or \"diffuse\"",
+        ),
+        (
+            format!("{CAM}{SSS}preset = \"skin1\"\nroughness = 2\n"),
+            None,
+            "scene.toml:8: field `materials.skin.roughness`",
         ),
         (
             format!(

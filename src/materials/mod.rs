@@ -5,6 +5,7 @@
 
 pub mod dielectric;
 pub mod diffuse;
+pub mod microfacet;
 pub mod subsurface;
 
 use std::sync::Arc;

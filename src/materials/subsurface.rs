@@ -12,9 +12,22 @@
 //! of a specular reflection layer, and the lobe at xi is either the
 //! normalized Fresnel lobe Sw (pbrt-v3 §11.4) or, as in the seed, a plain
 //! cosine lobe 1/π.
+//!
+//! **The coat.** The boundary is smooth (`roughness` = 0, a mirror) or a
+//! rough GGX dielectric ([`super::microfacet`], α = roughness²). For a rough
+//! coat, Fr(μo) becomes the coat's directional albedo E(μo): the coat
+//! reflects with its microfacet BRDF, and 1 − E(μo) of the light enters
+//! the medium; the entry lobe becomes (1 − E(μi)) / ((1 − Ē) π) with
+//! Ē = 2 ∫ E μ dμ, so that S stays reciprocal and the lobe integrates to 1
+//! against cos θ. A white medium (A = 1) under a coat therefore reflects
+//! E + (1 − E) = 1 of uniform light (`docs/bssrdf.md` §6). `specular`
+//! says whether the coat's reflection is rendered; without it the path is
+//! weighted by the transmitted fraction (1 − Fr or 1 − E) and the reflected
+//! light is lost, for either roughness.
 
+use super::microfacet::{alpha_from_roughness, RoughCoat, SMOOTH_ALPHA};
 use crate::bssrdf::{sw_normalization, ProbeOptions, ProbeSampler, SubsurfaceParams};
-use crate::error::ParamError;
+use crate::error::{Constraint, Param, ParamError};
 use crate::geometry::Vec3;
 
 #[derive(Clone, Debug)]
@@ -29,7 +42,11 @@ pub struct Subsurface {
     /// The boundary the random-walk integrator simulates (the diffusion
     /// estimator ignores it).
     pub boundary: WalkBoundary,
-    /// c = 1 − 2 FM1(1/η), Sw's normalization.
+    /// The coat's roughness in [0, 1] (α = roughness²); 0 is a mirror.
+    pub roughness: f32,
+    /// The rough coat, when α ≥ [`SMOOTH_ALPHA`]; None: the smooth one.
+    coat: Option<RoughCoat>,
+    /// c = 1 − 2 FM1(1/η), Sw's normalization (for a rough coat, 1 − Ē).
     sw_c: f32,
 }
 
@@ -40,6 +57,7 @@ impl PartialEq for Subsurface {
             && self.exit_sw == o.exit_sw
             && self.specular == o.specular
             && self.boundary == o.boundary
+            && self.roughness == o.roughness
     }
 }
 
@@ -58,7 +76,34 @@ impl Subsurface {
             exit_sw,
             specular,
             boundary: WalkBoundary::Dielectric,
+            roughness: 0.0,
+            coat: None,
         })
+    }
+
+    /// The material with a coat of `roughness` ∈ [0, 1] (NaN is refused);
+    /// below α = [`SMOOTH_ALPHA`] the coat is the smooth one.
+    pub fn with_roughness(mut self, roughness: f32) -> Result<Self, ParamError> {
+        if !(0.0..=1.0).contains(&roughness) {
+            return Err(ParamError::new(
+                Param::Roughness,
+                roughness,
+                Constraint::UnitInterval,
+            ));
+        }
+        let alpha = alpha_from_roughness(roughness);
+        self.roughness = roughness;
+        self.coat = (alpha >= SMOOTH_ALPHA).then(|| RoughCoat::new(alpha, self.params.eta));
+        self.sw_c = match &self.coat {
+            Some(c) => 1.0 - c.mean_albedo(),
+            None => sw_normalization(self.params.eta),
+        };
+        Ok(self)
+    }
+
+    /// The rough coat, or None for a smooth one.
+    pub fn rough_coat(&self) -> Option<&RoughCoat> {
+        self.coat.as_ref()
     }
 
     pub fn eta(&self) -> f32 {
@@ -72,7 +117,10 @@ impl Subsurface {
             return 0.0;
         }
         if self.exit_sw {
-            crate::bssrdf::sw(cos, self.params.eta, self.sw_c)
+            match &self.coat {
+                Some(c) => (1.0 - c.albedo(cos)) * std::f32::consts::FRAC_1_PI / self.sw_c,
+                None => crate::bssrdf::sw(cos, self.params.eta, self.sw_c),
+            }
         } else {
             std::f32::consts::FRAC_1_PI
         }
@@ -132,6 +180,7 @@ pub struct SubsurfaceOverrides {
     pub exit_sw: Option<bool>,
     pub specular: Option<bool>,
     pub boundary: Option<WalkBoundary>,
+    pub roughness: Option<f32>,
 }
 
 impl SubsurfaceOverrides {
@@ -152,7 +201,8 @@ impl SubsurfaceOverrides {
             &opts,
             self.exit_sw.unwrap_or(ss.exit_sw),
             self.specular.unwrap_or(ss.specular),
-        )?;
+        )?
+        .with_roughness(self.roughness.unwrap_or(ss.roughness))?;
         out.boundary = self.boundary.unwrap_or(ss.boundary);
         Ok(out)
     }

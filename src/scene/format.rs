@@ -157,6 +157,7 @@ pub struct MaterialDef {
     pub specular: Option<Spanned<bool>>,
     // subsurface: the random walk's boundary model
     pub boundary: Option<Spanned<String>>,
+    pub roughness: Option<Spanned<f64>>,
 }
 
 impl MaterialDef {
@@ -194,6 +195,7 @@ impl MaterialDef {
         add("exit_sw", self.exit_sw.as_ref().map(|x| x.span()));
         add("specular", self.specular.as_ref().map(|x| x.span()));
         add("boundary", self.boundary.as_ref().map(|x| x.span()));
+        add("roughness", self.roughness.as_ref().map(|x| x.span()));
         v
     }
 }

@@ -39,6 +39,7 @@ const SUBSURFACE_KEYS: &[&str] = &[
     "exit_sw",
     "specular",
     "boundary",
+    "roughness",
 ];
 
 /// The parameter forms, for messages.
@@ -92,6 +93,9 @@ pub(super) fn material(
                 flag(&d.exit_sw),
                 flag(&d.specular),
             )
+            .and_then(|ss| {
+                ss.with_roughness(d.roughness.as_ref().map_or(0.0, |r| *r.get_ref() as f32))
+            })
             .map_err(|e| locate_param(cx, &field, m, &e))?;
             if let Some((s, span)) = text(&d.boundary) {
                 ss.boundary = WalkBoundary::parse(s).ok_or_else(|| {
@@ -194,6 +198,7 @@ fn key_of(p: Param, m: &Spanned<MaterialDef>) -> Option<(&'static str, std::ops:
         Param::AlbedoSource => "albedo_source",
         Param::RadiusSampler | Param::TableSize => "radius",
         Param::RmaxQuantile => "rmax_quantile",
+        Param::Roughness => "roughness",
         Param::D | Param::Rmax | Param::UnitsPerMm => return None,
     };
     let present = m.get_ref().present_keys();

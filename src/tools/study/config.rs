@@ -151,6 +151,7 @@ fn full_probe(o: ProbeOptions) -> Overrides {
         exit_sw: None,
         specular: None,
         boundary: None,
+        roughness: None,
     }
 }
 
