@@ -118,7 +118,17 @@ impl fmt::Display for InputError {
         }
         write!(f, ": ")?;
         if let Some(field) = &self.field {
-            write!(f, "field `{field}`: ")?;
+            // a control character (a raw newline from a quoted key) shown
+            // as its escape, so a message stays on one line
+            write!(f, "field `")?;
+            for c in field.chars() {
+                if c.is_control() {
+                    write!(f, "{}", c.escape_default())?;
+                } else {
+                    write!(f, "{c}")?;
+                }
+            }
+            write!(f, "`: ")?;
         }
         write!(f, "{}", self.message)
     }
@@ -302,6 +312,8 @@ mod tests {
     fn input_and_runtime_errors_are_told_apart() {
         let located = Error::from(InputError::new("a.toml", "bad").at_line(3).in_field("x"));
         assert_eq!(located.to_string(), "a.toml:3: field `x`: bad");
+        let raw = InputError::new("a.toml", "bad").in_field("m.\"a\nb\"");
+        assert_eq!(raw.to_string(), "a.toml: field `m.\"a\\nb\"`: bad");
         assert!(located.is_input());
         let param = Error::from(ParamError::new(Param::Eta, 0, Constraint::FinitePositive));
         assert!(param.is_input());

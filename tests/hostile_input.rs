@@ -284,3 +284,85 @@ fn a_directory_or_device_as_the_scene_is_refused() {
     }
     assert!(!exr.exists());
 }
+
+// --- (6) unclear messages
+
+#[test]
+fn bytes_that_are_not_toml_or_not_utf8_are_named_at_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("out.exr");
+    let scene = dir.path().join("scene.toml");
+    let without_render = SCENE.replace("[render]\nspp = 1\n", "");
+    let n = without_render.lines().count();
+    // (text before the scene, after it, what the first line must contain)
+    let cases: [(&[u8], &[u8], String); 4] = [
+        (
+            b"# caf\xe9\n",
+            b"",
+            "scene.toml:1: byte 0xe9 at column 6 is not valid UTF-8".into(),
+        ),
+        (
+            b"# a \x0c form feed\n",
+            b"",
+            "scene.toml:1: control character U+000C (form feed)".into(),
+        ),
+        (
+            b"",
+            b"[render]\nspp = 1 # \x00\n",
+            format!(
+                "scene.toml:{}: field `render.spp`: control character U+0000 (NUL)",
+                n + 2
+            ),
+        ),
+        (
+            b"",
+            b"[render]\nseed =",
+            format!(
+                "scene.toml:{}: field `render.seed`: the file ends in the middle of an assignment",
+                n + 2
+            ),
+        ),
+    ];
+    for (before, after, want) in cases {
+        let text = [before, without_render.as_bytes(), after].concat();
+        fs::write(&scene, &text).unwrap();
+        let o = render_scene(&scene, &exr);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        let first = e.lines().next().unwrap_or("");
+        assert!(first.contains(&want), "{first:?} lacks {want:?}");
+        assert_eq!(names(dir.path()), ["scene.toml"]);
+    }
+    // an OBJ that is not UTF-8: its line and column
+    fs::write(&scene, OBJ_SCENE).unwrap();
+    fs::write(
+        dir.path().join("mesh.obj"),
+        b"v 0 0 0\nv 1 0 0 # \xff\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let o = render_scene(&scene, &exr);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("mesh.obj") && e.contains("byte 0xff at line 2, column 11"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_scene_without_a_camera_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let no_camera = SCENE.replace(
+        "[camera]\nlook_from = [0, 0, 3]\nlook_at = [0, 0, 0]\nresolution = [8, 8]\n",
+        "",
+    );
+    assert!(!no_camera.contains("camera"));
+    let scene = write_scene(dir.path(), &no_camera);
+    let o = render_scene(&scene, &dir.path().join("out.exr"));
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("scene.toml: field `camera`: missing table `[camera]`"),
+        "{e}"
+    );
+}

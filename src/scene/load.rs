@@ -18,6 +18,7 @@ use super::format::{CameraDef, RenderDef, SceneFile, Spanned};
 use super::material::material;
 use super::objects::object;
 pub use super::regular_file::read_regular_file;
+use super::regular_file::{read_regular_bytes, utf8_text};
 use super::{show_point, Camera, RenderSettings, Scene, MAX_COORDINATE};
 use crate::error::InputError;
 use crate::geometry::Vec3;
@@ -30,8 +31,18 @@ pub const MAX_RESOLUTION: u32 = 16384;
 
 /// Reads and loads the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, InputError> {
-    let text = read_regular_file(path)
+    let bytes = read_regular_bytes(path)
         .map_err(|e| InputError::new(path, format!("cannot read scene file: {e}")))?;
+    let text = utf8_text(bytes).map_err(|e| {
+        InputError::new(
+            path,
+            format!(
+                "byte {:#04x} at column {} is not valid UTF-8 (a scene file is UTF-8 text)",
+                e.byte, e.column
+            ),
+        )
+        .at_line(e.line)
+    })?;
     load_str(&text, path)
 }
 
@@ -39,6 +50,7 @@ pub fn load(path: &Path) -> Result<Scene, InputError> {
 /// relative OBJ paths are resolved from (its directory).
 pub fn load_str(text: &str, path: &Path) -> Result<Scene, InputError> {
     let cx = Cx { file: path, text };
+    cx.no_control_characters()?;
     let def: SceneFile = toml::from_str(text).map_err(|e| cx.toml_error(&e))?;
     build(&cx, def)
 }
@@ -49,7 +61,15 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         Some(u) => cx.positive(u, "units_per_mm")?,
         None => 1.0,
     };
-    let camera = camera(cx, cx.required(&def.camera, None, "camera")?)?;
+    let Some(c) = &def.camera else {
+        return Err(InputError::new(
+            cx.file,
+            "missing table `[camera]`: every scene needs one, with look_from, look_at and \
+             resolution",
+        )
+        .in_field("camera"));
+    };
+    let camera = camera(cx, c)?;
     let settings = settings(cx, &def.render)?;
 
     // Materials: indexed in name order (the map is sorted), so the same file

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use super::checked::{Cx, Res};
 use super::format::{Numbers, ShapeDef, ShapeKind, Spanned};
+use super::key_path::{key_segment, quoted};
 use super::obj::{first_vertex_where, load_obj};
 use super::regular_file::read_regular_file;
 use super::transform::Transform;
@@ -31,7 +32,7 @@ pub(super) fn object(
     let sd = s.get_ref();
     let m = cx.required(&sd.material, Some(s.span()), &format!("{field}.material"))?;
     let Some(&mat) = materials.get(m.get_ref().as_str()) else {
-        let mut known: Vec<&str> = materials.keys().copied().collect();
+        let mut known: Vec<String> = materials.keys().map(|k| key_segment(k)).collect();
         known.sort_unstable();
         let known = if known.is_empty() {
             "no materials are defined".to_string()
@@ -41,7 +42,7 @@ pub(super) fn object(
         return Err(cx.err(
             m.span(),
             &format!("{field}.material"),
-            format!("unknown material \"{}\" ({known})", m.get_ref()),
+            format!("unknown material {} ({known})", quoted(m.get_ref())),
         ));
     };
     let emission = match &sd.emission {
