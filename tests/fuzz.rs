@@ -29,7 +29,8 @@
 //! Case `i` of seed `s` is a pure function of `(s, i)`: a failure is
 //! reproduced with `LUCENT_FUZZ_SEED=s` and printed in full. Environment:
 //! `LUCENT_FUZZ_SECONDS` (budget, default 60), `LUCENT_FUZZ_SEED` (default
-//! 1), `LUCENT_FUZZ_JOBS` (parallel cases, default 2),
+//! 1), `LUCENT_FUZZ_JOBS` (parallel cases, default 2), `LUCENT_FUZZ_BIN`
+//! (the binary to run, default this build's),
 //! `LUCENT_FUZZ_CORPUS` (a directory: every failing case is saved there,
 //! as `scripts/fuzz.sh` does into `tests/fuzz-corpus/`).
 //!
@@ -846,6 +847,14 @@ struct Outcome {
     bad_outputs: Vec<String>,
 }
 
+/// The binary under test: this build's, or `LUCENT_FUZZ_BIN` (another
+/// build, or a copy that a rebuild during a long run does not replace).
+fn binary() -> PathBuf {
+    std::env::var_os("LUCENT_FUZZ_BIN")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_lucent")))
+}
+
 fn case_timeout() -> Duration {
     let s = std::env::var("LUCENT_FUZZ_CASE_TIMEOUT")
         .ok()
@@ -859,7 +868,7 @@ fn run(case: &Case) -> Outcome {
     fs::write(dir.path().join("scene.toml"), &case.scene).unwrap();
     fs::write(dir.path().join("mesh.obj"), &case.mesh).unwrap();
     let before = listing(dir.path());
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+    let mut child = Command::new(binary())
         .args(&case.args)
         .current_dir(dir.path())
         .env_remove("RUST_BACKTRACE")
