@@ -151,7 +151,7 @@ pub fn render(
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    let mut film = Film::new(w, h);
+    let mut film = Film::try_new(w, h)?;
     let mut counters = Counters::default();
     for (&(x0, y0), (pixels, c)) in tiles.iter().zip(results) {
         counters += c;

@@ -366,3 +366,83 @@ fn a_scene_without_a_camera_says_so() {
         "{e}"
     );
 }
+
+// --- (9) memory: requests that cannot fit fail before allocating
+
+#[test]
+fn images_meshes_and_files_beyond_the_bounds_are_refused_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("out.exr");
+    // 16384² pixels: each side is allowed, the product is not
+    let scene = write_scene(
+        dir.path(),
+        &SCENE.replace("resolution = [8, 8]", "resolution = [16384, 16384]"),
+    );
+    let e = stderr(&render_scene(&scene, &exr));
+    assert!(
+        e.contains("scene.toml:4: field `camera.resolution`: [16384, 16384] is 268435456 pixels"),
+        "{e}"
+    );
+    // seven spheres of 20·4⁹ triangles: refused before the first is built
+    let sphere = "[[shapes]]\ntype = \"sphere\"\nmaterial = \"white\"\nsubdivisions = 9\n";
+    let scene = write_scene(dir.path(), &format!("{SCENE}{}", sphere.repeat(7)));
+    let start = Instant::now();
+    let o = render_scene(&scene, &exr);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains(
+            "field `shapes[7].subdivisions`: the scene's meshes add up to 36700162 triangles"
+        ),
+        "{e}"
+    );
+    assert!(
+        start.elapsed() < Duration::from_secs(5),
+        "{:?}",
+        start.elapsed()
+    );
+    // files too large to be scenes or meshes (sparse: no disk used)
+    fs::File::create(dir.path().join("mesh.obj"))
+        .unwrap()
+        .set_len((512 << 20) + 1)
+        .unwrap();
+    let scene = write_scene(dir.path(), OBJ_SCENE);
+    let e = stderr(&render_scene(&scene, &exr));
+    assert!(
+        e.contains("mesh.obj")
+            && e.contains("the file is 536870913 bytes, more than the 536870912 supported"),
+        "{e}"
+    );
+    let big = dir.path().join("big.toml");
+    fs::File::create(&big)
+        .unwrap()
+        .set_len((16 << 20) + 1)
+        .unwrap();
+    let o = render_scene(&big, &exr);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("big.toml") && e.contains("more than the 16777216 supported"),
+        "{e}"
+    );
+    assert_eq!(names(dir.path()), ["big.toml", "mesh.obj", "scene.toml"]);
+    // a benchmark's query sets
+    let out = dir.path().join("bench");
+    let o = lucent(&["bench", "--rays", "1e9", "-o", out.to_str().unwrap()]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("1 to 20M"), "{e}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_film_that_cannot_be_allocated_is_an_error_not_an_abort() {
+    let e = lucent::film::Film::try_new(u32::MAX, u32::MAX).unwrap_err();
+    assert!(!e.is_input());
+    assert!(
+        e.to_string().starts_with("out of memory: cannot allocate"),
+        "{e}"
+    );
+    let f = lucent::film::Film::try_new(3, 2).unwrap();
+    assert_eq!(f, lucent::film::Film::new(3, 2));
+}

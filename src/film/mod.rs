@@ -30,6 +30,21 @@ impl Film {
             pixels: vec![Vec3::ZERO; width as usize * height as usize],
         }
     }
+    /// [`Film::new`], failing with a message (a runtime error: exit code 1)
+    /// instead of aborting the process when the pixels cannot be allocated.
+    pub fn try_new(width: u32, height: u32) -> Result<Self, Error> {
+        let n = width as usize * height as usize;
+        let mut pixels = Vec::new();
+        pixels.try_reserve_exact(n).map_err(|_| {
+            out_of_memory(&format!("a {width}×{height} image"), n.saturating_mul(12))
+        })?;
+        pixels.resize(n, Vec3::ZERO);
+        Ok(Film {
+            width,
+            height,
+            pixels,
+        })
+    }
     pub fn get(&self, x: u32, y: u32) -> Vec3 {
         self.pixels[(y * self.width + x) as usize]
     }
@@ -112,7 +127,9 @@ impl Film {
     /// [`commit_all`].
     pub fn stage_png(&self, path: &Path, tonemap: ToneMap, exposure: f32) -> Result<Staged, Error> {
         let scale = exposure.exp2();
-        let mut buf = Vec::with_capacity(self.pixels.len() * 3);
+        let mut buf = Vec::new();
+        buf.try_reserve_exact(self.pixels.len() * 3)
+            .map_err(|_| out_of_memory("the PNG preview", self.pixels.len().saturating_mul(3)))?;
         for p in &self.pixels {
             let c = tonemap.apply(*p * scale);
             for v in [c.x, c.y, c.z] {
@@ -130,6 +147,14 @@ impl Film {
                 .map_err(|e| e.to_string())
         })
     }
+}
+
+/// The error of an allocation that failed: what it was for and its size.
+pub fn out_of_memory(what: &str, bytes: usize) -> Error {
+    Error::Runtime(format!(
+        "out of memory: cannot allocate {} MB for {what}",
+        bytes.div_ceil(1 << 20)
+    ))
 }
 
 /// Runs `write` on a temporary path next to `path`, then renames it into

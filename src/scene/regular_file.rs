@@ -14,14 +14,16 @@ use std::path::Path;
 ///
 /// Text that is not UTF-8 fails with [`NotUtf8`]'s message (line, column,
 /// byte).
-pub fn read_regular_file(path: &Path) -> std::io::Result<String> {
-    utf8_text(read_regular_bytes(path)?)
+pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
+    utf8_text(read_regular_bytes(path, max_bytes)?)
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()))
 }
 
 /// The bytes of a file that must be a regular file (see
-/// [`read_regular_file`]).
-pub fn read_regular_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
+/// [`read_regular_file`]) of at most `max_bytes`: a larger one is refused
+/// before it is read, so its size (and what parsing it would allocate) is
+/// bounded.
+pub fn read_regular_bytes(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
     let meta = std::fs::metadata(path)?;
     if !meta.is_file() {
         return Err(std::io::Error::new(
@@ -29,7 +31,29 @@ pub fn read_regular_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
             format!("not a regular file: it is {}", file_kind(&meta.file_type())),
         ));
     }
-    std::fs::read(path)
+    if meta.len() > max_bytes {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "the file is {} bytes, more than the {max_bytes} supported (see \"Supported \
+                 ranges\" in docs/scene-format.md)",
+                meta.len()
+            ),
+        ));
+    }
+    // take no more than the bound even if the file grows meanwhile
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(std::fs::File::open(path)?, max_bytes + 1),
+        &mut bytes,
+    )?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("the file grew past the {max_bytes} bytes supported while being read"),
+        ));
+    }
+    Ok(bytes)
 }
 
 /// Where text stops being UTF-8: the 1-based line and column (in
