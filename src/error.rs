@@ -51,6 +51,10 @@ pub enum Error {
     /// cannot be started).
     #[error("{0}")]
     Runtime(String),
+    /// Stopped by a signal (its number) before the outputs were committed;
+    /// nothing was written (see [`crate::interrupt`]).
+    #[error("interrupted by {}: stopped, no output written", crate::interrupt::signal_name(*.0))]
+    Interrupted(i32),
 }
 
 impl Error {
@@ -65,7 +69,10 @@ impl Error {
             | Error::Unavailable(_)
             | Error::Backend(_)
             | Error::Input(_) => true,
-            Error::Read { .. } | Error::Write { .. } | Error::Runtime(_) => false,
+            Error::Read { .. }
+            | Error::Write { .. }
+            | Error::Runtime(_)
+            | Error::Interrupted(_) => false,
         }
     }
 }

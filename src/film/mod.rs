@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::Error;
 use crate::geometry::Vec3;
+use crate::interrupt;
 pub use tonemap::ToneMap;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -190,6 +191,7 @@ impl Staged {
             tmp: temp_path(path),
             path: path.to_path_buf(),
         };
+        interrupt::register_temporary(&staged.tmp);
         // on failure, dropping `staged` removes the temporary file
         write(&staged.tmp).map_err(|problem| Error::Write {
             path: path.to_path_buf(),
@@ -208,6 +210,7 @@ impl Drop for Staged {
     fn drop(&mut self) {
         // gone already once committed
         let _ = fs::remove_file(&self.tmp);
+        interrupt::unregister_temporary(&self.tmp);
     }
 }
 
@@ -217,7 +220,13 @@ impl Drop for Staged {
 /// otherwise cannot be replaced by a file) fails the whole commit before
 /// anything moves. Files already under the names are set aside first and
 /// put back if a later rename fails; each rename on its own is atomic.
+///
+/// After a signal ([`interrupt::requested`]) nothing is committed: the
+/// temporary files are removed and the error is [`Error::Interrupted`].
 pub fn commit_all(files: Vec<Staged>) -> Result<(), Error> {
+    if let Some(sig) = interrupt::requested() {
+        return Err(Error::Interrupted(sig));
+    }
     let write_err = |path: &Path, problem: String| Error::Write {
         path: path.to_path_buf(),
         problem,
