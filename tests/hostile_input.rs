@@ -446,3 +446,92 @@ fn a_film_that_cannot_be_allocated_is_an_error_not_an_abort() {
     let f = lucent::film::Film::try_new(3, 2).unwrap();
     assert_eq!(f, lucent::film::Film::new(3, 2));
 }
+
+// --- (4) bench and study leave their output directory as it was
+
+#[test]
+fn a_study_refuses_a_directory_it_cannot_resume_before_writing_in_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slab-uniform.toml");
+    let out = dir.path().join("study");
+    fs::create_dir(&out).unwrap();
+    let header = lucent::tools::study::results::HEADER;
+    for (csv, want) in [
+        ("not,our,header\n1,2,3\n".to_string(), "unexpected header"),
+        (
+            format!("{header}\nsome row\n"),
+            "has rows but no results.key",
+        ),
+    ] {
+        fs::write(out.join("results.csv"), &csv).unwrap();
+        let o = lucent(&[
+            "study",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--quick",
+            "--quiet",
+        ]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(e.contains(want), "{e}");
+        // no state/, no cached reference: as it was
+        assert_eq!(names(&out), ["results.csv"]);
+        assert_eq!(fs::read_to_string(out.join("results.csv")).unwrap(), csv);
+    }
+}
+
+#[test]
+fn a_benchmark_stopped_before_its_results_are_written_leaves_no_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args([
+            "bench",
+            "-o",
+            out.to_str().unwrap(),
+            "--sizes",
+            "20",
+            "--rays",
+            "50000",
+        ])
+        .args(["--accel", "bvh", "--threads", "1", "--quiet"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    let ok = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok);
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "bench still running"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let o = child.wait_with_output().unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{e}");
+    assert!(e.contains("interrupted by SIGINT"), "{e}");
+    assert!(!out.exists(), "{:?}", names(&out));
+    assert_eq!(names(dir.path()), Vec::<String>::new());
+    // an output path under a file is refused before anything is measured
+    fs::write(dir.path().join("file"), b"").unwrap();
+    let o = lucent(&[
+        "bench",
+        "-o",
+        dir.path().join("file/out").to_str().unwrap(),
+        "--sizes",
+        "20",
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("exists and is not a directory"), "{e}");
+}
