@@ -217,12 +217,13 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            match lucent::interrupt::requested() {
+            let shown = match lucent::interrupt::requested() {
                 Some(sig) if !matches!(e, Error::Interrupted(_)) => {
-                    eprintln!("error: {}", Error::Interrupted(sig))
+                    Error::Interrupted(sig).to_string()
                 }
-                _ => eprintln!("error: {e}"),
-            }
+                _ => e.to_string(),
+            };
+            eprintln!("error: {}", without_control_characters(&shown));
             ExitCode::from(exit_code(&e))
         }
     }
@@ -325,6 +326,21 @@ fn run_render(
     }
     report_rejected_rays(accel.as_ref());
     Ok(())
+}
+
+/// `s` with every control character (from a file name, an OBJ line or a
+/// key quoted in the message) shown as its escape: a message is one line,
+/// and input cannot send escape sequences to the terminal.
+fn without_control_characters(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 /// [`Error::Interrupted`] once a signal asked the process to stop.

@@ -535,3 +535,23 @@ fn a_benchmark_stopped_before_its_results_are_written_leaves_no_directory() {
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(e.contains("exists and is not a directory"), "{e}");
 }
+
+#[test]
+fn control_characters_from_the_input_are_escaped_in_messages() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path(), OBJ_SCENE);
+    // an escape sequence (ESC [31m) inside a face index
+    fs::write(
+        dir.path().join("mesh.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\u{1b}[31m 3\n",
+    )
+    .unwrap();
+    let o = render_scene(&scene, &dir.path().join("out.exr"));
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(!e.contains('\u{1b}'), "{e:?}");
+    assert!(
+        e.contains("mesh.obj:4:") && e.contains("2\\u{1b}[31m"),
+        "{e:?}"
+    );
+}
