@@ -51,6 +51,10 @@ pub enum Error {
     /// cannot be started).
     #[error("{0}")]
     Runtime(String),
+    /// Stopped by a signal (its number) before the outputs were committed;
+    /// nothing was written (see [`crate::interrupt`]).
+    #[error("interrupted by {}: stopped, no output written", crate::interrupt::signal_name(*.0))]
+    Interrupted(i32),
 }
 
 impl Error {
@@ -65,7 +69,10 @@ impl Error {
             | Error::Unavailable(_)
             | Error::Backend(_)
             | Error::Input(_) => true,
-            Error::Read { .. } | Error::Write { .. } | Error::Runtime(_) => false,
+            Error::Read { .. }
+            | Error::Write { .. }
+            | Error::Runtime(_)
+            | Error::Interrupted(_) => false,
         }
     }
 }
@@ -118,7 +125,17 @@ impl fmt::Display for InputError {
         }
         write!(f, ": ")?;
         if let Some(field) = &self.field {
-            write!(f, "field `{field}`: ")?;
+            // a control character (a raw newline from a quoted key) shown
+            // as its escape, so a message stays on one line
+            write!(f, "field `")?;
+            for c in field.chars() {
+                if c.is_control() {
+                    write!(f, "{}", c.escape_default())?;
+                } else {
+                    write!(f, "{c}")?;
+                }
+            }
+            write!(f, "`: ")?;
         }
         write!(f, "{}", self.message)
     }
@@ -308,6 +325,8 @@ mod tests {
     fn input_and_runtime_errors_are_told_apart() {
         let located = Error::from(InputError::new("a.toml", "bad").at_line(3).in_field("x"));
         assert_eq!(located.to_string(), "a.toml:3: field `x`: bad");
+        let raw = InputError::new("a.toml", "bad").in_field("m.\"a\nb\"");
+        assert_eq!(raw.to_string(), "a.toml: field `m.\"a\\nb\"`: bad");
         assert!(located.is_input());
         let param = Error::from(ParamError::new(Param::Eta, 0, Constraint::FinitePositive));
         assert!(param.is_input());

@@ -13,6 +13,7 @@ pub mod film;
 pub mod fresnel;
 pub mod geometry;
 pub mod integrator;
+pub mod interrupt;
 pub mod kernels;
 pub mod lights;
 pub mod materials;

@@ -186,6 +186,9 @@ impl SubsurfaceArgs {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = lucent::interrupt::install() {
+        eprintln!("warning: cannot catch SIGINT/SIGTERM ({e}); an interrupted command may leave temporary files");
+    }
     let result = match cli.command {
         Command::Render {
             scene,
@@ -235,7 +238,13 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            let shown = match lucent::interrupt::requested() {
+                Some(sig) if !matches!(e, Error::Interrupted(_)) => {
+                    Error::Interrupted(sig).to_string()
+                }
+                _ => e.to_string(),
+            };
+            eprintln!("error: {}", without_control_characters(&shown));
             ExitCode::from(exit_code(&e))
         }
     }
@@ -243,8 +252,13 @@ fn main() -> ExitCode {
 
 /// The exit code of a failed command: 2 for bad input (arguments, scene,
 /// meshes, parameters, a backend this build lacks), 1 for a failure while
-/// running or writing output.
+/// running or writing output, 128 + the signal's number (130 for SIGINT,
+/// 143 for SIGTERM) when a signal stopped it (whatever error the stopped
+/// work then reported: see src/interrupt.rs).
 fn exit_code(e: &Error) -> u8 {
+    if let Some(sig) = lucent::interrupt::requested() {
+        return u8::try_from(lucent::interrupt::exit_code(sig)).unwrap_or(1);
+    }
     if e.is_input() {
         2
     } else {
@@ -315,7 +329,9 @@ fn run_render(
     overrides
         .apply_all(&mut scene.materials)
         .map_err(option_error)?;
+    stop_if_interrupted()?;
     let accel = accel::build(&scene.meshes, backend)?;
+    stop_if_interrupted()?;
     let (film, stats) = render::render(&scene, accel.as_ref(), opts)?;
     film.write_exr_and_preview(output, tonemap, exposure)?;
     if !quiet {
@@ -331,6 +347,29 @@ fn run_render(
     }
     report_rejected_rays(accel.as_ref());
     Ok(())
+}
+
+/// `s` with every control character (from a file name, an OBJ line or a
+/// key quoted in the message) shown as its escape: a message is one line,
+/// and input cannot send escape sequences to the terminal.
+fn without_control_characters(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
+/// [`Error::Interrupted`] once a signal asked the process to stop.
+fn stop_if_interrupted() -> Result<(), Error> {
+    match lucent::interrupt::requested() {
+        Some(sig) => Err(Error::Interrupted(sig)),
+        None => Ok(()),
+    }
 }
 
 /// Says on stderr (even with `--quiet`: it means the image may be wrong)

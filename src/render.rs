@@ -16,6 +16,7 @@ use crate::film::Film;
 use crate::geometry::Vec3;
 use crate::integrator::path::Scratch;
 use crate::integrator::{Context, Counters, IntegratorKind};
+use crate::interrupt;
 use crate::sampling::{Draw, Rng, SampleRng};
 use crate::scene::Scene;
 
@@ -150,8 +151,12 @@ pub fn render(
     });
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    // stopped by a signal: the tiles after it are incomplete
+    if let Some(sig) = interrupt::requested() {
+        return Err(Error::Interrupted(sig));
+    }
 
-    let mut film = Film::new(w, h);
+    let mut film = Film::try_new(w, h)?;
     let mut counters = Counters::default();
     for (&(x0, y0), (pixels, c)) in tiles.iter().zip(results) {
         counters += c;
@@ -187,6 +192,11 @@ fn render_tile(
     let seed_key = Rng::seed_key(scene.settings.seed);
     for y in y0..y1 {
         for x in x0..x1 {
+            // a signal stops the render between pixels (see crate::interrupt);
+            // the tile is then incomplete and the render discarded
+            if interrupt::requested().is_some() {
+                return (out, counters);
+            }
             let pixel = y as u64 * w as u64 + x as u64;
             let pixel_key = Rng::pixel_key(seed_key, pixel);
             let mut sum = [0f64; 3];

@@ -284,3 +284,274 @@ fn a_directory_or_device_as_the_scene_is_refused() {
     }
     assert!(!exr.exists());
 }
+
+// --- (6) unclear messages
+
+#[test]
+fn bytes_that_are_not_toml_or_not_utf8_are_named_at_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("out.exr");
+    let scene = dir.path().join("scene.toml");
+    let without_render = SCENE.replace("[render]\nspp = 1\n", "");
+    let n = without_render.lines().count();
+    // (text before the scene, after it, what the first line must contain)
+    let cases: [(&[u8], &[u8], String); 4] = [
+        (
+            b"# caf\xe9\n",
+            b"",
+            "scene.toml:1: byte 0xe9 at column 6 is not valid UTF-8".into(),
+        ),
+        (
+            b"# a \x0c form feed\n",
+            b"",
+            "scene.toml:1: control character U+000C (form feed)".into(),
+        ),
+        (
+            b"",
+            b"[render]\nspp = 1 # \x00\n",
+            format!(
+                "scene.toml:{}: field `render.spp`: control character U+0000 (NUL)",
+                n + 2
+            ),
+        ),
+        (
+            b"",
+            b"[render]\nseed =",
+            format!(
+                "scene.toml:{}: field `render.seed`: the file ends in the middle of an assignment",
+                n + 2
+            ),
+        ),
+    ];
+    for (before, after, want) in cases {
+        let text = [before, without_render.as_bytes(), after].concat();
+        fs::write(&scene, &text).unwrap();
+        let o = render_scene(&scene, &exr);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        let first = e.lines().next().unwrap_or("");
+        assert!(first.contains(&want), "{first:?} lacks {want:?}");
+        assert_eq!(names(dir.path()), ["scene.toml"]);
+    }
+    // an OBJ that is not UTF-8: its line and column
+    fs::write(&scene, OBJ_SCENE).unwrap();
+    fs::write(
+        dir.path().join("mesh.obj"),
+        b"v 0 0 0\nv 1 0 0 # \xff\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let o = render_scene(&scene, &exr);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("mesh.obj") && e.contains("byte 0xff at line 2, column 11"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_scene_without_a_camera_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let no_camera = SCENE.replace(
+        "[camera]\nlook_from = [0, 0, 3]\nlook_at = [0, 0, 0]\nresolution = [8, 8]\n",
+        "",
+    );
+    assert!(!no_camera.contains("camera"));
+    let scene = write_scene(dir.path(), &no_camera);
+    let o = render_scene(&scene, &dir.path().join("out.exr"));
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("scene.toml: field `camera`: missing table `[camera]`"),
+        "{e}"
+    );
+}
+
+// --- (9) memory: requests that cannot fit fail before allocating
+
+#[test]
+fn images_meshes_and_files_beyond_the_bounds_are_refused_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("out.exr");
+    // 16384² pixels: each side is allowed, the product is not
+    let scene = write_scene(
+        dir.path(),
+        &SCENE.replace("resolution = [8, 8]", "resolution = [16384, 16384]"),
+    );
+    let e = stderr(&render_scene(&scene, &exr));
+    assert!(
+        e.contains("scene.toml:4: field `camera.resolution`: [16384, 16384] is 268435456 pixels"),
+        "{e}"
+    );
+    // seven spheres of 20·4⁹ triangles: refused before the first is built
+    let sphere = "[[shapes]]\ntype = \"sphere\"\nmaterial = \"white\"\nsubdivisions = 9\n";
+    let scene = write_scene(dir.path(), &format!("{SCENE}{}", sphere.repeat(7)));
+    let start = Instant::now();
+    let o = render_scene(&scene, &exr);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains(
+            "field `shapes[7].subdivisions`: the scene's meshes add up to 36700162 triangles"
+        ),
+        "{e}"
+    );
+    assert!(
+        start.elapsed() < Duration::from_secs(5),
+        "{:?}",
+        start.elapsed()
+    );
+    // files too large to be scenes or meshes (sparse: no disk used)
+    fs::File::create(dir.path().join("mesh.obj"))
+        .unwrap()
+        .set_len((512 << 20) + 1)
+        .unwrap();
+    let scene = write_scene(dir.path(), OBJ_SCENE);
+    let e = stderr(&render_scene(&scene, &exr));
+    assert!(
+        e.contains("mesh.obj")
+            && e.contains("the file is 536870913 bytes, more than the 536870912 supported"),
+        "{e}"
+    );
+    let big = dir.path().join("big.toml");
+    fs::File::create(&big)
+        .unwrap()
+        .set_len((16 << 20) + 1)
+        .unwrap();
+    let o = render_scene(&big, &exr);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("big.toml") && e.contains("more than the 16777216 supported"),
+        "{e}"
+    );
+    assert_eq!(names(dir.path()), ["big.toml", "mesh.obj", "scene.toml"]);
+    // a benchmark's query sets
+    let out = dir.path().join("bench");
+    let o = lucent(&["bench", "--rays", "1e9", "-o", out.to_str().unwrap()]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("1 to 20M"), "{e}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_film_that_cannot_be_allocated_is_an_error_not_an_abort() {
+    let e = lucent::film::Film::try_new(u32::MAX, u32::MAX).unwrap_err();
+    assert!(!e.is_input());
+    assert!(
+        e.to_string().starts_with("out of memory: cannot allocate"),
+        "{e}"
+    );
+    let f = lucent::film::Film::try_new(3, 2).unwrap();
+    assert_eq!(f, lucent::film::Film::new(3, 2));
+}
+
+// --- (4) bench and study leave their output directory as it was
+
+#[test]
+fn a_study_refuses_a_directory_it_cannot_resume_before_writing_in_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slab-uniform.toml");
+    let out = dir.path().join("study");
+    fs::create_dir(&out).unwrap();
+    let header = lucent::tools::study::results::HEADER;
+    for (csv, want) in [
+        ("not,our,header\n1,2,3\n".to_string(), "unexpected header"),
+        (
+            format!("{header}\nsome row\n"),
+            "has rows but no results.key",
+        ),
+    ] {
+        fs::write(out.join("results.csv"), &csv).unwrap();
+        let o = lucent(&[
+            "study",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--quick",
+            "--quiet",
+        ]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(e.contains(want), "{e}");
+        // no state/, no cached reference: as it was
+        assert_eq!(names(&out), ["results.csv"]);
+        assert_eq!(fs::read_to_string(out.join("results.csv")).unwrap(), csv);
+    }
+}
+
+#[test]
+fn a_benchmark_stopped_before_its_results_are_written_leaves_no_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args([
+            "bench",
+            "-o",
+            out.to_str().unwrap(),
+            "--sizes",
+            "20",
+            "--rays",
+            "50000",
+        ])
+        .args(["--accel", "bvh", "--threads", "1", "--quiet"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    let ok = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok);
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "bench still running"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let o = child.wait_with_output().unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{e}");
+    assert!(e.contains("interrupted by SIGINT"), "{e}");
+    assert!(!out.exists(), "{:?}", names(&out));
+    assert_eq!(names(dir.path()), Vec::<String>::new());
+    // an output path under a file is refused before anything is measured
+    fs::write(dir.path().join("file"), b"").unwrap();
+    let o = lucent(&[
+        "bench",
+        "-o",
+        dir.path().join("file/out").to_str().unwrap(),
+        "--sizes",
+        "20",
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("exists and is not a directory"), "{e}");
+}
+
+#[test]
+fn control_characters_from_the_input_are_escaped_in_messages() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path(), OBJ_SCENE);
+    // an escape sequence (ESC [31m) inside a face index
+    fs::write(
+        dir.path().join("mesh.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\u{1b}[31m 3\n",
+    )
+    .unwrap();
+    let o = render_scene(&scene, &dir.path().join("out.exr"));
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(!e.contains('\u{1b}'), "{e:?}");
+    assert!(
+        e.contains("mesh.obj:4:") && e.contains("2\\u{1b}[31m"),
+        "{e:?}"
+    );
+}

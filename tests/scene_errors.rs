@@ -81,7 +81,17 @@ fn cases() -> Vec<Case> {
         case("unknown top-level key", format!("sampels = 4\n{CAM}"), "unknown field `sampels`", Some("sampels"), Some("sampels")),
         case("unknown camera key", format!("{CAM}fov = 30\n"), "unknown field `fov`", Some("fov ="), Some("camera.fov")),
         case("unknown render key", format!("{CAM}[render]\nsamples = 4\n"), "unknown field `samples`", Some("samples"), Some("render.samples")),
-        case("missing camera", MAT, "missing field `camera`", None, Some("camera")),
+        case("missing camera", MAT, "missing table `[camera]`: every scene needs one", None, Some("camera")),
+        case("form feed in a comment", format!("# a comment\n# with a \x0c form feed\n{CAM}"), "control character U+000C (form feed) is not allowed", Some("form feed"), None),
+        case("NUL in a comment", format!("{CAM}fov_y = 30 # \0\n"), "control character U+0000 (NUL)", Some("fov_y"), Some("camera.fov_y")),
+        case("file ends mid-assignment", format!("{CAM}[render]\nspp ="), "the file ends in the middle of an assignment: `spp =` has no value", Some("spp ="), Some("render.spp")),
+        case(
+            "material name with a newline and a quote",
+            format!("{CAM}[materials.\"a\\n\\\"b\"]\ntype = \"diffuse\"\nalbedo = [2, 0, 0]\n"),
+            "expected RGB components in [0, 1]",
+            Some("albedo"),
+            Some("materials.\"a\\n\\\"b\".albedo"),
+        ),
         case(
             "missing resolution",
             "[camera]\nlook_from = [0, 1, 5]\nlook_at = [0, 1, 0]\n",

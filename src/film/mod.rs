@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::Error;
 use crate::geometry::Vec3;
+use crate::interrupt;
 pub use tonemap::ToneMap;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -29,6 +30,21 @@ impl Film {
             height,
             pixels: vec![Vec3::ZERO; width as usize * height as usize],
         }
+    }
+    /// [`Film::new`], failing with a message (a runtime error: exit code 1)
+    /// instead of aborting the process when the pixels cannot be allocated.
+    pub fn try_new(width: u32, height: u32) -> Result<Self, Error> {
+        let n = width as usize * height as usize;
+        let mut pixels = Vec::new();
+        pixels.try_reserve_exact(n).map_err(|_| {
+            out_of_memory(&format!("a {width}×{height} image"), n.saturating_mul(12))
+        })?;
+        pixels.resize(n, Vec3::ZERO);
+        Ok(Film {
+            width,
+            height,
+            pixels,
+        })
     }
     pub fn get(&self, x: u32, y: u32) -> Vec3 {
         self.pixels[(y * self.width + x) as usize]
@@ -112,7 +128,9 @@ impl Film {
     /// [`commit_all`].
     pub fn stage_png(&self, path: &Path, tonemap: ToneMap, exposure: f32) -> Result<Staged, Error> {
         let scale = exposure.exp2();
-        let mut buf = Vec::with_capacity(self.pixels.len() * 3);
+        let mut buf = Vec::new();
+        buf.try_reserve_exact(self.pixels.len() * 3)
+            .map_err(|_| out_of_memory("the PNG preview", self.pixels.len().saturating_mul(3)))?;
         for p in &self.pixels {
             let c = tonemap.apply(*p * scale);
             for v in [c.x, c.y, c.z] {
@@ -130,6 +148,14 @@ impl Film {
                 .map_err(|e| e.to_string())
         })
     }
+}
+
+/// The error of an allocation that failed: what it was for and its size.
+pub fn out_of_memory(what: &str, bytes: usize) -> Error {
+    Error::Runtime(format!(
+        "out of memory: cannot allocate {} MB for {what}",
+        bytes.div_ceil(1 << 20)
+    ))
 }
 
 /// Runs `write` on a temporary path next to `path`, then renames it into
@@ -165,6 +191,7 @@ impl Staged {
             tmp: temp_path(path),
             path: path.to_path_buf(),
         };
+        interrupt::register_temporary(&staged.tmp);
         // on failure, dropping `staged` removes the temporary file
         write(&staged.tmp).map_err(|problem| Error::Write {
             path: path.to_path_buf(),
@@ -183,6 +210,7 @@ impl Drop for Staged {
     fn drop(&mut self) {
         // gone already once committed
         let _ = fs::remove_file(&self.tmp);
+        interrupt::unregister_temporary(&self.tmp);
     }
 }
 
@@ -192,7 +220,13 @@ impl Drop for Staged {
 /// otherwise cannot be replaced by a file) fails the whole commit before
 /// anything moves. Files already under the names are set aside first and
 /// put back if a later rename fails; each rename on its own is atomic.
+///
+/// After a signal ([`interrupt::requested`]) nothing is committed: the
+/// temporary files are removed and the error is [`Error::Interrupted`].
 pub fn commit_all(files: Vec<Staged>) -> Result<(), Error> {
+    if let Some(sig) = interrupt::requested() {
+        return Err(Error::Interrupted(sig));
+    }
     let write_err = |path: &Path, problem: String| Error::Write {
         path: path.to_path_buf(),
         problem,

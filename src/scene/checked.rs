@@ -35,17 +35,61 @@ impl Cx<'_> {
     /// Converts a `toml` syntax or type error. Its message has no key path
     /// when the error carries a span, so the path is recovered from the
     /// span's position in the text (see [`super::key_path`]).
+    /// Some syntax errors come with an empty message (a key without a
+    /// value); those are described here from the text at the span.
     pub fn toml_error(&self, e: &toml::de::Error) -> InputError {
         // Syntax errors carry a multi-line message; keep it on one line.
-        let msg = e.message().trim_end().replace('\n', "; ");
+        let mut msg = e.message().trim_end().replace('\n', "; ");
+        let mut key = None;
+        if msg.is_empty() {
+            (msg, key) = match e.span() {
+                Some(span) => syntax_cause(self.text, span.start),
+                None => ("invalid TOML".into(), None),
+            };
+        }
         let mut err = InputError::new(self.file, msg);
         if let Some(span) = e.span() {
             err = err.at_line(line_of(self.text, span.start));
-            if let Some(path) = key_path_at(self.text, span.start) {
+            // a key without its value is not a statement to the scanner:
+            // its table's path, and the key
+            let path = match (key_path_at(self.text, span.start), key) {
+                (Some(p), Some(k)) if !p.ends_with(k.as_str()) => Some(format!("{p}.{k}")),
+                (None, Some(k)) => Some(k),
+                (p, _) => p,
+            };
+            if let Some(path) = path {
                 err = err.in_field(path);
             }
         }
         err
+    }
+
+    /// Fails at the first control character TOML does not allow anywhere,
+    /// comments included (all of U+0000–U+001F but tab and line ends, and
+    /// U+007F): the `toml` crate reports one with no message, or as an
+    /// "expected newline" that does not say what is wrong.
+    pub fn no_control_characters(&self) -> Res<()> {
+        let b = self.text.as_bytes();
+        let bad = b.iter().enumerate().find(|&(i, &c)| {
+            (c < 0x20 && c != b'\t' && c != b'\n' && !(c == b'\r' && b.get(i + 1) == Some(&b'\n')))
+                || c == 0x7f
+        });
+        let Some((at, &c)) = bad else {
+            return Ok(());
+        };
+        let mut err = InputError::new(
+            self.file,
+            format!(
+                "control character U+{c:04X} ({}) is not allowed in TOML, not even in a comment \
+                 (only tab; in a string, write an escape such as \\u{c:04X})",
+                control_name(c)
+            ),
+        )
+        .at_line(line_of(self.text, at));
+        if let Some(path) = key_path_at(self.text, at) {
+            err = err.in_field(path);
+        }
+        Err(err)
     }
 
     /// The value of a key the format requires, or a "missing field" error
@@ -146,5 +190,108 @@ impl Cx<'_> {
             }
         }
         Ok(())
+    }
+}
+
+/// The name of an ASCII control character, for messages.
+fn control_name(c: u8) -> &'static str {
+    match c {
+        0x00 => "NUL",
+        0x08 => "backspace",
+        0x0b => "vertical tab",
+        0x0c => "form feed",
+        0x0d => "carriage return without a line feed",
+        0x1b => "escape",
+        0x7f => "delete",
+        _ => "a control character",
+    }
+}
+
+/// What is wrong at byte `at` of a TOML text whose parse error came without
+/// a message: a key with no value (at the end of the file or of its line),
+/// or something else, quoted; and the key without a value.
+fn syntax_cause(text: &str, at: usize) -> (String, Option<String>) {
+    let at = at.min(text.len());
+    let at = (0..=at)
+        .rev()
+        .find(|&i| text.is_char_boundary(i))
+        .unwrap_or(0);
+    let line_start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let before = text[line_start..at].trim_end();
+    let rest = &text[at..];
+    let line_rest = rest.split('\n').next().unwrap_or("").trim();
+    let at_eof = rest.trim().is_empty();
+    if before.ends_with('=') && (line_rest.is_empty() || line_rest.starts_with('#')) {
+        let key = before.trim_end_matches('=').trim();
+        let msg = if at_eof {
+            format!("the file ends in the middle of an assignment: `{key} =` has no value")
+        } else {
+            format!("`{key} =` has no value on its line")
+        };
+        (msg, Some(key.to_string()))
+    } else if at_eof {
+        ("the file ends in the middle of a statement".into(), None)
+    } else {
+        let found: String = line_rest.chars().take(20).collect();
+        (
+            format!("invalid TOML at `{}`", found.escape_default()),
+            None,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> InputError {
+        let cx = Cx {
+            file: Path::new("s.toml"),
+            text,
+        };
+        match cx.no_control_characters() {
+            Err(e) => e,
+            Ok(()) => cx.toml_error(&toml::from_str::<toml::Table>(text).unwrap_err()),
+        }
+    }
+
+    #[test]
+    fn control_characters_are_named_at_their_line() {
+        for (text, line, name) in [
+            (
+                "# a comment\n# with a \x0c form feed\na = 1\n",
+                2,
+                "U+000C (form feed)",
+            ),
+            ("a = 1 # \0\n", 1, "U+0000 (NUL)"),
+            ("a = 1\rb = 2\n", 1, "carriage return"),
+            ("[t]\nk = \"x\x7f\"\n", 2, "U+007F (delete)"),
+        ] {
+            let e = err(text);
+            assert_eq!(e.line, Some(line), "{text:?}: {e}");
+            assert!(e.message.contains(name), "{text:?}: {e}");
+        }
+        assert_eq!(err("[t]\nk = \"x\x7f\"\n").field.as_deref(), Some("t.k"));
+        // tab and CRLF line ends are TOML
+        let cx = Cx {
+            file: Path::new("s.toml"),
+            text: "a\t= 1\r\nb = 2\r\n",
+        };
+        assert!(cx.no_control_characters().is_ok());
+    }
+
+    #[test]
+    fn a_key_without_a_value_says_so() {
+        let e = err("[camera]\nlook_from =");
+        assert_eq!(e.line, Some(2));
+        assert_eq!(e.field.as_deref(), Some("camera.look_from"));
+        assert_eq!(
+            e.message,
+            "the file ends in the middle of an assignment: `look_from =` has no value"
+        );
+        let e = err("a = 1\nb = ");
+        assert_eq!((e.line, e.field.as_deref()), (Some(2), Some("b")));
+        // toml's own messages are kept where it gives one
+        assert_eq!(err("a = [1,").message, "invalid array; expected `]`");
     }
 }

@@ -158,6 +158,41 @@ fn skip_value(b: &[u8], mut i: usize) -> usize {
     b.len()
 }
 
+/// A key as one segment of a dotted path, spelt as TOML would: bare when it
+/// is (`red`, `skin-1`), else quoted with escapes (`"my red"`, `"a\nb"`),
+/// so that a field path never carries a raw newline, quote or control
+/// character into a message.
+pub fn key_segment(key: &str) -> String {
+    let bare = !key.is_empty()
+        && key
+            .bytes()
+            .all(|c| c.is_ascii_alphanumeric() || c == b'_' || c == b'-');
+    if bare {
+        key.to_string()
+    } else {
+        quoted(key)
+    }
+}
+
+/// `s` as a TOML basic string: in double quotes, with `"`, `\` and
+/// control characters escaped.
+pub fn quoted(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\t' => out.push_str("\\t"),
+            '\r' => out.push_str("\\r"),
+            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
 /// `a . "b c"` → `a."b c"`; bare keys keep their spelling.
 fn normalize_key(k: &str) -> String {
     let mut out = String::new();
@@ -203,5 +238,16 @@ mod tests {
         assert_eq!(line_of(t, t.find("2]").unwrap()), 6);
         assert_eq!(line_of(t, 0), 1);
         assert_eq!(line_of(t, usize::MAX), t.lines().count() + 1);
+    }
+
+    #[test]
+    fn keys_are_quoted_and_escaped_unless_bare() {
+        assert_eq!(key_segment("red_1-b"), "red_1-b");
+        assert_eq!(key_segment("my red"), "\"my red\"");
+        assert_eq!(key_segment(""), "\"\"");
+        assert_eq!(
+            key_segment("a\n\"b\\\u{c}\u{3b7}"),
+            "\"a\\n\\\"b\\\\\\u000C\u{3b7}\""
+        );
     }
 }

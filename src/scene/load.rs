@@ -16,8 +16,9 @@ use std::sync::Arc;
 use super::checked::{Cx, Res};
 use super::format::{CameraDef, RenderDef, SceneFile, Spanned};
 use super::material::material;
-use super::objects::object;
+use super::objects::{generated_triangles, object};
 pub use super::regular_file::read_regular_file;
+use super::regular_file::{read_regular_bytes, utf8_text};
 use super::{show_point, Camera, RenderSettings, Scene, MAX_COORDINATE};
 use crate::error::InputError;
 use crate::geometry::Vec3;
@@ -28,10 +29,34 @@ pub use super::obj::load_obj;
 /// Largest accepted image side, in pixels.
 pub const MAX_RESOLUTION: u32 = 16384;
 
+/// Largest accepted image, in pixels (8192², or 16384 × 4096): a render
+/// holds about 28 bytes a pixel at its peak (the tiles' samples and the
+/// film, 12 bytes each, and the 3-byte preview), 1.9 GB at this bound.
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// Largest accepted scene file, in bytes: scenes are a few kB; anything
+/// near this is not a scene.
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+
+/// Largest accepted triangle count of a whole scene (2²⁵ ≈ 33.5 M):
+/// about 30 bytes a triangle in the meshes and 50–100 more in a backend's
+/// acceleration structure, a few GB at this bound.
+pub const MAX_TRIANGLES: u64 = 1 << 25;
+
 /// Reads and loads the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, InputError> {
-    let text = read_regular_file(path)
+    let bytes = read_regular_bytes(path, MAX_SCENE_BYTES)
         .map_err(|e| InputError::new(path, format!("cannot read scene file: {e}")))?;
+    let text = utf8_text(bytes).map_err(|e| {
+        InputError::new(
+            path,
+            format!(
+                "byte {:#04x} at column {} is not valid UTF-8 (a scene file is UTF-8 text)",
+                e.byte, e.column
+            ),
+        )
+        .at_line(e.line)
+    })?;
     load_str(&text, path)
 }
 
@@ -39,6 +64,7 @@ pub fn load(path: &Path) -> Result<Scene, InputError> {
 /// relative OBJ paths are resolved from (its directory).
 pub fn load_str(text: &str, path: &Path) -> Result<Scene, InputError> {
     let cx = Cx { file: path, text };
+    cx.no_control_characters()?;
     let def: SceneFile = toml::from_str(text).map_err(|e| cx.toml_error(&e))?;
     build(&cx, def)
 }
@@ -49,7 +75,15 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         Some(u) => cx.positive(u, "units_per_mm")?,
         None => 1.0,
     };
-    let camera = camera(cx, cx.required(&def.camera, None, "camera")?)?;
+    let Some(c) = &def.camera else {
+        return Err(InputError::new(
+            cx.file,
+            "missing table `[camera]`: every scene needs one, with look_from, look_at and \
+             resolution",
+        )
+        .in_field("camera"));
+    };
+    let camera = camera(cx, c)?;
     let settings = settings(cx, &def.render)?;
 
     // Materials: indexed in name order (the map is sorted), so the same file
@@ -67,11 +101,37 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         )?);
     }
 
+    // The generated shapes' triangles are counted before any is built, the
+    // OBJ meshes' as they are read: a scene beyond MAX_TRIANGLES fails
+    // before it allocates them.
+    let mut planned = 0;
+    for (i, s) in def.shapes.iter().enumerate() {
+        planned += generated_triangles(s.get_ref());
+        if planned > MAX_TRIANGLES {
+            let field = match &s.get_ref().subdivisions {
+                Some(_) => format!("shapes[{i}].subdivisions"),
+                None => format!("shapes[{i}]"),
+            };
+            return Err(too_many_triangles(cx, s.span(), &field, planned));
+        }
+    }
     let scene_dir = cx.file.parent().unwrap_or(Path::new(""));
     let mut meshes = Vec::with_capacity(def.shapes.len());
     let mut objects = Vec::with_capacity(def.shapes.len());
+    let mut total = planned;
     for (i, s) in def.shapes.iter().enumerate() {
         let (mesh, obj) = object(cx, scene_dir, i, s, &material_index)?;
+        if let Some(f) = &s.get_ref().file {
+            total += mesh.triangle_count() as u64;
+            if total > MAX_TRIANGLES {
+                return Err(too_many_triangles(
+                    cx,
+                    f.span(),
+                    &format!("shapes[{i}].file"),
+                    total,
+                ));
+            }
+        }
         meshes.push(mesh);
         objects.push(obj);
     }
@@ -95,6 +155,19 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         units_per_mm,
         source: Some(cx.file.to_path_buf()),
     })
+}
+
+/// The scene's triangles beyond [`MAX_TRIANGLES`], counted up to the shape
+/// at `span`.
+fn too_many_triangles(cx: &Cx, span: std::ops::Range<usize>, field: &str, n: u64) -> InputError {
+    cx.err(
+        span,
+        field,
+        format!(
+            "the scene's meshes add up to {n} triangles with this shape, more than the \
+             {MAX_TRIANGLES} supported (see \"Supported ranges\" in docs/scene-format.md)"
+        ),
+    )
 }
 
 /// `[camera]`: the required keys present, values finite, the field of view
@@ -147,6 +220,17 @@ fn camera(cx: &Cx, c: &Spanned<CameraDef>) -> Res<Camera> {
             resolution.span(),
             "camera.resolution",
             format!("expected [width, height] each in 1..={MAX_RESOLUTION}, found [{w}, {h}]"),
+        ));
+    }
+    if w as u64 * h as u64 > MAX_PIXELS {
+        return Err(cx.err(
+            resolution.span(),
+            "camera.resolution",
+            format!(
+                "[{w}, {h}] is {} pixels, more than the {MAX_PIXELS} (8192²) supported (see \
+                 \"Supported ranges\" in docs/scene-format.md)",
+                w as u64 * h as u64
+            ),
         ));
     }
     let view = at - from;

@@ -12,6 +12,7 @@ use std::sync::Arc;
 
 use super::checked::{Cx, Res};
 use super::format::{MaterialDef, MaterialKind, Spanned, Triple3};
+use super::key_path::key_segment;
 use super::MAX_SUBSURFACE_RADIUS;
 use crate::bssrdf::{
     AlbedoSource, ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler,
@@ -55,7 +56,7 @@ pub(super) fn material(
     units_per_mm: f32,
     units_def: Option<&Spanned<f64>>,
 ) -> Res<Material> {
-    let field = format!("materials.{name}");
+    let field = format!("materials.{}", key_segment(name));
     let d = m.get_ref();
     let kind = *cx
         .required(&d.kind, Some(m.span()), &format!("{field}.type"))?

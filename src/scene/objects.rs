@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use super::checked::{Cx, Res};
 use super::format::{Numbers, ShapeDef, ShapeKind, Spanned};
+use super::key_path::{key_segment, quoted};
 use super::obj::{first_vertex_where, load_obj};
 use super::regular_file::read_regular_file;
 use super::transform::Transform;
@@ -17,6 +18,27 @@ use crate::geometry::{Mesh, Vec3};
 
 /// Highest accepted `subdivisions` for spheres: 20·4⁹ ≈ 5.2 M triangles.
 pub const MAX_SPHERE_SUBDIVISIONS: u32 = 9;
+
+/// The largest OBJ file read (bytes): parsing holds the text, the OBJ
+/// library's index and position arrays and the mesh, at worst about eight
+/// times the file's size (a polygon `f 1 1 1 …` is one triangle per two
+/// bytes), so this bounds a mesh's memory to a few GB.
+pub const MAX_OBJ_BYTES: u64 = 512 << 20;
+
+/// The triangles a generated shape (sphere, quad, box) will have, known
+/// before its mesh is built; 0 for an OBJ (counted once read) and for an
+/// entry that [`object`] rejects.
+pub(super) fn generated_triangles(d: &ShapeDef) -> u64 {
+    match d.kind.as_ref().map(|k| *k.get_ref()) {
+        Some(ShapeKind::Sphere) => match d.subdivisions.as_ref().map_or(4, |l| *l.get_ref()) {
+            l if l <= MAX_SPHERE_SUBDIVISIONS => 20 * 4u64.pow(l),
+            _ => 0,
+        },
+        Some(ShapeKind::Quad) => 2,
+        Some(ShapeKind::Box) => 12,
+        Some(ShapeKind::Obj) | None => 0,
+    }
+}
 
 /// Shape `i` (entry `s`): its transformed mesh and its object. `materials`
 /// maps material names to indices; OBJ paths are relative to `dir`.
@@ -31,7 +53,7 @@ pub(super) fn object(
     let sd = s.get_ref();
     let m = cx.required(&sd.material, Some(s.span()), &format!("{field}.material"))?;
     let Some(&mat) = materials.get(m.get_ref().as_str()) else {
-        let mut known: Vec<&str> = materials.keys().copied().collect();
+        let mut known: Vec<String> = materials.keys().map(|k| key_segment(k)).collect();
         known.sort_unstable();
         let known = if known.is_empty() {
             "no materials are defined".to_string()
@@ -41,7 +63,7 @@ pub(super) fn object(
         return Err(cx.err(
             m.span(),
             &format!("{field}.material"),
-            format!("unknown material \"{}\" ({known})", m.get_ref()),
+            format!("unknown material {} ({known})", quoted(m.get_ref())),
         ));
     };
     let emission = match &sd.emission {
@@ -166,7 +188,7 @@ fn shape_mesh(
                 ));
             };
             let path = dir.join(f.get_ref());
-            let text = read_regular_file(&path).map_err(|e| {
+            let text = read_regular_file(&path, MAX_OBJ_BYTES).map_err(|e| {
                 cx.err(
                     f.span(),
                     &format!("{field}.file"),

@@ -35,6 +35,7 @@ mod csv;
 mod hits;
 pub mod measure;
 mod meshes;
+mod out_dir;
 pub mod plot;
 pub mod rays;
 pub mod replay;

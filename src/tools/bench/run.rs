@@ -41,8 +41,8 @@ type Pools = Vec<(usize, rayon::ThreadPool)>;
 /// writing the results.
 pub fn run(s: &Settings) -> Result<Outcome, Error> {
     validate(s)?;
-    std::fs::create_dir_all(&s.out)
-        .map_err(|e| Error::Input(format!("{}: {e}", s.out.display())))?;
+    // created only to write the results (see out_dir.rs)
+    super::out_dir::check(&s.out)?;
     let mut notes = Vec::new();
     let plan = plan(s, &mut notes);
     let mut threads = s.threads.clone();
@@ -68,6 +68,9 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
     for (kind, level) in &plan {
         bar.set_message(format!("generating {kind}"));
         let first_row = rows.len();
+        if let Some(sig) = crate::interrupt::requested() {
+            return Err(Error::Interrupted(sig));
+        }
         let label = measure_mesh(s, kind, *level, &pools, &bar, &mut rows)?;
         check_hits(&rows[first_row..], &label, &mut warnings, &mut failures);
     }
@@ -76,7 +79,6 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
         eprintln!("warning: {w}");
     }
 
-    let csv = write_csv(&s.out, &rows)?;
     let mut report = report(&rows, &threads, s, started.elapsed().as_secs_f64());
     for n in &notes {
         let _ = writeln!(report, "note: {n}");
@@ -84,9 +86,15 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
     for w in &warnings {
         let _ = writeln!(report, "warning: {w}");
     }
-    std::fs::write(s.out.join("report.txt"), &report)
-        .map_err(|e| Error::Runtime(format!("report.txt: {e}")))?;
-    let plots = plot::write_plots(&s.out, &rows).map_err(|e| Error::Runtime(e.to_string()))?;
+    let out = super::out_dir::create(&s.out)?;
+    let (csv, plots) = out.finish((|| {
+        let csv = write_csv(&s.out, &rows)?;
+        crate::film::write_atomically(&s.out.join("report.txt"), |tmp| {
+            std::fs::write(tmp, &report).map_err(|e| e.to_string())
+        })?;
+        let plots = plot::write_plots(&s.out, &rows).map_err(|e| Error::Runtime(e.to_string()))?;
+        Ok((csv, plots))
+    })())?;
     if !failures.is_empty() {
         print!("{report}");
         return Err(Error::Runtime(format!(

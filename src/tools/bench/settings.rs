@@ -121,7 +121,12 @@ pub fn parse_threads(s: &str) -> Result<usize, String> {
     }
 }
 
-/// Parses a ray count: a positive integer, `k`/`M` suffixes allowed.
+/// The most rays a query set may have: each set is held in memory with its
+/// results (about 40 bytes a ray), 800 MB at this bound.
+pub const MAX_RAYS: usize = 20_000_000;
+
+/// Parses a ray count: a positive integer up to [`MAX_RAYS`], `k`/`M`
+/// suffixes allowed.
 pub fn parse_rays(s: &str) -> Result<usize, String> {
     let t = s.trim();
     let (num, mul) = match t.chars().last() {
@@ -130,9 +135,11 @@ pub fn parse_rays(s: &str) -> Result<usize, String> {
         _ => (t, 1.0),
     };
     match num.parse::<f64>() {
-        Ok(v) if (v * mul).round() >= 1.0 && v * mul <= 1e9 => Ok((v * mul).round() as usize),
+        Ok(v) if (v * mul).round() >= 1.0 && v * mul <= MAX_RAYS as f64 => {
+            Ok((v * mul).round() as usize)
+        }
         _ => Err(format!(
-            "\"{s}\" is not a ray count (examples: 100000, 500k, 2M)"
+            "\"{s}\" is not a ray count from 1 to 20M (examples: 100000, 500k, 2M)"
         )),
     }
 }
@@ -172,5 +179,7 @@ mod tests {
         assert!(parse_threads("0").is_err() && parse_threads("x").is_err());
         assert_eq!(parse_rays("500k"), Ok(500_000));
         assert!(parse_rays("0").is_err() && parse_rays("nan").is_err());
+        assert_eq!(parse_rays("20M"), Ok(MAX_RAYS));
+        assert!(parse_rays("20000001").is_err() && parse_rays("1e9").is_err());
     }
 }

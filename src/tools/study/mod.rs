@@ -138,6 +138,12 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
         .into_iter()
         .filter(|c| c.axis == Axis::Baseline || s.only.is_empty() || s.only.contains(&c.axis))
         .collect();
+    // A directory whose results cannot be resumed is refused before
+    // anything is written in it (no state/, no cached reference).
+    let csv = s.out_dir.join("results.csv");
+    Results::read(&csv).map_err(Error::Input)?;
+    let hash = reference::hash_for(s, &scene, &scene_text, seed);
+    resume::check_results_key(s, hash, seed, &scene)?;
     fs::create_dir_all(s.out_dir.join("state"))
         .map_err(|e| Error::Runtime(format!("cannot create {}: {e}", s.out_dir.display())))?;
     let accels = build_accels(&scene, &backends, &configs)?;
@@ -149,8 +155,8 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
         seed,
     )?;
 
-    resume::check_results_key(s, &ref_info, seed, &scene)?;
-    let mut results = Results::open(&s.out_dir.join("results.csv")).map_err(runtime)?;
+    resume::write_results_key(s, &ref_info, seed, &scene)?;
+    let mut results = Results::open(&csv).map_err(runtime)?;
     let spps = ladder(s.max_spp);
     let bar = ladder::progress_bar(s, &configs, &spps, &results);
     let started = Instant::now();

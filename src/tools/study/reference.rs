@@ -66,6 +66,12 @@ impl Fnv1a {
     }
 }
 
+/// The cache key of the reference render of `scene` under the settings.
+pub(super) fn hash_for(s: &Settings, scene: &Scene, scene_text: &[u8], seed: u64) -> u64 {
+    let ref_seed = seed.wrapping_add(REFERENCE_SEED_OFFSET);
+    reference_hash(scene_text, scene, s.reference, s.reference_spp, ref_seed)
+}
+
 /// The cache key of the reference render.
 fn reference_hash(
     scene_text: &[u8],

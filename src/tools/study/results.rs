@@ -85,6 +85,29 @@ impl Results {
     /// header is an error (it is not ours to overwrite); unparseable lines
     /// (a row torn by an interruption) are dropped.
     pub fn open(path: &Path) -> Result<Results, String> {
+        let rows = Self::read(path)?;
+        // Rewrite what was valid, so appends start after a complete line.
+        let mut text = format!("{HEADER}\n");
+        for r in &rows {
+            text.push_str(&r.to_line());
+            text.push('\n');
+        }
+        atomic_write(path, |tmp| fs::write(tmp, &text).map_err(|e| e.to_string()))?;
+        let file = OpenOptions::new()
+            .append(true)
+            .open(path)
+            .map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+        Ok(Results {
+            path: path.to_path_buf(),
+            rows,
+            file,
+        })
+    }
+
+    /// The rows of the results file at `path` (none if there is no file),
+    /// or why it cannot be resumed; reads only, so a study can refuse a
+    /// directory before it writes anything in it.
+    pub fn read(path: &Path) -> Result<Vec<Row>, String> {
         let mut rows = Vec::new();
         if path.exists() {
             let text = fs::read_to_string(path)
@@ -103,22 +126,7 @@ impl Results {
             }
             rows.extend(lines.filter_map(Row::parse));
         }
-        // Rewrite what was valid, so appends start after a complete line.
-        let mut text = format!("{HEADER}\n");
-        for r in &rows {
-            text.push_str(&r.to_line());
-            text.push('\n');
-        }
-        atomic_write(path, |tmp| fs::write(tmp, &text).map_err(|e| e.to_string()))?;
-        let file = OpenOptions::new()
-            .append(true)
-            .open(path)
-            .map_err(|e| format!("cannot open {}: {e}", path.display()))?;
-        Ok(Results {
-            path: path.to_path_buf(),
-            rows,
-            file,
-        })
+        Ok(rows)
     }
 
     pub fn rows(&self) -> &[Row] {

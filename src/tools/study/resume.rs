@@ -44,16 +44,17 @@ pub(super) fn state_path(dir: &Path, config: &str, spp: u32) -> PathBuf {
 /// are recorded in `DIR/results.key` next to the CSV; a directory holding
 /// rows made under other settings is refused rather than mixed. Thread
 /// count, ladder length and the axis filter may change between runs.
+///
+/// Only reads: [`write_results_key`] records the key once the reference
+/// exists. A study checks this before it writes anything, so a directory
+/// it refuses is left as it was.
 pub(super) fn check_results_key(
     s: &Settings,
-    r: &ReferenceInfo,
+    reference_hash: u64,
     seed: u64,
     scene: &Scene,
 ) -> Result<(), Error> {
-    let key = format!(
-        "reference={:016x} seed={seed} firefly_k={} resolution={}x{}\n",
-        r.hash, s.firefly_k, scene.camera.width, scene.camera.height
-    );
+    let key = results_key(s, reference_hash, seed, scene);
     let key_path = s.out_dir.join("results.key");
     let csv = s.out_dir.join("results.csv");
     let has_rows = fs::read_to_string(&csv)
@@ -76,6 +77,30 @@ pub(super) fn check_results_key(
             )))
         }
         _ => {}
+    }
+    Ok(())
+}
+
+/// The line `results.key` holds for these settings.
+fn results_key(s: &Settings, reference_hash: u64, seed: u64, scene: &Scene) -> String {
+    format!(
+        "reference={reference_hash:016x} seed={seed} firefly_k={} resolution={}x{}\n",
+        s.firefly_k, scene.camera.width, scene.camera.height
+    )
+}
+
+/// Records the settings of the rows in `results.csv` (see
+/// [`check_results_key`]).
+pub(super) fn write_results_key(
+    s: &Settings,
+    r: &ReferenceInfo,
+    seed: u64,
+    scene: &Scene,
+) -> Result<(), Error> {
+    let key = results_key(s, r.hash, seed, scene);
+    let key_path = s.out_dir.join("results.key");
+    if fs::read_to_string(&key_path).is_ok_and(|old| old == key) {
+        return Ok(());
     }
     film::atomic_write(&key_path, |tmp| {
         fs::write(tmp, &key).map_err(|e| e.to_string())

@@ -85,7 +85,8 @@ fn status(s: &Settings, m: String) {
 pub fn run(s: &Settings) -> Result<Outcome, Error> {
     settings::validate(s)?;
     let scene = crate::scene::load(&s.scene).map_err(|e| input(e.to_string()))?;
-    std::fs::create_dir_all(&s.out).map_err(|e| input(format!("{}: {e}", s.out.display())))?;
+    // created only to write the results (see out_dir.rs)
+    super::out_dir::check(&s.out)?;
     let mut threads = s.threads.clone();
     threads.sort_unstable();
     threads.dedup();
@@ -95,17 +96,25 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
     for &backend in &s.backends {
         let accel = accel::build(&scene.meshes, backend).map_err(input)?;
         for &t in &threads {
+            if let Some(sig) = crate::interrupt::requested() {
+                return Err(Error::Interrupted(sig));
+            }
             let row = measure::measure(s, &scene, accel.as_ref(), t, &mut notes)?;
             rows.push(row);
         }
     }
-    let csv = csv::write_csv(&s.out, &rows, &s.scene, &scene, s.spp)?;
     let mut rep = report(&rows, s, &scene, started.elapsed());
     for n in &notes {
         let _ = writeln!(rep, "note: {n}");
     }
-    let txt = s.out.join("render-mix.txt");
-    std::fs::write(&txt, &rep).map_err(|e| runtime(format!("{}: {e}", txt.display())))?;
+    let out = super::out_dir::create(&s.out)?;
+    let csv = out.finish((|| {
+        let csv = csv::write_csv(&s.out, &rows, &s.scene, &scene, s.spp)?;
+        crate::film::write_atomically(&s.out.join("render-mix.txt"), |tmp| {
+            std::fs::write(tmp, &rep).map_err(|e| e.to_string())
+        })?;
+        Ok(csv)
+    })())?;
     Ok(Outcome {
         rows,
         csv,

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Long runs of the mutation fuzzer (tests/fuzz.rs): `scripts/fuzz.sh
+# [SECONDS] [SEED]` (defaults: 600 s, a seed from the clock, printed).
+# Every failing case is saved under tests/fuzz-corpus/ (scene, mesh,
+# arguments, and an `expect` file with the exit codes allowed and what
+# was found), where the `corpus_replays` test runs it on every test run
+# until it is fixed. LUCENT_FUZZ_JOBS sets the cases run in parallel
+# (default 2), LUCENT_FUZZ_CASE_TIMEOUT the seconds after which a case
+# counts as a hang (default 30).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export LUCENT_FUZZ_SECONDS="${1:-${LUCENT_FUZZ_SECONDS:-600}}"
+export LUCENT_FUZZ_SEED="${2:-${LUCENT_FUZZ_SEED:-$(date +%s)}}"
+export LUCENT_FUZZ_CORPUS="${LUCENT_FUZZ_CORPUS:-$PWD/tests/fuzz-corpus}"
+echo "fuzzing for ${LUCENT_FUZZ_SECONDS} s with seed ${LUCENT_FUZZ_SEED}; failures go to ${LUCENT_FUZZ_CORPUS}"
+cargo test --test fuzz mutated_inputs_end_in_an_image_or_a_clear_error -- --nocapture
