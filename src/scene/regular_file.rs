@@ -12,7 +12,7 @@ use std::path::Path;
 /// never end, and a directory cannot be read, so each is refused before it
 /// is opened, by what it is ("not a regular file: it is a FIFO").
 ///
-/// Text that is not UTF-8 fails with [`NotUtf8`]'s message (line, column,
+/// Text that is not UTF-8 fails with `NotUtf8`'s message (line, column,
 /// byte).
 pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
     utf8_text(read_regular_bytes(path, max_bytes)?)

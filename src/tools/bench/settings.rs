@@ -125,7 +125,7 @@ pub fn parse_threads(s: &str) -> Result<usize, String> {
 /// results (about 40 bytes a ray), 800 MB at this bound.
 pub const MAX_RAYS: usize = 20_000_000;
 
-/// Parses a ray count: a positive integer up to [`MAX_RAYS`], `k`/`M`
+/// Parses a ray count: a positive integer up to `MAX_RAYS`, `k`/`M`
 /// suffixes allowed.
 pub fn parse_rays(s: &str) -> Result<usize, String> {
     let t = s.trim();
