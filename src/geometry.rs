@@ -70,6 +70,7 @@ pub struct Mesh {
     /// Optional per-vertex shading normals (unit length), same count as vertices.
     pub normals: Option<Vec<Vec3>>,
     face_normals: OnceLock<Vec<Vec3>>,
+    bounding_radius: OnceLock<f32>,
 }
 
 impl Mesh {
@@ -88,6 +89,7 @@ impl Mesh {
             indices,
             normals,
             face_normals: OnceLock::new(),
+            bounding_radius: OnceLock::new(),
         }
     }
     /// Vertex positions (without the padding element).
@@ -116,6 +118,7 @@ impl Mesh {
     /// Applies `f` to every vertex position (and `g` to every normal).
     pub fn transform(&mut self, f: impl Fn(Vec3) -> Vec3, g: impl Fn(Vec3) -> Vec3) {
         self.face_normals = OnceLock::new();
+        self.bounding_radius = OnceLock::new();
         let n = self.vertex_count();
         for p in &mut self.positions[..n] {
             *p = f(*p);
@@ -162,6 +165,23 @@ impl Mesh {
     #[inline]
     pub fn face_normal(&self, prim: u32) -> Vec3 {
         self.face_normals()[prim as usize]
+    }
+
+    /// Half the diagonal of the vertices' axis-aligned bounding box: the
+    /// radius of a ball around the box's centre that holds the mesh (at
+    /// most √3 times the smallest such ball's). 0 for an empty mesh;
+    /// computed once, on the first call.
+    pub fn bounding_radius(&self) -> f32 {
+        *self.bounding_radius.get_or_init(|| {
+            let p = self.positions();
+            if p.is_empty() {
+                return 0.0;
+            }
+            let (lo, hi) = p
+                .iter()
+                .fold((p[0], p[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+            0.5 * (hi - lo).length()
+        })
     }
 
     /// [`face_normal`](Self::face_normal) of every triangle, in order;

@@ -26,7 +26,8 @@
 //! - [`ProbeAxes::Curvature`] (the default): N, T, B with probabilities
 //!   1 − 2ε, ε, ε and the same balance heuristic, ε a function of κ·d at xo
 //!   ([`tangent_probability`]), κ the surface's curvature there (the
-//!   integrator reads it from the shading normals of xo's triangle) and d
+//!   integrator reads it from the shading normals of xo's triangle,
+//!   floored at 1/R for the object's bounding radius R) and d
 //!   the widest channel's. Why: where d·κ is small the profile's mass lies
 //!   on a nearly flat surface, which probes along T and B almost never
 //!   meet; mis3 spends half its probes there and doubles the weight of the

@@ -30,7 +30,7 @@
 //! rough coat measured worse per unit time (see `COAT_SPLIT_DEPTH`).
 
 use super::interaction::offset_along;
-use super::probe::{curvature, sample_entry, ProbeTarget};
+use super::probe::{exit_curvature, sample_entry, ProbeTarget};
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
 use crate::bssrdf::ProbeRandoms;
@@ -596,7 +596,7 @@ fn probe_entry<'s>(
         &ss.probe,
         si.p,
         &frame_o,
-        curvature(target.mesh, si.prim),
+        exit_curvature(target.mesh, si.prim),
         &u,
         &target,
         &mut scratch.probe_hits,

@@ -42,6 +42,29 @@ pub fn curvature(mesh: &Mesh, prim: u32) -> f32 {
     k
 }
 
+/// The curvature the probe-axis rule reads at an exit point on triangle
+/// `prim` of `mesh`: [`curvature`], but at least 1/R for the mesh's
+/// [`bounding radius`](Mesh::bounding_radius) R.
+///
+/// Why the floor: a closed surface inside a ball of radius R turns at
+/// least as fast as 1/R somewhere (at its point farthest from the centre
+/// every normal curvature is ≥ 1/R), so an object no larger than the
+/// profile cannot look flat to it. On a smooth-shaded mesh the vertex
+/// normals already show that turning (a sphere of radius ρ reads 1/ρ ≥
+/// 1/R); on a flat-shaded one — the `box` shape, an OBJ without normals —
+/// the turning sits in edges the normals do not see, and [`curvature`]
+/// reads 0 everywhere. With the floor, an object smaller than the
+/// profile's reach (κ·d ≥ 1) gets mis3's tangent probabilities, as it
+/// did before `ProbeAxes::Curvature` became the default; a large
+/// flat-shaded object keeps ε near ε_min away from everything but its
+/// edges, where the weight bound of `ProbeAxes::weight_bound` still holds.
+/// An open mesh (a quad) gets the same floor; it only raises ε.
+pub fn exit_curvature(mesh: &Mesh, prim: u32) -> f32 {
+    let r = mesh.bounding_radius();
+    let floor = if r > 0.0 { 1.0 / r } else { 0.0 };
+    curvature(mesh, prim).max(floor)
+}
+
 /// The object a probe searches: mesh `geom` of `accel`, and that mesh (for
 /// its face normals).
 #[derive(Clone, Copy)]
@@ -853,6 +876,54 @@ mod tests {
         m.normals = Some(vec![Vec3::Z, Vec3::Z, Vec3::X, Vec3::Z]);
         let k = curvature(&m, 1);
         assert!(k.is_finite() && (k - 2f32.sqrt()).abs() < 1e-6, "{k}");
+    }
+
+    #[test]
+    fn exit_curvature_floors_flat_shaded_objects_at_their_size() {
+        use crate::bssrdf::probe::tangent_probability;
+        // a flat-shaded cube of half-side h: no shading normals, so
+        // `curvature` reads 0, and the floor is 1/(h√3)
+        let h = 0.5f32;
+        let c = [-h, h];
+        let pos: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new(c[i & 1], c[(i >> 1) & 1], c[(i >> 2) & 1]))
+            .collect();
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let idx = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        let cube = Mesh::new(pos, idx, None);
+        let floor = 1.0 / (h * 3f32.sqrt());
+        for prim in 0..cube.triangle_count() as u32 {
+            assert_eq!(curvature(&cube, prim), 0.0);
+            assert!((exit_curvature(&cube, prim) - floor).abs() < 1e-6);
+        }
+        // a profile as wide as the cube gets mis3's tangent probabilities;
+        // without the floor it would get ε_min
+        let d = 2.0 * h;
+        assert_eq!(
+            tangent_probability((exit_curvature(&cube, 0) * d) as f64),
+            0.25
+        );
+        assert!(tangent_probability((curvature(&cube, 0) * d) as f64) < 0.03);
+        // a smooth sphere's own curvature 1/ρ is above its floor 1/(ρ√3)
+        let rs = 2.5f32;
+        let sphere = uv_sphere(Vec3::new(1.0, -2.0, 0.5), rs, 10);
+        for prim in 0..sphere.triangle_count() as u32 {
+            assert_eq!(exit_curvature(&sphere, prim), curvature(&sphere, prim));
+        }
+        // the floor follows the mesh through transforms
+        let mut big = cube.clone();
+        big.transform(|p| p * 10.0, |n| n);
+        assert!((exit_curvature(&big, 0) - floor / 10.0).abs() < 1e-7);
     }
 
     /// A closed thin wedge (triangular prism): faces z = ±x·tan(angle/2)
