@@ -237,6 +237,30 @@ mod tests {
         }
     }
 
+    /// Sampling the exit lobe returns the density it draws with and the
+    /// weight f cos θ / pdf; over the square those weights integrate to
+    /// ∫ f cos dω = 1 (every walk that leaves goes somewhere).
+    #[test]
+    fn exit_lobe_sample_weights_are_f_cos_over_pdf_and_sum_to_one() {
+        for eta in [1.3f32, 1.5, 2.5] {
+            let lobe = DiffuseBoundary::new(eta).exit_lobe();
+            let n = 400;
+            let mut sum = 0.0f64;
+            for i in 0..n {
+                for j in 0..n {
+                    let u = [(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32];
+                    let (wi, w, pdf) = lobe.sample(u).unwrap();
+                    assert!((pdf - lobe.pdf(wi)).abs() <= 1e-6 * pdf, "{pdf}");
+                    let want = lobe.eval(wi) * wi.z / pdf;
+                    assert!((w - want).abs() <= 1e-5 * want.max(1e-3), "{w} vs {want}");
+                    sum += w as f64;
+                }
+            }
+            let mean = sum / (n * n) as f64;
+            assert!((mean - 1.0).abs() < 1e-3, "η {eta}: {mean}");
+        }
+    }
+
     /// At normal incidence a fraction Fr(1, η) reflects; the inner
     /// direction is distributed ∝ T_in(μ') μ': none lies in the total-
     /// internal-reflection cone, and its mean cosine is that law's.
