@@ -477,6 +477,21 @@ mod tests {
         assert!(alpha_from_roughness(0.032) >= SMOOTH_ALPHA);
     }
 
+    /// The coat only reflects: f and its pdf are 0 when either direction
+    /// is below the surface (a light behind it must get nothing).
+    #[test]
+    fn nothing_is_reflected_to_or_from_below_the_surface() {
+        let coat = RoughCoat::new(0.5, 1.5);
+        for (a, b) in [(0.3f64, 2.0f64), (1.2, 1.7), (0.0, 2.9), (1.5, 1.6)] {
+            let (up, down) = (dir(a, 0.4), dir(b, 2.5));
+            assert!(up.z > 0.0 && down.z < 0.0);
+            for (wo, wi) in [(up, down), (down, up), (down, down)] {
+                assert_eq!(coat.eval(wo, wi), 0.0, "{wo} {wi}");
+                assert_eq!(coat.pdf(wo, wi), 0.0, "{wo} {wi}");
+            }
+        }
+    }
+
     /// Two coats are the same material exactly when α and η agree (the
     /// table is a function of them).
     #[test]
