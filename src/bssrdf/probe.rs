@@ -795,6 +795,29 @@ mod tests {
     }
 
     #[test]
+    fn tangent_probability_follows_the_slow_lobe_at_a_quarter_turn() {
+        // Between ε_min and ¼, ε rises as the profile's slow lobe e^{−r/3d}
+        // at the arc length r = π/(2κ) where a sphere of curvature κ has
+        // turned 90° from xo, normalized to 1 at κd = kd_full: computed
+        // here from that geometry (d = 1, κ = kd), not from the formula.
+        let slow_lobe_at_quarter_turn = |kd: f64| {
+            let (d, kappa) = (1.0, kd);
+            let r = std::f64::consts::FRAC_PI_2 / kappa;
+            (-r / (3.0 * d)).exp()
+        };
+        let full = slow_lobe_at_quarter_turn(TANGENT_PROB_FULL_AT);
+        for kd in [0.087, 0.2, 0.35, 0.5, 0.75, 0.9] {
+            let e = tangent_probability(kd);
+            let share = (e - TANGENT_PROB_MIN) / (0.25 - TANGENT_PROB_MIN);
+            let want = slow_lobe_at_quarter_turn(kd) / full;
+            assert!(
+                (share - want).abs() <= 1e-12 + 1e-9 * want,
+                "κd {kd}: share {share}, slow lobe {want}"
+            );
+        }
+    }
+
+    #[test]
     fn options_validate() {
         let p = SubsurfaceParams {
             albedo: [0.5; 3],

@@ -237,6 +237,30 @@ mod tests {
         }
     }
 
+    /// Sampling the exit lobe returns the density it draws with and the
+    /// weight f cos θ / pdf; over the square those weights integrate to
+    /// ∫ f cos dω = 1 (every walk that leaves goes somewhere).
+    #[test]
+    fn exit_lobe_sample_weights_are_f_cos_over_pdf_and_sum_to_one() {
+        for eta in [1.3f32, 1.5, 2.5] {
+            let lobe = DiffuseBoundary::new(eta).exit_lobe();
+            let n = 400;
+            let mut sum = 0.0f64;
+            for i in 0..n {
+                for j in 0..n {
+                    let u = [(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32];
+                    let (wi, w, pdf) = lobe.sample(u).unwrap();
+                    assert!((pdf - lobe.pdf(wi)).abs() <= 1e-6 * pdf, "{pdf}");
+                    let want = lobe.eval(wi) * wi.z / pdf;
+                    assert!((w - want).abs() <= 1e-5 * want.max(1e-3), "{w} vs {want}");
+                    sum += w as f64;
+                }
+            }
+            let mean = sum / (n * n) as f64;
+            assert!((mean - 1.0).abs() < 1e-3, "η {eta}: {mean}");
+        }
+    }
+
     /// At normal incidence a fraction Fr(1, η) reflects; the inner
     /// direction is distributed ∝ T_in(μ') μ': none lies in the total-
     /// internal-reflection cone, and its mean cosine is that law's.
@@ -275,5 +299,59 @@ mod tests {
         }
         let mean = sum_mu / n as f64;
         assert!((mean - num / den).abs() < 2e-3, "{mean} vs {}", num / den);
+    }
+    /// At a high index the inner direction's acceptance 1 − F̄_in =
+    /// (1 − F̄)/η² is small and many entries take the fallback (η = 6:
+    /// acceptance 1.4 %, fallback for (1 − 0.014)⁶⁴ ≈ 40 % of entries): its weight
+    /// T_in/(1 − F̄_in) must keep the weighted inner directions on the same
+    /// law, ∝ T_in(μ') μ', with mean weight 1 (energy transmitted, not made
+    /// or lost).
+    #[test]
+    fn entry_fallback_keeps_the_refracted_law_at_high_index() {
+        let eta = 6.0f32;
+        let b = DiffuseBoundary::new(eta);
+        let mut rng = SampleRng::new(5, 9, 2);
+        let (mut n, mut fallbacks) = (0u32, 0u32);
+        let (mut sum_w, mut sum_w2) = (0.0f64, 0.0f64);
+        let (mut sum_wmu, mut sum_wmu2) = (0.0f64, 0.0f64);
+        for _ in 0..200_000 {
+            if let Some((w, weight)) = b.enter(1.0, &mut rng) {
+                n += 1;
+                if weight != 1.0 {
+                    fallbacks += 1;
+                }
+                let weight = weight as f64;
+                sum_w += weight;
+                sum_w2 += weight * weight;
+                sum_wmu += weight * w.z as f64;
+                sum_wmu2 += (weight * w.z as f64).powi(2);
+            }
+        }
+        assert!(fallbacks as f64 > 0.2 * n as f64, "{fallbacks} of {n}");
+        let nf = n as f64;
+        let mean_w = sum_w / nf;
+        let sigma = ((sum_w2 / nf - mean_w * mean_w) / nf).sqrt();
+        assert!(
+            (mean_w - 1.0).abs() < 4.0 * sigma + 1e-4,
+            "mean weight {mean_w} ± {sigma}"
+        );
+        // E[w μ'] = ∫ T_in μ'² dμ' / ∫ T_in μ' dμ' (the fallback's weights
+        // are 0 outside the narrow cone μ' > μ_c and up to 1/(1 − F̄_in)
+        // inside it: a wide spread, so the bound is statistical)
+        let m = 100_000;
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..m {
+            let mu = (i as f64 + 0.5) / m as f64;
+            let t = 1.0 - fresnel::dielectric(-(mu as f32), eta) as f64;
+            num += t * mu * mu;
+            den += t * mu;
+        }
+        let mean_mu = sum_wmu / nf;
+        let sigma_mu = ((sum_wmu2 / nf - mean_mu * mean_mu) / nf).sqrt();
+        assert!(
+            (mean_mu - num / den).abs() < 4.0 * sigma_mu + 1e-4,
+            "{mean_mu} ± {sigma_mu} vs {}",
+            num / den
+        );
     }
 }

@@ -462,6 +462,47 @@ mod tests {
         assert!(clear.albedo(0.5) < 1e-6 && clear.mean_albedo() < 1e-6);
     }
 
+    /// The scene's roughness is α = roughness², and the coat is smooth
+    /// below α = 10⁻³, i.e. roughness < 0.032 (docs/scene-format.md).
+    #[test]
+    fn roughness_maps_to_alpha_squared() {
+        for r in [0.1f32, 0.3, 0.5, 0.7, 1.0] {
+            assert!(
+                (alpha_from_roughness(r) - r * r).abs() <= 1e-7,
+                "roughness {r}"
+            );
+        }
+        assert_eq!(alpha_from_roughness(0.0), 0.0);
+        assert!(alpha_from_roughness(0.031) < SMOOTH_ALPHA);
+        assert!(alpha_from_roughness(0.032) >= SMOOTH_ALPHA);
+    }
+
+    /// The coat only reflects: f and its pdf are 0 when either direction
+    /// is below the surface (a light behind it must get nothing).
+    #[test]
+    fn nothing_is_reflected_to_or_from_below_the_surface() {
+        let coat = RoughCoat::new(0.5, 1.5);
+        for (a, b) in [(0.3f64, 2.0f64), (1.2, 1.7), (0.0, 2.9), (1.5, 1.6)] {
+            let (up, down) = (dir(a, 0.4), dir(b, 2.5));
+            assert!(up.z > 0.0 && down.z < 0.0);
+            for (wo, wi) in [(up, down), (down, up), (down, down)] {
+                assert_eq!(coat.eval(wo, wi), 0.0, "{wo} {wi}");
+                assert_eq!(coat.pdf(wo, wi), 0.0, "{wo} {wi}");
+            }
+        }
+    }
+
+    /// Two coats are the same material exactly when α and η agree (the
+    /// table is a function of them).
+    #[test]
+    fn coats_are_equal_when_alpha_and_eta_are() {
+        let c = RoughCoat::new(0.3, 1.5);
+        assert_eq!(c, RoughCoat::new(0.3, 1.5));
+        assert_ne!(c, RoughCoat::new(0.4, 1.5));
+        assert_ne!(c, RoughCoat::new(0.3, 1.4));
+        assert_ne!(c, RoughCoat::new(0.4, 1.4));
+    }
+
     /// The table's stated error: within 5·10⁻³ of a 512² quadrature between
     /// and at nodes, for narrow to wide lobes.
     #[test]
