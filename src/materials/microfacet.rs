@@ -232,28 +232,18 @@ impl RoughCoat {
 
     /// f(ωo, ωi) per steradian; 0 unless both are above the surface.
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        let Some(h) = half_vector(wo, wi) else {
             return 0.0;
-        }
-        let h = wo + wi;
-        if h.length_squared() == 0.0 {
-            return 0.0;
-        }
-        let h = h.normalize();
+        };
         let fr = fresnel::dielectric(wo.dot(h), self.eta);
         self.ggx.d(h) * self.ggx.g2(wo, wi) * fr / (4.0 * wo.z * wi.z)
     }
 
     /// The solid-angle density with which [`RoughCoat::sample`] returns ωi.
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        let Some(h) = half_vector(wo, wi) else {
             return 0.0;
-        }
-        let h = wo + wi;
-        if h.length_squared() == 0.0 {
-            return 0.0;
-        }
-        let h = h.normalize();
+        };
         self.ggx.g1(wo) * self.ggx.d(h) / (4.0 * wo.z)
     }
 
@@ -277,6 +267,17 @@ impl RoughCoat {
         let w = fresnel::dielectric(cos_om, self.eta) * self.ggx.g2(wo, wi) / g1;
         Some((wi, w, pdf))
     }
+}
+
+/// The unit half vector of a reflection, ωh = (ωo + ωi)/|ωo + ωi|; None
+/// unless both directions are above the surface (and their sum nonzero),
+/// where the coat reflects nothing.
+fn half_vector(wo: Vec3, wi: Vec3) -> Option<Vec3> {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return None;
+    }
+    let h = wo + wi;
+    (h.length_squared() != 0.0).then(|| h.normalize())
 }
 
 #[cfg(test)]
