@@ -5,6 +5,7 @@
 //! the outputs of one command are committed together ([`commit_all`]), so a
 //! failure never leaves an EXR without its PNG.
 
+pub mod layers;
 pub mod tonemap;
 
 use std::fs;
