@@ -6,7 +6,8 @@
 //! place looked at then), else with `pkg-config embree3`, else in the
 //! standard Debian locations. Not found is a build error that says what to
 //! install. Without the feature (`--no-default-features`) it does nothing
-//! and lucent has only its own BVH.
+//! and lucent has only its own BVH. Embree 4 (the `embree4` feature) needs
+//! nothing here: it is opened at run time (src/accel/embree4/load.rs).
 
 use std::env;
 use std::path::{Path, PathBuf};

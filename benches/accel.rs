@@ -85,13 +85,13 @@ mod helpers {
             .measurement_time(Duration::from_secs(5));
         let threads: &[usize] = match backend {
             Backend::Bvh => &[1, 2],
-            Backend::Embree => &[2],
+            Backend::Embree | Backend::Embree3 | Backend::Embree4 => &[2],
         };
         for &t in threads {
             let p = pool(t);
             let id = match backend {
                 Backend::Bvh => format!("{t}t"),
-                Backend::Embree => "own-threads".to_string(),
+                _ => "own-threads".to_string(),
             };
             g.bench_with_input(BenchmarkId::new(backend.name(), id), &t, |b, _| {
                 b.iter(|| p.install(|| accel::build(meshes, backend).unwrap()))

@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Installs what lucent needs on Debian 12 and skips what is already there:
 # Embree 3 (Debian's libembree-dev, the production ray-query backend),
-# pkg-config (to find it), a C compiler (for the FFI layout test) and the
-# DejaVu Sans font (text in `lucent study` plots, read by path).
-# Safe to run any number of times.
+# pkg-config (to find it), a C compiler (for the FFI layout test), the
+# DejaVu Sans font (text in `lucent study` plots, read by path), and an
+# Embree 4 for the tests of the `embree4` backend (Debian 12 has none: the
+# 4.4.0 library and the TBB it needs, from the `embreex` wheel on PyPI,
+# unpacked into .cache/embree4/, which scripts/test.sh points
+# LUCENT_EMBREE4 at). Safe to run any number of times.
 set -euo pipefail
 
 need=()
@@ -29,3 +32,30 @@ for c in rustfmt clippy; do
     rustup component add "$c"
   fi
 done
+
+# Embree 4.4.0 from the embreex 4.4.0.post1 wheel: its libembree4 (renamed
+# by the wheel's packager, with RPATH $ORIGIN) and the libtbb it links,
+# renamed too, so it never meets Debian's TBB. Only the two libraries are
+# kept; libembree4.so.4 is a link to the real file, the name lucent looks
+# for. The wheel is the same library for every CPython tag, so pip is asked
+# for one tag explicitly rather than the local interpreter's.
+e4=.cache/embree4
+cd "$(dirname "$0")/.."
+if [ ! -e "$e4/libembree4.so.4" ]; then
+  command -v python3 >/dev/null 2>&1 || {
+    echo "error: python3 (with pip) is needed to fetch Embree 4 for the tests" >&2
+    exit 1
+  }
+  tmp=$(mktemp -d)
+  trap 'rm -rf "$tmp"' EXIT
+  python3 -m pip download --quiet --no-deps --only-binary=:all: \
+    --python-version 3.11 --platform manylinux_2_28_x86_64 \
+    -d "$tmp" embreex==4.4.0.post1
+  python3 -m zipfile -e "$tmp"/embreex-4.4.0.post1-*.whl "$tmp/x"
+  mkdir -p "$e4.part"
+  cp "$tmp"/x/embreex.libs/libembree4-*.so.4 "$tmp"/x/embreex.libs/libtbb-*.so.* "$e4.part/"
+  (cd "$e4.part" && ln -sf libembree4-*.so.4 libembree4.so.4)
+  rm -rf "$e4"
+  mv "$e4.part" "$e4"
+  echo "Embree 4.4.0 unpacked into $e4" >&2
+fi

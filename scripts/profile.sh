@@ -32,7 +32,7 @@ for b in $backends; do
     --callgrind-out-file="$OUT/$b.cg" \
     "$LUCENT" render "$OUT/scene.toml" -o "$OUT/$b.exr" --spp "$SPP" --threads 1 --accel "$b" -q \
     >/dev/null 2>&1
-  case $b in embree) ty=EmbreeAccel ;; *) ty=Bvh ;; esac
+  case $b in embree3) ty=EmbreeAccel ;; embree4) ty=Embree4Accel ;; *) ty=Bvh ;; esac
   pats=("lucent::render::render_tile"
         "$ty as lucent::accel::Accel>::intersect"
         "$ty as lucent::accel::Accel>::occluded"

@@ -36,7 +36,10 @@ enum IntegratorArg {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum AccelArg {
+    /// The best Embree available (Embree 4, else Embree 3).
     Embree,
+    Embree3,
+    Embree4,
     Bvh,
 }
 
@@ -44,6 +47,8 @@ impl From<AccelArg> for Backend {
     fn from(a: AccelArg) -> Backend {
         match a {
             AccelArg::Embree => Backend::Embree,
+            AccelArg::Embree3 => Backend::Embree3,
+            AccelArg::Embree4 => Backend::Embree4,
             AccelArg::Bvh => Backend::Bvh,
         }
     }
@@ -67,7 +72,9 @@ enum Command {
         /// Random seed (default: the scene's `render.seed`).
         #[arg(long)]
         seed: Option<u64>,
-        /// Ray-query backend (default: embree when built with it, else bvh).
+        /// Ray-query backend: embree (the best available: embree4, else
+        /// embree3), embree3, embree4 or bvh (default: embree if any is
+        /// available, else bvh).
         #[arg(long, value_enum)]
         accel: Option<AccelArg>,
         /// Tone map of the PNG preview (the EXR is always linear).
@@ -489,8 +496,8 @@ struct BenchArgs {
     /// Rays per query set (default 500000, quick 16384).
     #[arg(long, value_parser = lucent::tools::bench::parse_rays)]
     rays: Option<usize>,
-    /// Backends to measure: bvh | embree | both (default: every backend of
-    /// this build).
+    /// Backends to measure: bvh | embree (the best available) | embree3 |
+    /// embree4 | both (every backend available; the default).
     #[arg(long, value_enum)]
     accel: Option<BenchAccelArg>,
     /// Render this scene, record its ray queries and replay them on the bare
@@ -509,24 +516,22 @@ struct BenchArgs {
 enum BenchAccelArg {
     Bvh,
     Embree,
+    Embree3,
+    Embree4,
     Both,
 }
 
-/// The backends `--accel` asks for; one this build lacks is bad input.
+/// The backends `--accel` asks for, each concrete (`embree` resolved); one
+/// this process lacks is bad input, with why and how to get it.
 fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Error> {
     let want = match a {
         None | Some(BenchAccelArg::Both) => return Ok(lucent::tools::bench::available_backends()),
         Some(BenchAccelArg::Bvh) => Backend::Bvh,
         Some(BenchAccelArg::Embree) => Backend::Embree,
+        Some(BenchAccelArg::Embree3) => Backend::Embree3,
+        Some(BenchAccelArg::Embree4) => Backend::Embree4,
     };
-    if !lucent::tools::bench::available_backends().contains(&want) {
-        // accel::build says why and how to get it.
-        let why = accel::build(&std::sync::Arc::new(Vec::new()), want).err();
-        return Err(why.unwrap_or_else(|| {
-            Error::Unavailable(format!("backend {} is not available", want.name()))
-        }));
-    }
-    Ok(vec![want])
+    Ok(vec![want.resolve()?])
 }
 
 fn run_bench(a: BenchArgs) -> Result<(), Error> {
@@ -575,17 +580,22 @@ fn run_bench(a: BenchArgs) -> Result<(), Error> {
 }
 
 fn info() -> String {
-    let mut s = format!("lucent {}\nbackends: bvh", env!("CARGO_PKG_VERSION"));
-    #[cfg(feature = "embree")]
-    s.push_str(&format!(", embree (Embree {})", accel::embree::version()));
-    #[cfg(not(feature = "embree"))]
-    s.push_str(
-        "\nbuilt without the `embree` feature (--no-default-features): --accel embree is \
-         not available; the default build has it (needs Embree 3, Debian 12: libembree-dev)",
+    let names: Vec<&str> = Backend::all_available().iter().map(|b| b.name()).collect();
+    let mut s = format!(
+        "lucent {}\nbackends: {}",
+        env!("CARGO_PKG_VERSION"),
+        names.join(", ")
     );
-    s.push_str(&format!(
-        "\ndefault backend: {}",
-        Backend::default_available().name()
-    ));
+    for line in accel::embree_report() {
+        s.push('\n');
+        s.push_str(&line);
+    }
+    let default = Backend::default_available();
+    s.push_str(&format!("\ndefault backend: {}", default.name()));
+    if let Ok(b) = default.resolve() {
+        if b != default {
+            s.push_str(&format!(" ({})", b.name()));
+        }
+    }
     s
 }

@@ -1,4 +1,4 @@
-//! Embree and our BVH must answer the three ray queries alike.
+//! Embree (3 and 4) and our BVH must answer the three ray queries alike.
 //!
 //! Each backend is first checked against an independent brute-force
 //! reference (every triangle, Möller–Trumbore in f64 with closed edges), then
@@ -11,7 +11,9 @@
 //! exactly the reference's hits, including every triangle around a shared
 //! vertex or edge.
 //!
-//! Built only with the `embree` feature (`required-features` in Cargo.toml).
+//! Every check runs once on Embree 3 and once on Embree 4 (`on_embree3::*`,
+//! `on_embree4::*`). Built only with the `embree` feature
+//! (`required-features` in Cargo.toml).
 
 mod embree_vs_bvh {
     use std::path::Path;
@@ -292,8 +294,8 @@ mod embree_vs_bvh {
         hits: usize,
     }
 
-    fn embree(meshes: &Arc<Vec<Mesh>>) -> Box<dyn Accel> {
-        accel::build(meshes, Backend::Embree).expect("Embree build")
+    fn embree(meshes: &Arc<Vec<Mesh>>, which: Backend) -> Box<dyn Accel> {
+        accel::build(meshes, which).expect("Embree build")
     }
     fn bvh(meshes: &Arc<Vec<Mesh>>) -> Box<dyn Accel> {
         accel::build(meshes, Backend::Bvh).expect("BVH build")
@@ -365,9 +367,16 @@ mod embree_vs_bvh {
 
     /// Embree against the reference and against the BVH on `qs`, asserting
     /// that at most `max_ambiguous` of the queries were knife edges.
-    fn run(name: &str, meshes: Vec<Mesh>, qs: &[Query], eps: f64, max_ambiguous: f64) {
+    fn run(
+        which: Backend,
+        name: &str,
+        meshes: Vec<Mesh>,
+        qs: &[Query],
+        eps: f64,
+        max_ambiguous: f64,
+    ) {
         let meshes = Arc::new(meshes);
-        let e = embree(&meshes);
+        let e = embree(&meshes, which);
         // Embree against the reference alone first, so a BVH failure below
         // cannot hide an Embree one.
         compare(&*e, None, &meshes, qs, eps);
@@ -614,27 +623,32 @@ mod embree_vs_bvh {
 
     // ---- tests --------------------------------------------------------
 
-    #[test]
-    fn random_soups() {
+    fn random_soups(which: Backend) {
         for (seed, n, size) in [(1u64, 2000usize, 0.3f32), (2, 500, 1.0), (3, 20000, 0.05)] {
             let mesh = shapes::random_soup(n, size, seed);
             let qs = random_queries(1500, 1.5, 1, seed + 100);
-            run(&format!("soup {n}/{size}"), vec![mesh], &qs, 1e-5, 0.02);
+            run(
+                which,
+                &format!("soup {n}/{size}"),
+                vec![mesh],
+                &qs,
+                1e-5,
+                0.02,
+            );
         }
     }
 
-    #[test]
-    fn subdivided_sphere() {
+    fn subdivided_sphere(which: Backend) {
         let mesh = shapes::sphere(5);
         let mut qs = random_queries(1500, 1.5, 1, 7);
         qs.extend(inside_queries(1000, Vec3::ZERO, 0.9, 0, 8));
-        run("sphere(5)", vec![mesh.clone()], &qs, 1e-5, 0.02);
+        run(which, "sphere(5)", vec![mesh.clone()], &qs, 1e-5, 0.02);
 
         let meshes = Arc::new(vec![mesh.clone()]);
         let graze = grazing_queries(&mesh, 0, 600, 9);
         let cross = crossing_queries(&mesh, 0, 1000, 10);
         // Grazing queries are knife edges by construction: allow all of them.
-        let e = embree(&meshes);
+        let e = embree(&meshes, which);
         check_watertight(&*e, &cross);
         compare(&*e, None, &meshes, &graze, 1e-5);
         let b = bvh(&meshes);
@@ -647,8 +661,7 @@ mod embree_vs_bvh {
         check_watertight(&*b, &cross);
     }
 
-    #[test]
-    fn several_meshes() {
+    fn several_meshes(which: Backend) {
         let meshes = vec![
             shapes::random_soup(800, 0.3, 11),
             scaled(shapes::sphere(3), 0.5, Vec3::new(0.4, 0.0, 0.0)),
@@ -663,11 +676,10 @@ mod embree_vs_bvh {
         let mut qs = random_queries(2000, 1.5, 5, 12);
         qs.extend(inside_queries(500, Vec3::new(0.4, 0.0, 0.0), 0.4, 1, 13));
         qs.extend(inside_queries(500, Vec3::new(-0.5, 0.3, 0.2), 0.25, 3, 14));
-        run("several meshes", meshes, &qs, 1e-5, 0.02);
+        run(which, "several meshes", meshes, &qs, 1e-5, 0.02);
     }
 
-    #[test]
-    fn stanford_bunny() {
+    fn stanford_bunny(which: Backend) {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/meshes/bunny.obj");
         assert!(
             path.is_file(),
@@ -691,11 +703,11 @@ mod embree_vs_bvh {
         let mut qs = random_queries(2000, 1.5, 1, 21);
         qs.extend(inside_queries(1000, Vec3::ZERO, 0.3, 0, 22));
         let graze = grazing_queries(&mesh, 0, 400, 23);
-        run(name, vec![mesh.clone()], &qs, 1e-5, 0.03);
+        run(which, name, vec![mesh.clone()], &qs, 1e-5, 0.03);
 
         let meshes = Arc::new(vec![mesh]);
         let cross = crossing_queries(&meshes[0], 0, 1000, 24);
-        let e = embree(&meshes);
+        let e = embree(&meshes, which);
         check_watertight(&*e, &cross);
         compare(&*e, None, &meshes, &graze, 1e-5);
         let b = bvh(&meshes);
@@ -783,15 +795,14 @@ mod embree_vs_bvh {
 
     /// Off the grid-line planes (cell interiors and shared diagonal edges),
     /// both backends report exactly the reference's hits.
-    #[test]
-    fn integer_grid_diagonal_edges_exact() {
+    fn integer_grid_diagonal_edges_exact(which: Backend) {
         let meshes = Arc::new(grid_meshes());
         let qs: Vec<Query> = grid_queries()
             .into_iter()
             .filter(|q| !on_grid_plane(q))
             .collect();
         assert!(qs.len() > 90);
-        let e = embree(&meshes);
+        let e = embree(&meshes, which);
         let st = compare(&*e, None, &meshes, &qs, 0.0);
         assert_eq!(st.ambiguous, 0);
         assert!(st.hits > 300, "{st:?}");
@@ -821,11 +832,10 @@ mod embree_vs_bvh {
     /// it needs a ray exactly inside an axis plane through the geometry.)
     /// What holds, and is checked: no false hits, exact t, and, except in
     /// the scene's max bounding planes, every layer is found (watertight).
-    #[test]
-    fn integer_grid_vertices_embree_watertight() {
+    fn integer_grid_vertices_embree_watertight(which: Backend) {
         let meshes = Arc::new(grid_meshes());
         let qs: Vec<Query> = grid_queries().into_iter().filter(on_grid_plane).collect();
-        let e = embree(&meshes);
+        let e = embree(&meshes, which);
         let (mut fewer, mut checked) = (0, 0);
         for q in &qs {
             let r = reference(&meshes, &q.ray, 0.0, q.tmax, Some(q.geom), 0.0);
@@ -866,8 +876,7 @@ mod embree_vs_bvh {
     }
 
     /// More hits than `MAX_PROBE_HITS`: both backends keep the same subset.
-    #[test]
-    fn overflowing_probe_keeps_the_same_subset() {
+    fn overflowing_probe_keeps_the_same_subset(which: Backend) {
         let stack: Vec<Mesh> = (0..150).map(|k| grid(2, k as f32 * 0.25)).collect();
         let meshes = vec![merged(&stack)];
         let mut qs = Vec::new();
@@ -886,7 +895,7 @@ mod embree_vs_bvh {
             }
         }
         let meshes = Arc::new(meshes);
-        let e = embree(&meshes);
+        let e = embree(&meshes, which);
         let b = bvh(&meshes);
         let mut subsets = std::collections::HashSet::new();
         for q in &qs {
@@ -907,14 +916,53 @@ mod embree_vs_bvh {
     }
 
     /// Embree's build rejects meshes it would read out of bounds.
-    #[test]
-    fn embree_rejects_out_of_range_indices() {
+    fn embree_rejects_out_of_range_indices(which: Backend) {
         let mut m = shapes::quad();
         m.indices.push([0, 1, 4]);
-        let err = accel::build(&Arc::new(vec![m]), Backend::Embree)
-            .err()
-            .unwrap();
+        let err = accel::build(&Arc::new(vec![m]), which).err().unwrap();
         assert!(matches!(err, lucent::Error::Backend(_)), "{err}");
         assert!(err.to_string().contains("vertex index 4"), "{err}");
+    }
+
+    /// Each check above as one test per Embree this build has: Embree 3
+    /// (the `embree` feature; these tests need it) and Embree 4 (the
+    /// `embree4` feature and a library: see [`embree4`]).
+    macro_rules! on_each_embree {
+        ($($body:ident),* $(,)?) => {
+            mod on_embree3 {
+                use lucent::accel::Backend;
+                $( #[test] fn $body() { super::$body(Backend::Embree3) } )*
+            }
+            #[cfg(feature = "embree4")]
+            mod on_embree4 {
+                $( #[test] fn $body() { if let Some(b) = super::embree4() { super::$body(b) } } )*
+            }
+        };
+    }
+
+    on_each_embree!(
+        random_soups,
+        subdivided_sphere,
+        several_meshes,
+        stanford_bunny,
+        integer_grid_diagonal_edges_exact,
+        integer_grid_vertices_embree_watertight,
+        overflowing_probe_keeps_the_same_subset,
+        embree_rejects_out_of_range_indices,
+    );
+
+    /// Embree 4 if this process can load it; else `None` (the test is
+    /// skipped, saying so), unless `LUCENT_REQUIRE_EMBREE4` is set (as
+    /// scripts/test.sh does), where a missing Embree 4 fails the test.
+    #[cfg(feature = "embree4")]
+    fn embree4() -> Option<Backend> {
+        match Backend::Embree4.resolve() {
+            Ok(b) => Some(b),
+            Err(e) if std::env::var_os("LUCENT_REQUIRE_EMBREE4").is_none() => {
+                eprintln!("Embree 4 not tested: {e}");
+                None
+            }
+            Err(e) => panic!("LUCENT_REQUIRE_EMBREE4 is set but {e}"),
+        }
     }
 }

@@ -5,7 +5,9 @@
 //! image means must agree within Monte-Carlo noise, and nearly every pixel
 //! must agree to rounding.
 //!
-//! Built only with the `embree` feature (`required-features` in Cargo.toml).
+//! Run on Embree 3 and on Embree 4 (where this process has it; required
+//! under scripts/test.sh, which sets `LUCENT_REQUIRE_EMBREE4`). Built only
+//! with the `embree` feature (`required-features` in Cargo.toml).
 
 use std::path::Path;
 
@@ -29,7 +31,7 @@ fn render_with(scene: &scene::Scene, backend: Backend) -> Film {
     .0
 }
 
-fn compare(name: &str) {
+fn compare(name: &str, which: Backend) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenes")
         .join(name);
@@ -37,7 +39,7 @@ fn compare(name: &str) {
     let c = &scene.camera;
     scene.camera = Camera::new(c.look_from, c.look_at, c.up, c.fov_y, 160, 120);
     let bvh = render_with(&scene, Backend::Bvh);
-    let embree = render_with(&scene, Backend::Embree);
+    let embree = render_with(&scene, which);
     let n = bvh.pixels.len() as f64;
     for ch in 0..3 {
         let (mut mb, mut me, mut var) = (0.0, 0.0, 0.0);
@@ -54,7 +56,8 @@ fn compare(name: &str) {
         // independent renders would differ by ~√2·se; these share streams
         assert!(
             (mb - me).abs() < 3.0 * se,
-            "{name} ch{ch}: bvh {mb} embree {me} (se {se})"
+            "{name} ch{ch}: bvh {mb} {} {me} (se {se})",
+            which.name()
         );
     }
     let same = bvh
@@ -65,16 +68,44 @@ fn compare(name: &str) {
         .count();
     assert!(
         same as f64 > 0.95 * n,
-        "{name}: only {same} of {n} pixels agree"
+        "{name} on {}: only {same} of {n} pixels agree",
+        which.name()
     );
+}
+
+/// Embree 4 if this process can load it; else `None` (skipped, saying
+/// so), unless `LUCENT_REQUIRE_EMBREE4` is set, where that fails the test.
+fn embree4() -> Option<Backend> {
+    match Backend::Embree4.resolve() {
+        Ok(b) => Some(b),
+        Err(e) if std::env::var_os("LUCENT_REQUIRE_EMBREE4").is_none() => {
+            eprintln!("Embree 4 not tested: {e}");
+            None
+        }
+        Err(e) => panic!("LUCENT_REQUIRE_EMBREE4 is set but {e}"),
+    }
 }
 
 #[test]
 fn cornell_box_matches_across_backends() {
-    compare("cornell.toml");
+    compare("cornell.toml", Backend::Embree3);
 }
 
 #[test]
 fn marble_bunny_matches_across_backends() {
-    compare("marble-bunny.toml");
+    compare("marble-bunny.toml", Backend::Embree3);
+}
+
+#[test]
+fn cornell_box_matches_across_backends_on_embree4() {
+    if let Some(b) = embree4() {
+        compare("cornell.toml", b);
+    }
+}
+
+#[test]
+fn marble_bunny_matches_across_backends_on_embree4() {
+    if let Some(b) = embree4() {
+        compare("marble-bunny.toml", b);
+    }
 }

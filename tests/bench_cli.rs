@@ -262,7 +262,7 @@ fn scene_bench_replays_the_renders_queries() {
     let rows = parse_mix(&std::fs::read_to_string(out_dir.join("render-mix.csv")).unwrap());
     let backends = backends();
     // The tests are built with the binary's features.
-    assert_eq!(backends.contains("embree"), cfg!(feature = "embree"));
+    assert_eq!(backends.contains("embree3"), cfg!(feature = "embree"));
     let seen: BTreeSet<(String, String)> = rows
         .iter()
         .map(|r| (r["backend"].clone(), r["threads"].clone()))

@@ -158,16 +158,107 @@ fn info_lists_the_backends() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("backends: bvh"), "{text}");
     if cfg!(feature = "embree") {
-        assert!(text.contains("embree (Embree 3."), "{text}");
+        assert!(text.contains("embree3: Embree 3."), "{text}");
         assert!(text.contains("default backend: embree"), "{text}");
     } else {
         assert!(
             text.contains("built without the `embree` feature"),
             "{text}"
         );
+    }
+    if !cfg!(feature = "embree4") {
+        assert!(
+            text.contains("embree4: unavailable (this lucent was built without the `embree4`"),
+            "{text}"
+        );
+    }
+    if !cfg!(feature = "embree") && !cfg!(feature = "embree4") {
         assert!(text.contains("default backend: bvh"), "{text}");
     }
     assert!(Path::new(env!("CARGO_BIN_EXE_lucent")).exists());
+}
+
+/// Under scripts/test.sh (`LUCENT_EMBREE4` set to the wheel's 4.4.0),
+/// `info` lists both Embrees with their versions and where Embree 4 came
+/// from, and `--accel embree` means Embree 4.
+#[cfg(all(feature = "embree", feature = "embree4"))]
+#[test]
+fn info_lists_both_embrees_with_versions() {
+    let Some(lib) = std::env::var_os("LUCENT_EMBREE4") else {
+        eprintln!("LUCENT_EMBREE4 not set: not tested");
+        return;
+    };
+    let out = lucent().arg("info").output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("backends: bvh, embree3, embree4"), "{text}");
+    let want = format!("embree4: Embree 4.4.0 ({})", lib.to_string_lossy());
+    assert!(text.contains(&want), "{text}");
+    assert!(text.contains("default backend: embree (embree4)"), "{text}");
+}
+
+/// A missing, wrong or unknown Embree 4 is bad input for `--accel embree4`
+/// (exit 2, a message naming what was found and what is needed, nothing
+/// written), and `--accel embree` falls back to Embree 3: never a crash.
+#[cfg(all(feature = "embree", feature = "embree4"))]
+#[test]
+fn a_bad_embree4_library_is_refused_with_what_was_found() {
+    let embree3 = ["/usr/lib/x86_64-linux-gnu", "/usr/lib/aarch64-linux-gnu"]
+        .iter()
+        .map(|d| format!("{d}/libembree3.so.3"))
+        .find(|p| Path::new(p).exists())
+        .expect("Embree 3 is installed (the `embree` feature links it)");
+    let libm = ["/lib/x86_64-linux-gnu", "/lib/aarch64-linux-gnu"]
+        .iter()
+        .map(|d| format!("{d}/libm.so.6"))
+        .find(|p| Path::new(p).exists())
+        .unwrap();
+    let cases = [
+        (
+            "/nonexistent/libembree4.so.4".to_string(),
+            "LUCENT_EMBREE4=/nonexistent/libembree4.so.4: cannot load it".to_string(),
+        ),
+        (
+            embree3.clone(),
+            format!("{embree3} is Embree 3.13.5, not Embree 4: the embree4 backend needs Embree 4.3 to 4.4"),
+        ),
+        (
+            libm.clone(),
+            format!("{libm} is not an Embree 4 library: it has no rtcNewDevice"),
+        ),
+    ];
+    for (lib, needle) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let exr = dir.path().join("x.exr");
+        let run = |accel: &str| {
+            lucent()
+                .env("LUCENT_EMBREE4", &lib)
+                .arg("render")
+                .args([&scene("cornell.toml"), "-o", exr.to_str().unwrap()])
+                .args(["--spp", "1", "-q", "--accel", accel])
+                .output()
+                .unwrap()
+        };
+        let out = run("embree4");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{lib}: {err}");
+        assert!(err.contains(&needle), "{lib}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        let out = run("embree");
+        assert!(out.status.success(), "{lib}: embree3 fallback failed");
+        let info = lucent()
+            .env("LUCENT_EMBREE4", &lib)
+            .arg("info")
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&info.stdout);
+        assert!(info.status.success());
+        assert!(text.contains("default backend: embree (embree3)"), "{text}");
+        assert!(
+            text.contains(&format!("embree4: unavailable ({needle}")),
+            "{text}"
+        );
+    }
 }
 
 /// A BVH-only binary asked for Embree says it was built without the

@@ -1,5 +1,15 @@
-//! Ray queries behind one trait, with two backends: our own BVH
-//! ([`bvh`]) and Embree ([`embree`], when lucent is built with it).
+//! Ray queries behind one trait, with three backends: our own BVH
+//! ([`bvh`]), Embree 3 (`embree`, linked, with the `embree` feature) and
+//! Embree 4 (`embree4`, loaded at run time, with the `embree4` feature).
+//!
+//! Which Embree: a binary may have both. Embree 3 is linked, so a binary
+//! with it needs `libembree3.so.3` to start (Debian 12). Embree 4 is
+//! opened at run time, so the same binary runs whether or not the machine
+//! has it, and `--no-default-features --features embree4` gives one binary
+//! for Debian 12 (BVH only, or Embree 4 if provided) and Debian 13 (Embree
+//! 4.3). [`Backend::Embree`] is the best Embree this process can use:
+//! Embree 4 if it loads with a known version, else Embree 3 (why: see
+//! [`EMBREE_PREFERENCE`]).
 //!
 //! Three queries serve the integrators:
 //! - [`Accel::intersect`]: the nearest hit on a ray interval;
@@ -222,7 +232,7 @@ impl Clone for RejectedRays {
 /// the traversal (or Embree, which would abort the process); it misses and
 /// is counted in [`Accel::rejected_rays`].
 pub trait Accel: Send + Sync {
-    /// Short name for logs and `lucent info` ("bvh", "embree").
+    /// Short name for logs and `lucent info` ("bvh", "embree3", "embree4").
     fn name(&self) -> &'static str;
 
     /// Nearest hit with t in [tmin, tmax] (inclusive, as Embree), or None.
@@ -242,56 +252,156 @@ pub trait Accel: Send + Sync {
 }
 
 /// Which backend to build.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Backend {
     Bvh,
+    /// The best Embree available ([`EMBREE_PREFERENCE`]); resolved to
+    /// `Embree3` or `Embree4` by [`Backend::resolve`].
     Embree,
+    Embree3,
+    Embree4,
 }
 
+/// The order in which [`Backend::Embree`] picks an Embree: Embree 4 first.
+/// Both answer the queries alike (tests/backend_equivalence.rs); Embree 4
+/// is the maintained series, and where a machine has it, it is the one the
+/// user installed on purpose (Debian 13, or `LUCENT_EMBREE4`). The speed
+/// difference measured on these machines is in docs/performance.md.
+pub const EMBREE_PREFERENCE: [Backend; 2] = [Backend::Embree4, Backend::Embree3];
+
 impl Backend {
-    /// The default: Embree when lucent was built with the `embree` feature,
-    /// else our BVH.
+    /// The default: the best Embree this process can use, else our BVH.
     pub fn default_available() -> Backend {
-        if cfg!(feature = "embree") {
+        if Backend::Embree.resolve().is_ok() {
             Backend::Embree
         } else {
             Backend::Bvh
         }
     }
+
     pub fn name(self) -> &'static str {
         match self {
             Backend::Bvh => "bvh",
             Backend::Embree => "embree",
+            Backend::Embree3 => "embree3",
+            Backend::Embree4 => "embree4",
         }
     }
+
+    /// The concrete backend this one stands for (`Embree`: the first of
+    /// [`EMBREE_PREFERENCE`] available), or why it is not available
+    /// ([`Error::Unavailable`], with how to get it).
+    pub fn resolve(self) -> Result<Backend, Error> {
+        match self {
+            Backend::Bvh => Ok(Backend::Bvh),
+            Backend::Embree3 => embree3_available().map(|_| Backend::Embree3),
+            Backend::Embree4 => embree4_available().map(|_| Backend::Embree4),
+            Backend::Embree => {
+                let mut why = Vec::new();
+                for b in EMBREE_PREFERENCE {
+                    match b.resolve() {
+                        Ok(b) => return Ok(b),
+                        Err(e) => why.push(e.to_string()),
+                    }
+                }
+                Err(Error::Unavailable(format!(
+                    "no Embree is available: {}",
+                    why.join("; ")
+                )))
+            }
+        }
+    }
+
+    /// The concrete backends this process can use: our BVH, then each
+    /// available Embree (Embree 3, Embree 4).
+    pub fn all_available() -> Vec<Backend> {
+        [Backend::Bvh, Backend::Embree3, Backend::Embree4]
+            .into_iter()
+            .filter(|b| b.resolve().is_ok())
+            .collect()
+    }
+}
+
+fn embree3_available() -> Result<(), Error> {
+    if cfg!(feature = "embree") {
+        Ok(())
+    } else {
+        Err(Error::Unavailable(
+            "this lucent was built without the `embree` feature, so it has no Embree 3: use \
+             --accel bvh (or embree4), or rebuild with the default features \
+             (`cargo build --release`, which needs Embree 3: on Debian 12 \
+             `apt-get install -y --no-install-recommends libembree-dev`)"
+                .into(),
+        ))
+    }
+}
+
+fn embree4_available() -> Result<(), Error> {
+    #[cfg(feature = "embree4")]
+    {
+        embree4::load::api().map(|_| ())
+    }
+    #[cfg(not(feature = "embree4"))]
+    {
+        Err(Error::Unavailable(
+            "this lucent was built without the `embree4` feature, so it has no Embree 4: use \
+             --accel bvh (or embree3), or rebuild with the default features"
+                .into(),
+        ))
+    }
+}
+
+/// The Embree versions this process has, one line each, for `lucent info`:
+/// "embree3: Embree 3.13.5", "embree4: Embree 4.4.0 (path)", or why not.
+pub fn embree_report() -> Vec<String> {
+    let mut v = Vec::new();
+    #[cfg(feature = "embree")]
+    v.push(format!("embree3: Embree {}", embree::version()));
+    #[cfg(not(feature = "embree"))]
+    v.push(format!(
+        "embree3: unavailable ({})",
+        embree3_available().unwrap_err()
+    ));
+    #[cfg(feature = "embree4")]
+    v.push(match embree4::version() {
+        Ok(s) => format!("embree4: Embree {s}"),
+        Err(e) => format!("embree4: unavailable ({e})"),
+    });
+    #[cfg(not(feature = "embree4"))]
+    v.push(format!(
+        "embree4: unavailable ({})",
+        embree4_available().unwrap_err()
+    ));
+    v
 }
 
 /// Builds the chosen backend over `meshes`. The meshes are shared (not
 /// copied) by backends that can read our buffers directly, hence the `Arc`.
 pub fn build(meshes: &Arc<Vec<Mesh>>, backend: Backend) -> Result<Box<dyn Accel>, Error> {
-    match backend {
+    match backend.resolve()? {
         Backend::Bvh => Ok(Box::new(bvh::Bvh::build(meshes))),
-        Backend::Embree => {
-            #[cfg(feature = "embree")]
-            {
-                embree::EmbreeAccel::build(meshes).map(|a| Box::new(a) as Box<dyn Accel>)
-            }
-            #[cfg(not(feature = "embree"))]
-            {
-                Err(Error::Unavailable(
-                    "this lucent was built without the `embree` feature, so it has only \
-                     its own BVH: use --accel bvh, or rebuild with the default features \
-                     (`cargo build --release`, which needs Embree 3: on Debian 12 \
-                     `apt-get install -y --no-install-recommends libembree-dev`)"
-                        .into(),
-                ))
-            }
+        #[cfg(feature = "embree")]
+        Backend::Embree3 => {
+            embree::EmbreeAccel::build(meshes).map(|a| Box::new(a) as Box<dyn Accel>)
         }
+        #[cfg(feature = "embree4")]
+        Backend::Embree4 => {
+            embree4::Embree4Accel::build(meshes).map(|a| Box::new(a) as Box<dyn Accel>)
+        }
+        // `resolve` returns only backends this build has.
+        other => Err(Error::Unavailable(format!(
+            "backend {} is not available",
+            other.name()
+        ))),
     }
 }
 
 #[cfg(feature = "embree")]
 pub mod embree;
+#[cfg(feature = "embree4")]
+pub mod embree4;
+#[cfg(any(feature = "embree", feature = "embree4"))]
+mod embree_shared;
 
 #[cfg(test)]
 mod tests {
@@ -374,7 +484,21 @@ mod tests {
     fn embree_guard_turns_nan_and_huge_rays_into_counted_misses() {
         // Without the guard, the first bad ray aborts the test process
         // inside Embree (its `ray.valid()` assertion).
-        let accel = build(&quad(), Backend::Embree).unwrap();
+        let accel = build(&quad(), Backend::Embree3).unwrap();
         guard_turns_bad_rays_into_counted_misses(accel.as_ref());
+    }
+
+    /// The same on Embree 4, where this process has it (the test command
+    /// provides it: scripts/test.sh sets `LUCENT_EMBREE4`).
+    #[cfg(feature = "embree4")]
+    #[test]
+    fn embree4_guard_turns_nan_and_huge_rays_into_counted_misses() {
+        match build(&quad(), Backend::Embree4) {
+            Ok(accel) => guard_turns_bad_rays_into_counted_misses(accel.as_ref()),
+            Err(e) if std::env::var_os("LUCENT_REQUIRE_EMBREE4").is_none() => {
+                eprintln!("Embree 4 not tested: {e}")
+            }
+            Err(e) => panic!("LUCENT_REQUIRE_EMBREE4 is set but {e}"),
+        }
     }
 }

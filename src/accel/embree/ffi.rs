@@ -179,45 +179,6 @@ pub struct RTCFilterFunctionNArguments {
     pub n: c_uint,
 }
 
-// Indices of the SoA fields, as in `RTCRayN_*` / `RTCHitN_*` of
-// `rtcore_ray.h`: field k of lane i is the 4-byte word k*N + i.
-pub const RAYN_TFAR: usize = 8;
-pub const HITN_U: usize = 3;
-pub const HITN_V: usize = 4;
-pub const HITN_PRIM_ID: usize = 5;
-pub const HITN_GEOM_ID: usize = 6;
-
-/// `RTCRayN_tfar(ray, N, i)`.
-///
-/// # Safety
-/// `ray` must point to a valid `RTCRayN` of width `n`, and `i < n`.
-#[inline]
-pub unsafe fn rayn_tfar(ray: *const RTCRayN, n: u32, i: u32) -> f32 {
-    // SAFETY: per the caller's contract the word k*N + i is inside the packet.
-    unsafe { *(ray as *const f32).add(RAYN_TFAR * n as usize + i as usize) }
-}
-
-/// `RTCHitN_u/v/primID/geomID(hit, N, i)` as (u, v, primID, geomID).
-///
-/// # Safety
-/// `hit` must point to a valid `RTCHitN` of width `n`, and `i < n`.
-#[inline]
-pub unsafe fn hitn_get(hit: *const RTCHitN, n: u32, i: u32) -> (f32, f32, u32, u32) {
-    let (n, i) = (n as usize, i as usize);
-    let f = hit as *const f32;
-    let w = hit as *const u32;
-    // SAFETY: per the caller's contract the words k*N + i for k ≤ 6 are
-    // inside the packet (it has 7 + instance-level words per lane).
-    unsafe {
-        (
-            *f.add(HITN_U * n + i),
-            *f.add(HITN_V * n + i),
-            *w.add(HITN_PRIM_ID * n + i),
-            *w.add(HITN_GEOM_ID * n + i),
-        )
-    }
-}
-
 /// `RTCErrorFunction`. Must not unwind into Embree.
 pub type RTCErrorFunction =
     Option<unsafe extern "C" fn(user_ptr: *mut c_void, code: RTCError, str: *const c_char)>;

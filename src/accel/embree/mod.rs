@@ -12,12 +12,15 @@
 #[doc(hidden)]
 pub mod ffi;
 
-use std::ffi::{c_char, c_void, CStr, CString};
+use std::ffi::{c_void, CString};
 use std::marker::PhantomData;
 use std::ptr;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, OnceLock};
 
+use super::embree_shared::{
+    check_shareable, error_name, on_device_error, record_and_reject, ErrorSink,
+};
 use super::{valid_query, Accel, Hit, ProbeHits, RejectedRays};
 use crate::error::Error;
 use crate::geometry::{Mesh, Ray, Vec3};
@@ -53,55 +56,6 @@ pub fn version() -> String {
             Err(e) => format!("unavailable ({e})"),
         })
         .clone()
-}
-
-/// Errors Embree reported through the device's error callback, kept until
-/// the next [`Device::check`].
-#[derive(Default)]
-struct ErrorSink {
-    messages: Mutex<Vec<String>>,
-}
-
-/// At most this many messages are kept between checks (the first ones, which
-/// name the cause; later ones are usually consequences).
-const MAX_ERRORS: usize = 8;
-
-fn error_name(code: ffi::RTCError) -> &'static str {
-    match code {
-        ffi::RTC_ERROR_NONE => "no error",
-        ffi::RTC_ERROR_UNKNOWN => "unknown error",
-        ffi::RTC_ERROR_INVALID_ARGUMENT => "invalid argument",
-        ffi::RTC_ERROR_INVALID_OPERATION => "invalid operation",
-        ffi::RTC_ERROR_OUT_OF_MEMORY => "out of memory",
-        ffi::RTC_ERROR_UNSUPPORTED_CPU => "unsupported CPU",
-        ffi::RTC_ERROR_CANCELLED => "cancelled",
-        _ => "unrecognized error code",
-    }
-}
-
-/// The device error callback. A panic here would abort the process (Rust
-/// does not unwind out of `extern "C"`), and nothing here can panic: the
-/// lock ignores poisoning.
-unsafe extern "C" fn on_device_error(user: *mut c_void, code: ffi::RTCError, msg: *const c_char) {
-    if user.is_null() {
-        return;
-    }
-    // SAFETY: `user` is the `ErrorSink` boxed in the `Device` that installed
-    // this callback; `Device::drop` uninstalls the callback before the box is
-    // freed, so it is alive here. The sink is only accessed through `&`.
-    let sink = unsafe { &*(user as *const ErrorSink) };
-    let text = if msg.is_null() {
-        String::new()
-    } else {
-        // SAFETY: Embree passes a NUL-terminated message valid for the call.
-        unsafe { CStr::from_ptr(msg) }
-            .to_string_lossy()
-            .into_owned()
-    };
-    let mut m = sink.messages.lock().unwrap_or_else(|e| e.into_inner());
-    if m.len() < MAX_ERRORS {
-        m.push(format!("Embree: {} ({code}): {text}", error_name(code)));
-    }
 }
 
 /// An owned `RTCDevice`, released on drop.
@@ -161,21 +115,7 @@ impl Device {
     fn check(&self, what: &str) -> Result<(), Error> {
         // SAFETY: `self.raw` is a live device. Reading the code also clears it.
         let code = unsafe { ffi::rtcGetDeviceError(self.raw) };
-        let mut msgs = std::mem::take(
-            &mut *self
-                .errors
-                .messages
-                .lock()
-                .unwrap_or_else(|e| e.into_inner()),
-        );
-        if code != ffi::RTC_ERROR_NONE && msgs.is_empty() {
-            msgs.push(format!("Embree: {} ({code})", error_name(code)));
-        }
-        if msgs.is_empty() {
-            Ok(())
-        } else {
-            Err(Error::Backend(format!("{what}: {}", msgs.join("; "))))
-        }
+        self.errors.take(code, what)
     }
 }
 
@@ -228,43 +168,12 @@ unsafe impl Send for EmbreeAccel {}
 // SAFETY: see `Send` above.
 unsafe impl Sync for EmbreeAccel {}
 
-/// Checks that Embree can share every mesh's buffers safely: Embree reads
-/// them without bounds checks, so an index out of range would be an
-/// out-of-bounds read (`Mesh::new` checks only in debug builds).
-fn check_shareable(meshes: &[Mesh]) -> Result<(), Error> {
-    for (i, m) in meshes.iter().enumerate() {
-        let nv = m.vertex_count();
-        if nv > u32::MAX as usize || m.triangle_count() > u32::MAX as usize {
-            return Err(Error::Backend(format!("Embree: mesh {i} is too large")));
-        }
-        if let Some(bad) = m.indices.iter().flatten().find(|&&v| v as usize >= nv) {
-            return Err(Error::Backend(format!(
-                "Embree: mesh {i} has vertex index {bad} but only {nv} vertices"
-            )));
-        }
-        // Embree's 16-byte vertex loads need the padding element
-        // (`Mesh::default()` has none, but also no vertices to index).
-        if m.triangle_count() > 0 && m.padded_positions().len() <= nv {
-            return Err(Error::Backend(format!(
-                "Embree: mesh {i} lacks its padding vertex"
-            )));
-        }
-    }
-    Ok(())
-}
-
 impl EmbreeAccel {
     /// Builds and commits an Embree scene over `meshes`, sharing their
     /// buffers; called inside a rayon pool, the build uses that many
     /// threads. Fails (without leaking) if Embree reports any error or if a
     /// mesh cannot be shared safely (index out of range, too many elements).
     pub fn build(meshes: &Arc<Vec<Mesh>>) -> Result<EmbreeAccel, Error> {
-        if meshes.len() >= ffi::RTC_INVALID_GEOMETRY_ID as usize {
-            return Err(Error::Backend(format!(
-                "Embree: too many meshes ({})",
-                meshes.len()
-            )));
-        }
         check_shareable(meshes)?;
 
         // Inside a rayon pool, build with as many threads as it has (so a
@@ -438,34 +347,23 @@ unsafe extern "C" fn probe_filter(args: *const ffi::RTCFilterFunctionNArguments)
     // the filter runs synchronously on the calling thread, so this is the
     // only live reference.
     let out = unsafe { &mut *pc.out };
-    for i in 0..args.n {
-        // SAFETY: `valid` has `n` entries; ray and hit are packets of width
-        // `n` (for rtcIntersect1, n = 1 and they are a plain RTCRayHit).
-        unsafe {
-            let valid = args.valid.add(i as usize);
-            if *valid == 0 {
-                continue; // inactive lane
-            }
-            let (u, v, prim, geom) = ffi::hitn_get(args.hit, args.n, i);
-            if geom == pc.geom {
-                // During the filter, tfar holds the candidate's distance.
-                let t = ffi::rayn_tfar(args.ray, args.n, i);
-                out.record(Hit {
-                    t,
-                    geom,
-                    prim,
-                    u,
-                    v,
-                });
-            }
-            *valid = 0;
-        }
-    }
+    // SAFETY: Embree passes `valid`, ray and hit packets of width `n` (for
+    // rtcIntersect1, n = 1 and they are a plain RTCRayHit).
+    unsafe {
+        record_and_reject(
+            args.valid,
+            args.ray as *const c_void,
+            args.hit as *const c_void,
+            args.n,
+            pc.geom,
+            out,
+        )
+    };
 }
 
 impl Accel for EmbreeAccel {
     fn name(&self) -> &'static str {
-        "embree"
+        "embree3"
     }
 
     fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {

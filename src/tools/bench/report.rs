@@ -1,5 +1,6 @@
 //! The text report of `lucent bench` (`report.txt`, also printed):
-//! throughput per mesh, query and thread count with the Embree/BVH ratio,
+//! throughput per mesh, query and thread count with each Embree's ratio to
+//! the BVH (and Embree 4's to Embree 3 when both ran),
 //! the builds, how time per ray grows with the triangle count (a
 //! least-squares fit of t = a + b·log2(n) and of the log-log exponent k,
 //! t ∝ n^k, over the displaced spheres), and thread scaling.
@@ -75,6 +76,18 @@ pub fn report(rows: &[Row], threads: &[usize], s: &Settings, seconds: f64) -> St
     o
 }
 
+/// The throughput ratios shown, as (numerator, denominator) indices into
+/// `backends`: every other backend over the first (the BVH), and
+/// embree4/embree3 when both are there.
+fn ratio_pairs(backends: &[String]) -> Vec<(usize, usize)> {
+    let mut v: Vec<(usize, usize)> = (1..backends.len()).map(|i| (i, 0)).collect();
+    let at = |n: &str| backends.iter().position(|b| b == n);
+    if let (Some(e3), Some(e4)) = (at("embree3"), at("embree4")) {
+        v.push((e4, e3));
+    }
+    v
+}
+
 /// Mrays/s per (mesh, query, threads), one column per backend.
 fn throughput_table(
     o: &mut String,
@@ -88,8 +101,13 @@ fn throughput_table(
     for b in backends {
         let _ = write!(head, " {:>9}", b);
     }
-    if backends.len() == 2 {
-        let _ = write!(head, " {:>8}", format!("{}/{}", backends[1], backends[0]));
+    let pairs = ratio_pairs(backends);
+    for &(num, den) in &pairs {
+        let _ = write!(
+            head,
+            " {:>13}",
+            format!("{}/{}", backends[num], backends[den])
+        );
     }
     let _ = write!(head, " {:>12}", "hits");
     let _ = writeln!(o, "{head}");
@@ -114,8 +132,15 @@ fn throughput_table(
                         r.map_or("-".into(), |r| format!("{:.2}", r.mrays()))
                     );
                 }
-                if let [Some(a), Some(b)] = rs[..] {
-                    let _ = write!(o, " {:>8.2}", b.mrays() / a.mrays());
+                for &(num, den) in &pairs {
+                    match (rs[num], rs[den]) {
+                        (Some(n), Some(d)) => {
+                            let _ = write!(o, " {:>13.2}", n.mrays() / d.mrays());
+                        }
+                        _ => {
+                            let _ = write!(o, " {:>13}", "-");
+                        }
+                    }
                 }
                 let hits: Vec<u64> = rs.iter().flatten().map(|r| r.hits).collect();
                 let same = hits.windows(2).all(|w| w[0] == w[1]);

@@ -81,13 +81,9 @@ pub fn default_threads() -> Vec<usize> {
     threads
 }
 
-/// Our BVH, and Embree when lucent was built with it.
+/// Our BVH, and each Embree this process can use (Embree 3, Embree 4).
 pub fn available_backends() -> Vec<Backend> {
-    let mut v = vec![Backend::Bvh];
-    if Backend::default_available() == Backend::Embree {
-        v.push(Backend::Embree);
-    }
-    v
+    Backend::all_available()
 }
 
 /// Parses a triangle count: `1000`, `16k`, `1.3M`.
