@@ -176,34 +176,56 @@ pub fn render_passes(
         pool: &pool,
         bar: &bar,
     };
-    let (film, counters, seconds, layers, coverage) = if passes.is_empty() {
-        let (film, counters, seconds, _) = run.tiles(|_| NoAov)?;
-        (film, counters, seconds, Vec::new(), Vec::new())
+    let (done, layers, coverage) = if passes.is_empty() {
+        (
+            run.tiles(|_| NoAov)?.without_passes(),
+            Vec::new(),
+            Vec::new(),
+        )
     } else {
         let setup = Setup::new(scene, &ctx.lights, passes);
         let layout = Layout::new(&setup);
-        let (film, counters, seconds, out) =
-            run.tiles(|pixels| TilePasses::new(&setup, &layout, pixels))?;
+        let done = run.tiles(|pixels| TilePasses::new(&setup, &layout, pixels))?;
         let tile_width = |x0: u32| TILE.min(w - x0);
         let parts = tiles
             .iter()
-            .zip(&out)
+            .zip(&done.passes)
             .map(|(&(x0, y0), t)| ((x0, y0), tile_width(x0), t));
         let (layers, coverage) = assemble(&setup, &layout, w, h, parts)?;
-        (film, counters, seconds, layers, coverage)
+        (done.without_passes(), layers, coverage)
     };
     let stats = RenderStats {
-        seconds,
+        seconds: done.seconds,
         samples: w as u64 * h as u64 * scene.settings.spp as u64,
         threads,
-        counters,
+        counters: done.counters,
     };
     Ok(RenderOutput {
-        film,
+        film: done.film,
         layers,
         coverage,
         stats,
     })
+}
+
+/// The rendered tiles: the film, the summed counters, the seconds the tiles
+/// took, and each tile's passes in tile order.
+struct Tiles<T> {
+    film: Film,
+    counters: Counters,
+    seconds: f64,
+    passes: Vec<T>,
+}
+
+impl<T> Tiles<T> {
+    fn without_passes(self) -> Tiles<()> {
+        Tiles {
+            film: self.film,
+            counters: self.counters,
+            seconds: self.seconds,
+            passes: Vec::new(),
+        }
+    }
 }
 
 /// What rendering the tiles needs.
@@ -216,13 +238,11 @@ struct Run<'a> {
 }
 
 impl Run<'_> {
-    /// Renders every tile with the passes `passes(pixels)` makes for it:
-    /// the film, the summed counters, the seconds the tiles took and each
-    /// tile's passes, in tile order.
+    /// Renders every tile with the passes `passes(pixels)` makes for it.
     fn tiles<P: PixelPasses>(
         &self,
         passes: impl Fn(usize) -> P + Sync,
-    ) -> Result<(Film, Counters, f64, Vec<P::Tile>), Error> {
+    ) -> Result<Tiles<P::Tile>, Error> {
         let ctx = self.ctx;
         let start = Instant::now();
         let (w, h) = (ctx.scene.camera.width, ctx.scene.camera.height);
@@ -255,7 +275,12 @@ impl Run<'_> {
             }
             out.push(t);
         }
-        Ok((film, counters, seconds, out))
+        Ok(Tiles {
+            film,
+            counters,
+            seconds,
+            passes: out,
+        })
     }
 }
 

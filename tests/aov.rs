@@ -184,6 +184,42 @@ fn light_paths_and_light_groups_sum_to_the_beauty_with_both_integrators() {
 }
 
 #[test]
+fn each_light_group_holds_the_light_of_its_own_lights() {
+    // One colour per group: key red, the ungrouped bulb green, the sky
+    // blue. Transport never moves light between channels, so each group's
+    // layer is its channel of the beauty, and exactly black elsewhere.
+    let text = MIXED
+        .replace("emission = [6, 6, 6]", "emission = [6, 0, 0]")
+        .replace("emission = [3, 3, 2]", "emission = [0, 3, 0]")
+        .replace("radiance = [0.2, 0.25, 0.3]", "radiance = [0, 0, 0.3]");
+    let s = scene(&text);
+    for integrator in [IntegratorKind::Path, IntegratorKind::RandomWalk] {
+        let out = render_with(
+            &s,
+            PassSet::named("lightgroups").unwrap(),
+            integrator,
+            2,
+            None,
+        );
+        for (g, name) in ["RGBA_key", "RGBA_default", "RGBA_sky"].iter().enumerate() {
+            let l = layer(&out, name);
+            assert!(max(l) > 0.0, "{integrator:?}: {name} is black");
+            for (p, b) in out.film.pixels.iter().enumerate() {
+                for c in 0..3 {
+                    let (v, want) = (l.get(p, c), if c == g { b[c] } else { 0.0 });
+                    // (the beauty sums a coat split's branches apart: ulps)
+                    let ok = (v - want).abs() <= 1e-5 * want;
+                    assert!(
+                        ok,
+                        "{integrator:?}: {name} pixel {p} channel {c}: {v}, not {want}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
 fn every_pass_is_the_same_for_one_and_two_threads() {
     let s = scene(MIXED);
     for integrator in [IntegratorKind::Path, IntegratorKind::RandomWalk] {
