@@ -197,6 +197,10 @@ pub struct TileOut {
 pub struct TilePasses<'a> {
     setup: &'a Setup,
     layout: &'a Layout,
+    /// Which sums the passes need (the rest are skipped per sample).
+    variance: bool,
+    objects: bool,
+    materials: bool,
     rec: SampleAovs<'a>,
     sums: Sums,
     out: TileOut,
@@ -209,6 +213,9 @@ impl<'a> TilePasses<'a> {
         TilePasses {
             setup,
             layout,
+            variance: setup.passes.contains(Pass::Variance),
+            objects: setup.passes.contains(Pass::CryptoObject),
+            materials: setup.passes.contains(Pass::CryptoMaterial),
             rec: SampleAovs::new(setup),
             sums: Sums::new(setup.groups.len()),
             out: TileOut {
@@ -241,12 +248,14 @@ impl<'a> PixelPasses for TilePasses<'a> {
                 add(sum, *v);
             }
         }
-        let x = if finite { l } else { Vec3::ZERO };
-        for (c, x) in [x.x, x.y, x.z].into_iter().enumerate() {
-            let x = x as f64;
-            let delta = x - s.mean[c];
-            s.mean[c] += delta / s.n as f64;
-            s.m2[c] += delta * (x - s.mean[c]);
+        if self.variance {
+            let x = if finite { l } else { Vec3::ZERO };
+            for (c, x) in [x.x, x.y, x.z].into_iter().enumerate() {
+                let x = x as f64;
+                let delta = x - s.mean[c];
+                s.mean[c] += delta / s.n as f64;
+                s.m2[c] += delta * (x - s.mean[c]);
+            }
         }
         if let Some((albedo, normal)) = r.surface {
             add(&mut s.albedo, albedo);
@@ -257,8 +266,12 @@ impl<'a> PixelPasses for TilePasses<'a> {
             if s.nearest.is_none_or(|(zn, _, _)| z < zn) {
                 s.nearest = Some((z, p, geom));
             }
-            count(&mut s.objects, setup.object_name[geom as usize]);
-            count(&mut s.materials, setup.object_material[geom as usize]);
+            if self.objects {
+                count(&mut s.objects, setup.object_name[geom as usize]);
+            }
+            if self.materials {
+                count(&mut s.materials, setup.object_material[geom as usize]);
+            }
         }
     }
 
@@ -301,10 +314,10 @@ impl<'a> PixelPasses for TilePasses<'a> {
                 .map(|&(i, c)| (i, (c as f64 / n) as f32))
                 .collect::<Vec<_>>()
         };
-        if setup.passes.contains(Pass::CryptoObject) {
+        if self.objects {
             out.objects.push(fractions(&mut s.objects));
         }
-        if setup.passes.contains(Pass::CryptoMaterial) {
+        if self.materials {
             out.materials.push(fractions(&mut s.materials));
         }
         out.pixels += 1;
