@@ -15,6 +15,8 @@ pub struct LightSet {
     dist: Distribution1D,
     /// For each geom: index of its first triangle in `tris`, or None.
     first: Vec<Option<u32>>,
+    /// For each triangle of `tris`, its geom (the object it belongs to).
+    geoms: Vec<u32>,
 }
 
 /// What sampling a point on one emissive triangle needs, computed once so
@@ -40,6 +42,8 @@ pub struct LightSample {
     pub radiance: Vec3,
     /// Probability density per unit area.
     pub pdf_area: f32,
+    /// The emissive triangle it is on (see [`LightSet::geom_of`]).
+    pub index: u32,
 }
 
 pub fn luminance(c: Vec3) -> f32 {
@@ -51,6 +55,7 @@ impl LightSet {
         let mut tris = Vec::new();
         let mut weights = Vec::new();
         let mut first = vec![None; scene.meshes.len()];
+        let mut geoms = Vec::new();
         for (g, (mesh, obj)) in scene.meshes.iter().zip(&scene.objects).enumerate() {
             let Some(le) = obj.emission else { continue };
             let power = luminance(le).max(le.max_element() * 1e-3) as f64;
@@ -70,6 +75,7 @@ impl LightSet {
                     pdf_area: 0.0,
                 });
                 weights.push(mesh.area(p) as f64 * power);
+                geoms.push(g as u32);
             }
         }
         let dist = Distribution1D::new(&weights);
@@ -82,7 +88,17 @@ impl LightSet {
                 0.0
             };
         }
-        LightSet { tris, dist, first }
+        LightSet {
+            tris,
+            dist,
+            first,
+            geoms,
+        }
+    }
+
+    /// The number of emissive triangles.
+    pub fn len(&self) -> usize {
+        self.tris.len()
     }
 
     pub fn is_empty(&self) -> bool {
@@ -95,7 +111,8 @@ impl LightSet {
         if self.is_empty() {
             return None;
         }
-        let t = &self.tris[self.dist.sample_index(u_pick)];
+        let index = self.dist.sample_index(u_pick);
+        let t = &self.tris[index];
         if t.pdf_area <= 0.0 {
             return None;
         }
@@ -105,7 +122,14 @@ impl LightSet {
             normal: t.normal,
             radiance: t.radiance,
             pdf_area: t.pdf_area,
+            index: index as u32,
         })
+    }
+
+    /// The geom (object index) of emissive triangle `index` of a
+    /// [`LightSample`].
+    pub fn geom_of(&self, index: u32) -> u32 {
+        self.geoms[index as usize]
     }
 
     /// The area density with which [`sample`](Self::sample) picks a point on

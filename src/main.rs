@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use lucent::accel::{self, Backend};
 use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
 use lucent::error::{Param, ParamError};
+use lucent::film::passes::PassSet;
 use lucent::film::ToneMap;
 use lucent::integrator::IntegratorKind;
 use lucent::materials::{SubsurfaceOverrides, WalkBoundary};
@@ -90,6 +91,15 @@ enum Command {
         /// randomwalk (volumetric reference).
         #[arg(long, value_enum, default_value = "path")]
         integrator: IntegratorArg,
+        /// Passes besides the beauty, comma separated (replaces the scene's
+        /// `[output] aovs`): light paths (emission, background,
+        /// diffuse_direct, diffuse_indirect, specular_direct,
+        /// specular_indirect, transmission, sss_direct, sss_indirect),
+        /// lightgroups, albedo, N, P, Z, object_id, material_id,
+        /// crypto_object, crypto_material, sample_count, variance; groups:
+        /// all, lightpaths, data, ids, cryptomatte, noise (docs/output.md).
+        #[arg(long, value_parser = parse_aov)]
+        aov: Option<PassSet>,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
     },
@@ -165,6 +175,10 @@ fn parse_radius(s: &str) -> Result<RadiusSampler, ParamError> {
     RadiusSampler::parse(s)
 }
 
+fn parse_aov(s: &str) -> Result<PassSet, String> {
+    PassSet::parse_list(s).map_err(|e| e.problem())
+}
+
 impl SubsurfaceArgs {
     fn overrides(&self) -> SubsurfaceOverrides {
         SubsurfaceOverrides {
@@ -208,6 +222,7 @@ fn main() -> ExitCode {
             exposure,
             quiet,
             integrator,
+            aov,
             subsurface,
         } => {
             let backend = accel
@@ -229,6 +244,7 @@ fn main() -> ExitCode {
                 &output,
                 backend,
                 &opts,
+                aov,
                 &subsurface.overrides(),
                 tonemap,
                 exposure,
@@ -294,6 +310,7 @@ fn run_render(
     output: &Path,
     backend: Backend,
     opts: &RenderOptions,
+    aov: Option<PassSet>,
     overrides: &SubsurfaceOverrides,
     tonemap: ToneMap,
     exposure: f32,
@@ -339,8 +356,23 @@ fn run_render(
     stop_if_interrupted()?;
     let accel = accel::build(&scene.meshes, backend)?;
     stop_if_interrupted()?;
-    let (film, stats) = render::render(&scene, accel.as_ref(), opts)?;
+    let passes = aov.unwrap_or(scene.output.aovs);
+    let render::RenderOutput {
+        film,
+        layers,
+        coverage,
+        stats,
+    } = render::render_passes(&scene, accel.as_ref(), opts, passes)?;
     film.write_exr_and_preview(output, tonemap, exposure)?;
+    if !layers.is_empty() || !coverage.is_empty() {
+        // The multi-layer writer takes these at its merge.
+        eprintln!(
+            "warning: {} pass layers and {} coverage sets were computed, but this build \
+             writes the beauty only",
+            layers.len(),
+            coverage.len()
+        );
+    }
     if !quiet {
         eprintln!(
             "{}: {}x{} at {} spp, {} triangles: {}",

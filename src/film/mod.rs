@@ -6,6 +6,7 @@
 //! failure never leaves an EXR without its PNG.
 
 pub mod layers;
+pub mod passes;
 pub mod tonemap;
 
 use std::fs;

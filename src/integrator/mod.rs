@@ -8,8 +8,10 @@
 //! and weighs the hit, the integrator queries the accel.
 //! [`randomwalk`] is the brute-force volumetric reference for subsurface
 //! materials, selected with [`IntegratorKind`]; [`diffuse_boundary`] is
-//! its optional diffuse Fresnel boundary model.
+//! its optional diffuse Fresnel boundary model. [`aov`] records what the
+//! passes (light paths, light groups, data, ID coverage) measure.
 
+pub mod aov;
 pub mod diffuse_boundary;
 pub mod interaction;
 pub mod path;
@@ -94,18 +96,22 @@ pub enum IntegratorKind {
 }
 
 impl IntegratorKind {
-    /// One sample of the radiance along `ray` with this estimator.
-    pub fn radiance(
+    /// One sample of the radiance along `ray` with this estimator; its
+    /// parts go to `rec` ([`aov`]).
+    pub fn radiance<R: aov::Recorder>(
         self,
         ctx: &Context,
         ray: crate::geometry::Ray,
         rng: &mut crate::sampling::SampleRng,
         scratch: &mut path::Scratch,
         counters: &mut Counters,
+        rec: &mut R,
     ) -> crate::geometry::Vec3 {
         match self {
-            IntegratorKind::Path => path::radiance(ctx, ray, rng, scratch, counters),
-            IntegratorKind::RandomWalk => randomwalk::radiance(ctx, ray, rng, scratch, counters),
+            IntegratorKind::Path => path::radiance(ctx, ray, rng, scratch, counters, rec),
+            IntegratorKind::RandomWalk => {
+                randomwalk::radiance(ctx, ray, rng, scratch, counters, rec)
+            }
         }
     }
 }

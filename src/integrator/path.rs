@@ -29,11 +29,13 @@
 //! Light sampling already finds the highlight there, and splitting the
 //! rough coat measured worse per unit time (see `COAT_SPLIT_DEPTH`).
 
+use super::aov::{self, Event, Recorder, Source};
 use super::interaction::offset_along;
 use super::probe::{exit_curvature, sample_entry, ProbeTarget};
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
 use crate::bssrdf::ProbeRandoms;
+use crate::film::passes::Pass;
 use crate::fresnel;
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::materials::microfacet::RoughCoat;
@@ -85,6 +87,14 @@ pub(crate) enum Lobe<'a> {
 }
 
 impl Lobe<'_> {
+    /// The light-path class of scattering by this lobe ([`aov`]).
+    fn event(&self) -> Event {
+        match self {
+            Lobe::Diffuse(_) => Event::Diffuse,
+            Lobe::SubsurfaceEntry(_) | Lobe::WalkExit(_) => Event::Subsurface,
+            Lobe::Coat { .. } => Event::Specular,
+        }
+    }
     /// f(ωo, ωi) per steradian (ωo, ωi local; z > 0 is the lit side).
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
@@ -132,12 +142,13 @@ pub(crate) struct Vertex<'a> {
 
 /// What a subsurface hit turns into: a vertex that scatters light with a
 /// lobe (next-event estimation, then lobe sampling), a ray that continues
-/// without one (a specular bounce, or leaving a medium), or the end of the
+/// without one (a specular bounce, or leaving a medium; with the class of
+/// that event for the light-path passes, [`aov`]), or the end of the
 /// path. Both integrators share one bounce loop, [`trace`], and differ only
 /// in how they produce this.
 pub(crate) enum Scatter<'a> {
     Vertex(Vertex<'a>),
-    Continue(Ray),
+    Continue(Ray, Event),
     Absorbed,
     /// A subsurface hit under a coat ([`subsurface_probe`]).
     Coated(Coated<'a>),
@@ -164,13 +175,15 @@ pub(crate) struct Coated<'a> {
 pub(crate) type Reflected = (Ray, Vec3, Option<(Vec3, f32)>);
 
 /// A path to trace: its ray, throughput, the last non-specular vertex and
-/// its lobe pdf (for the emission MIS weight), and its depth.
+/// its lobe pdf (for the emission MIS weight), its depth, and the class of
+/// its first event (for the light-path passes).
 #[derive(Clone, Copy)]
 struct Branch {
     ray: Ray,
     beta: Vec3,
     prev: Option<(Vec3, f32)>,
     depth: u32,
+    event: Event,
 }
 
 /// A fixed-capacity stack of [`Branch`]es (no allocation per sample).
@@ -200,19 +213,22 @@ impl Branches {
 }
 
 /// The radiance arriving along `camera_ray`: one sample of L, with the
-/// BSSRDF estimated by one probe ray per subsurface hit.
-pub fn radiance(
+/// BSSRDF estimated by one probe ray per subsurface hit; its parts go to
+/// `rec` ([`aov`]).
+pub fn radiance<R: Recorder>(
     ctx: &Context,
     camera_ray: Ray,
     rng: &mut SampleRng,
     scratch: &mut Scratch,
     counters: &mut Counters,
+    rec: &mut R,
 ) -> Vec3 {
     trace_at(
         ctx,
         camera_ray,
         rng,
         counters,
+        rec,
         |ss, si, wo, beta, rng, counters, depth| {
             subsurface_probe(ctx, ss, si, wo, beta, rng, scratch, counters, depth)
         },
@@ -221,11 +237,12 @@ pub fn radiance(
 
 /// The bounce loop both integrators share; `subsurface` handles hits on
 /// subsurface objects (and may scale the throughput `beta`).
-pub(crate) fn trace<'s>(
+pub(crate) fn trace<'s, R: Recorder>(
     ctx: &'s Context,
     camera_ray: Ray,
     rng: &mut SampleRng,
     counters: &mut Counters,
+    rec: &mut R,
     mut subsurface: impl FnMut(
         &'s Subsurface,
         &Interaction,
@@ -240,16 +257,18 @@ pub(crate) fn trace<'s>(
         camera_ray,
         rng,
         counters,
+        rec,
         |ss, si, wo, beta, rng, counters, _depth| subsurface(ss, si, wo, beta, rng, counters),
     )
 }
 
 /// [`trace`] whose `subsurface` also receives the depth of the hit.
-fn trace_at<'s>(
+fn trace_at<'s, R: Recorder>(
     ctx: &'s Context,
     camera_ray: Ray,
     rng: &mut SampleRng,
     counters: &mut Counters,
+    rec: &mut R,
     mut subsurface: impl FnMut(
         &'s Subsurface,
         &Interaction,
@@ -267,10 +286,12 @@ fn trace_at<'s>(
         beta: Vec3::ONE,
         prev: None,
         depth: 0,
+        // Set at the first hit.
+        event: Event::Diffuse,
     });
     let mut l = Vec3::ZERO;
     while let Some(start) = first.take().or_else(|| stack.pop()) {
-        l += follow(ctx, start, rng, counters, &mut subsurface, &mut stack);
+        l += follow(ctx, start, rng, counters, rec, &mut subsurface, &mut stack);
     }
     l
 }
@@ -278,11 +299,12 @@ fn trace_at<'s>(
 /// One path from `start` until it ends; paths split off on the way are
 /// pushed on `stack`.
 #[inline(always)]
-fn follow<'s>(
+fn follow<'s, R: Recorder>(
     ctx: &'s Context,
     start: Branch,
     rng: &mut SampleRng,
     counters: &mut Counters,
+    rec: &mut R,
     subsurface: &mut impl FnMut(
         &'s Subsurface,
         &Interaction,
@@ -304,23 +326,34 @@ fn follow<'s>(
     // lobe sampled the current ray; None after the camera or a specular
     // bounce, where no light sample competed for this direction.
     let mut prev: Option<(Vec3, f32)> = start.prev;
+    // The class of the path's first event, known after its first hit.
+    let mut event = start.event;
 
     let max_depth = scene.settings.max_depth;
     for depth in start.depth..=max_depth {
         counters.rays += 1;
         let Some(hit) = ctx.accel.intersect(&ray, 0.0, f32::INFINITY) else {
             if ctx.plan.environment {
-                l += beta * scene.environment.unwrap_or(Vec3::ZERO);
+                let c = beta * scene.environment.unwrap_or(Vec3::ZERO);
+                l += c;
+                let path = aov::found(event, depth, Pass::Background);
+                rec.light(c, path, Source::Environment);
             }
             break;
         };
         let object = &scene.objects[hit.geom as usize];
         let si = ctx.interaction(&ray, &hit);
         let wo = -ray.d;
+        if R::ON && depth == 0 {
+            rec.camera_hit(hit.geom, si.p);
+        }
 
         // Le, MIS-weighted against next-event estimation.
         if let (Some(le), true) = (object.emission, si.front) {
-            l += beta * le * emission_weight(ctx, &si, wo, prev);
+            let c = beta * le * emission_weight(ctx, &si, wo, prev);
+            l += c;
+            let path = aov::found(event, depth, Pass::Emission);
+            rec.light(c, path, Source::Object(hit.geom));
         }
         if depth == max_depth {
             break;
@@ -329,6 +362,7 @@ fn follow<'s>(
         let scatter = match &scene.materials[object.material] {
             Material::Diffuse { albedo } => {
                 let frame = si.shading_frame_facing(wo);
+                rec.surface(*albedo, frame.n);
                 let ng = if wo.dot(si.ng) >= 0.0 { si.ng } else { -si.ng };
                 Scatter::Vertex(Vertex {
                     p: si.p,
@@ -339,14 +373,32 @@ fn follow<'s>(
                 })
             }
             Material::Dielectric { eta } => {
-                Scatter::Continue(dielectric_bounce(ctx, *eta, &si, wo, &mut beta, rng))
+                let (next, e) = dielectric_bounce(ctx, *eta, &si, wo, &mut beta, rng);
+                Scatter::Continue(next, e)
             }
-            Material::Subsurface(ss) => subsurface(ss, &si, wo, &mut beta, rng, counters, depth),
+            Material::Subsurface(ss) => {
+                if R::ON {
+                    rec.surface(ss.albedo(), si.shading_frame_facing(wo).n);
+                }
+                subsurface(ss, &si, wo, &mut beta, rng, counters, depth)
+            }
         };
         // Borrowed, not moved out: the vertex stays where it was built.
+        // At the first hit the path's class becomes that of what scattered;
+        // the coat's reflections are specular.
+        let first = R::ON && depth == 0;
+        let coat_event = if first { Event::Specular } else { event };
         let vertex = match &scatter {
-            Scatter::Vertex(v) => v,
-            Scatter::Continue(next) => {
+            Scatter::Vertex(v) => {
+                if first {
+                    event = v.lobe.event();
+                }
+                v
+            }
+            Scatter::Continue(next, e) => {
+                if first {
+                    event = *e;
+                }
                 prev = None;
                 ray = *next;
                 if !roulette(depth, &mut beta, rng) {
@@ -357,7 +409,10 @@ fn follow<'s>(
             Scatter::Absorbed => break,
             Scatter::Coated(c) => {
                 if let (Some((v, b)), true) = (&c.coat, ctx.plan.area_lights) {
-                    l += *b * direct_lighting(ctx, v, rng, counters);
+                    let (d, light) = direct_lighting(ctx, v, rng, counters);
+                    let c = *b * d;
+                    l += c;
+                    rec.light(c, aov::sampled(coat_event, depth), Source::Light(light));
                 }
                 let (next, follow_reflected) = match (&c.entry, c.reflected) {
                     (Some(v), Some((r, mut b, p))) => {
@@ -370,6 +425,7 @@ fn follow<'s>(
                             beta: b,
                             prev: p,
                             depth: depth + 1,
+                            event: coat_event,
                         });
                         match branch.map(|br| stack.push(br)) {
                             Some(false) if rng.uniform() < 0.5 => (None, Some((r, 2.0 * b, p))),
@@ -384,9 +440,14 @@ fn follow<'s>(
                     (None, reflected) => (None, reflected),
                 };
                 match (next, follow_reflected) {
-                    (Some(v), _) => v,
+                    (Some(v), _) => {
+                        if first {
+                            event = v.lobe.event();
+                        }
+                        v
+                    }
                     (None, Some((r, b, p))) => {
-                        (ray, beta, prev) = (r, b, p);
+                        (ray, beta, prev, event) = (r, b, p, coat_event);
                         if !roulette(depth, &mut beta, rng) {
                             break;
                         }
@@ -399,7 +460,10 @@ fn follow<'s>(
 
         // Next-event estimation, then continue by sampling the lobe.
         if ctx.plan.area_lights {
-            l += beta * direct_lighting(ctx, vertex, rng, counters);
+            let (d, light) = direct_lighting(ctx, vertex, rng, counters);
+            let c = beta * d;
+            l += c;
+            rec.light(c, aov::sampled(event, depth), Source::Light(light));
         }
         let Some((wi_local, weight, pdf)) =
             vertex.lobe.sample(vertex.wo_local, rng.uniform2_packed())
@@ -422,7 +486,7 @@ fn follow<'s>(
     l
 }
 
-/// A specular bounce off or through a dielectric.
+/// A specular bounce off or through a dielectric, and which it was.
 // Out of line, as are the probe step and the emission weight: a measured
 // gain, see `crate::kernels`.
 #[inline(never)]
@@ -433,11 +497,16 @@ fn dielectric_bounce(
     wo: Vec3,
     beta: &mut Vec3,
     rng: &mut SampleRng,
-) -> Ray {
+) -> (Ray, Event) {
     let frame = Frame::from_normal(si.ng);
     let s = dielectric::sample(eta, frame.to_local(wo), rng.uniform());
     *beta *= s.weight;
-    si.spawn(frame.to_world(s.wi), ctx.ray_epsilon)
+    let e = if s.transmitted {
+        Event::Transmission
+    } else {
+        Event::Specular
+    };
+    (si.spawn(frame.to_world(s.wi), ctx.ray_epsilon), e)
 }
 
 /// A subsurface hit at xo under the diffusion model: the coat at xo, then
@@ -485,7 +554,7 @@ fn subsurface_probe<'s>(
             });
         } else if rng.uniform() < fr {
             // Specular reflection with probability Fr: weight 1.
-            return Scatter::Continue(mirror(ctx, si, wo, n_out));
+            return Scatter::Continue(mirror(ctx, si, wo, n_out), Event::Specular);
         }
         return match probe_entry(ctx, ss, si, wo, beta, rng, scratch, counters) {
             Some(v) => Scatter::Vertex(v),
@@ -641,31 +710,34 @@ fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3
 }
 
 /// Next-event estimation at a vertex: one light sample, weighted by the
-/// power heuristic against lobe sampling of the same direction.
+/// power heuristic against lobe sampling of the same direction; and the
+/// light triangle it sampled ([`aov::NO_LIGHT`] when none). (A plain index,
+/// not a [`Source`]: the pair then still fits in two registers.)
 fn direct_lighting(
     ctx: &Context,
     v: &Vertex,
     rng: &mut SampleRng,
     counters: &mut Counters,
-) -> Vec3 {
+) -> (Vec3, u32) {
     let [u_pick, u0, u1] = rng.uniform3();
     let Some(ls) = ctx.lights.sample(u_pick, [u0, u1]) else {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, aov::NO_LIGHT);
     };
+    let source = ls.index;
     let to_light = ls.point - v.p;
     let dist2 = to_light.length_squared();
     if dist2 <= 0.0 {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, source);
     }
     let wi = to_light / dist2.sqrt();
     let cos_l = -wi.dot(ls.normal);
     if cos_l <= 0.0 || wi.dot(v.ng) <= 0.0 {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, source);
     }
     let wi_local = v.frame.to_local(wi);
     let f = v.lobe.eval(v.wo_local, wi_local);
     if f == Vec3::ZERO {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, source);
     }
     let pdf_light = ls.pdf_area * dist2 / cos_l;
     counters.rays += 1;
@@ -676,8 +748,8 @@ fn direct_lighting(
         .accel
         .occluded(&Ray::new(origin, ls.point - origin), 0.0, 1.0 - 1e-4)
     {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, source);
     }
     let w = power(pdf_light, v.lobe.pdf(v.wo_local, wi_local));
-    f * ls.radiance * (wi_local.z.abs() * w / pdf_light)
+    (f * ls.radiance * (wi_local.z.abs() * w / pdf_light), source)
 }

@@ -55,6 +55,7 @@
 //! around it, so the walk ends there with zero radiance (counted in
 //! [`Counters::walks_escaped`]) instead of scattering through infinite space.
 
+use super::aov::{Event, Recorder};
 use super::diffuse_boundary::DiffuseBoundary;
 use super::interaction::offset_along;
 use super::path::{trace, Lobe, Scatter, Scratch, Vertex};
@@ -78,18 +79,20 @@ const WALK_RR_START: u32 = 16;
 /// subsurface objects simulated as media. Same contract as
 /// [`super::path::radiance`], and the same bounce loop (`trace`); only
 /// subsurface hits differ.
-pub fn radiance(
+pub fn radiance<R: Recorder>(
     ctx: &Context,
     camera_ray: Ray,
     rng: &mut SampleRng,
     _scratch: &mut Scratch,
     counters: &mut Counters,
+    rec: &mut R,
 ) -> Vec3 {
     trace(
         ctx,
         camera_ray,
         rng,
         counters,
+        rec,
         |ss, si, wo, beta, rng, counters| {
             // Parameters built by hand without a medium leave nothing to
             // simulate; the path ends as at a black surface.
@@ -106,14 +109,14 @@ pub fn radiance(
                     *beta *= s.weight;
                     let wi = frame.to_world(s.wi).normalize();
                     if !s.transmitted {
-                        return Scatter::Continue(si.spawn(wi, ctx.ray_epsilon));
+                        return Scatter::Continue(si.spawn(wi, ctx.ray_epsilon), Event::Specular);
                     }
                     let inside = si.spawn(wi, ctx.ray_epsilon);
                     let law = Boundary::Dielectric(ss.eta());
                     match walk(ctx, &medium, law, inside, rng, counters) {
                         Some((WalkEnd::Refracted(exit), w)) => {
                             *beta *= w;
-                            Scatter::Continue(exit)
+                            Scatter::Continue(exit, Event::Subsurface)
                         }
                         _ => Scatter::Absorbed,
                     }
@@ -159,7 +162,7 @@ fn diffuse_hit<'s>(
     let mu = wo.dot(n_out).max(0.0);
     let Some((w_in, weight)) = b.enter(mu, rng) else {
         let wi = (2.0 * mu) * n_out - wo;
-        return Scatter::Continue(si.spawn(wi, ctx.ray_epsilon));
+        return Scatter::Continue(si.spawn(wi, ctx.ray_epsilon), Event::Specular);
     };
     *beta *= weight;
     let inward = Frame::from_normal(-n_out).to_world(w_in).normalize();
@@ -185,7 +188,7 @@ fn diffuse_hit<'s>(
         Some((wi, w, _)) => {
             *beta *= w;
             let origin = offset_along(p, n_out, ctx.ray_epsilon);
-            Scatter::Continue(Ray::new(origin, frame.to_world(wi)))
+            Scatter::Continue(Ray::new(origin, frame.to_world(wi)), Event::Subsurface)
         }
         None => Scatter::Absorbed,
     }

@@ -76,6 +76,7 @@ pub struct SceneFile {
     #[serde(default)]
     pub shapes: Vec<Spanned<ShapeDef>>,
     pub environment: Option<Spanned<EnvironmentDef>>,
+    pub output: Option<Spanned<OutputDef>>,
 }
 
 /// `[camera]`.
@@ -108,6 +109,16 @@ pub struct RenderDef {
 pub struct EnvironmentDef {
     /// Required.
     pub radiance: Option<Spanned<Triple3>>,
+    /// The light group of the environment's light (`RGBA_<group>` pass).
+    pub light_group: Option<Spanned<String>>,
+}
+
+/// `[output]`: what the render writes besides the beauty.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputDef {
+    /// Pass names (`crate::film::passes`), as `--aov` takes them.
+    pub aovs: Option<Vec<Spanned<String>>>,
 }
 
 /// The `type` of a `[materials.NAME]` table.
@@ -241,6 +252,8 @@ pub struct ShapeDef {
     /// The material's name. Required.
     pub material: Option<Spanned<String>>,
     pub emission: Option<Spanned<Triple3>>,
+    /// The light group of an emitter (`RGBA_<group>` pass).
+    pub light_group: Option<Spanned<String>>,
     pub scale: Option<Spanned<Scale>>,
     pub rotate: Option<Vec<Spanned<Rotation>>>,
     pub translate: Option<Spanned<Triple3>>,

@@ -17,6 +17,7 @@ use super::checked::{Cx, Res};
 use super::format::{CameraDef, RenderDef, SceneFile, Spanned};
 use super::material::material;
 use super::objects::{generated_triangles, object};
+use super::output::output;
 pub use super::regular_file::read_regular_file;
 use super::regular_file::{read_regular_bytes, utf8_text};
 use super::{show_point, Camera, RenderSettings, Scene, MAX_COORDINATE};
@@ -145,6 +146,8 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         None => None,
     };
 
+    let output = output(cx, &def, &objects)?;
+
     Ok(Scene {
         camera,
         settings,
@@ -154,6 +157,7 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         environment,
         units_per_mm,
         source: Some(cx.file.to_path_buf()),
+        output,
     })
 }
 

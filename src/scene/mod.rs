@@ -11,6 +11,7 @@ pub mod load;
 mod material;
 pub mod obj;
 mod objects;
+mod output;
 mod regular_file;
 pub mod shapes;
 pub mod transform;
@@ -20,6 +21,7 @@ use std::sync::Arc;
 
 pub use camera::Camera;
 pub use load::{load, load_str};
+pub use output::{Output, DEFAULT_GROUP};
 
 use crate::geometry::{Mesh, Vec3};
 use crate::materials::Material;
@@ -92,6 +94,8 @@ pub struct Scene {
     pub units_per_mm: f32,
     /// Where the scene came from, for messages and caches.
     pub source: Option<PathBuf>,
+    /// Its passes, light groups and material names.
+    pub output: Output,
 }
 
 impl Scene {
