@@ -2,7 +2,9 @@
 # Installs what lucent needs on Debian 12 and skips what is already there:
 # Embree 3 (Debian's libembree-dev, the production ray-query backend),
 # pkg-config (to find it), a C compiler (for the FFI layout test) and the
-# DejaVu Sans font (text in `lucent study` plots, read by path).
+# DejaVu Sans font (text in `lucent study` plots, read by path) and
+# OpenImageIO's tools (`oiiotool`, `iinfo`: tests/exr_oiio.rs reads the EXR
+# files back with them).
 # Safe to run any number of times.
 set -euo pipefail
 
@@ -11,6 +13,7 @@ dpkg -s libembree-dev >/dev/null 2>&1 || need+=(libembree-dev)
 command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
 command -v cc >/dev/null 2>&1 || need+=(gcc libc6-dev)
 [ -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || need+=(fonts-dejavu-core)
+command -v oiiotool >/dev/null 2>&1 || need+=(openimageio-tools)
 
 if ((${#need[@]})); then
   sudo=""

@@ -67,6 +67,7 @@ fn slab_scene(material: Material, side: f32, thickness: f32, theta_deg: f32, spp
         environment: Some(Vec3::ONE),
         units_per_mm: 1.0,
         source: None,
+        output: Default::default(),
     }
 }
 

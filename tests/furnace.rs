@@ -39,6 +39,7 @@ fn scene_with(
         environment: env,
         units_per_mm: 1.0,
         source: None,
+        output: Default::default(),
     }
 }
 

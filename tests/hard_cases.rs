@@ -111,6 +111,7 @@ fn scene(
         environment: Some(Vec3::ONE),
         units_per_mm: 1.0,
         source: None,
+        output: Default::default(),
     }
 }
 

@@ -77,6 +77,7 @@ fn scene(parts: Vec<Part>, env: Option<Vec3>, camera: Camera, spp: u32, max_dept
         environment: env,
         units_per_mm: 1.0,
         source: None,
+        output: Default::default(),
     }
 }
 

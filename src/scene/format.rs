@@ -76,6 +76,8 @@ pub struct SceneFile {
     #[serde(default)]
     pub shapes: Vec<Spanned<ShapeDef>>,
     pub environment: Option<Spanned<EnvironmentDef>>,
+    #[serde(default)]
+    pub output: OutputDef,
 }
 
 /// `[camera]`.
@@ -100,6 +102,21 @@ pub struct RenderDef {
     pub spp: Option<Spanned<u32>>,
     pub max_depth: Option<Spanned<u32>>,
     pub seed: Option<u64>,
+}
+
+/// `[output]`: how the frame is stored; every key is optional (the
+/// CLI's options override them).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputDef {
+    /// `"half"` or `"float"`: light passes' precision.
+    pub aov_precision: Option<Spanned<String>>,
+    /// A lossless EXR compression name.
+    pub exr_compression: Option<Spanned<String>>,
+    /// One file per pass.
+    pub aov_split: Option<bool>,
+    /// Cryptomatte ranks per pixel.
+    pub cryptomatte_ranks: Option<Spanned<u32>>,
 }
 
 /// `[environment]`.

@@ -85,6 +85,7 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
     };
     let camera = camera(cx, c)?;
     let settings = settings(cx, &def.render)?;
+    let output = super::output::output(cx, &def.output)?;
 
     // Materials: indexed in name order (the map is sorted), so the same file
     // always gives the same indices.
@@ -154,6 +155,7 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         environment,
         units_per_mm,
         source: Some(cx.file.to_path_buf()),
+        output,
     })
 }
 

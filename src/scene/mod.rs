@@ -11,6 +11,7 @@ pub mod load;
 mod material;
 pub mod obj;
 mod objects;
+pub mod output;
 mod regular_file;
 pub mod shapes;
 pub mod transform;
@@ -20,6 +21,7 @@ use std::sync::Arc;
 
 pub use camera::Camera;
 pub use load::{load, load_str};
+pub use output::OutputSettings;
 
 use crate::geometry::{Mesh, Vec3};
 use crate::materials::Material;
@@ -92,6 +94,8 @@ pub struct Scene {
     pub units_per_mm: f32,
     /// Where the scene came from, for messages and caches.
     pub source: Option<PathBuf>,
+    /// `[output]`: how the frame is stored (the CLI's options override it).
+    pub output: OutputSettings,
 }
 
 impl Scene {
