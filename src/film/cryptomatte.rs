@@ -338,6 +338,13 @@ mod tests {
         assert_eq!(encode(&cov, 1, 3).unwrap().channels.len(), 8);
         assert!(encode(&cov, 1, 0).is_err());
         assert!(encode(&cov, 2, 6).is_err());
+        // a tie ranks the same whatever order the things were listed in
+        let tie = coverage(
+            &["a", "c"],
+            vec![vec![(0, 0.5), (1, 0.5)], vec![(1, 0.5), (0, 0.5)]],
+        );
+        let e = encode(&tie, 2, 2).unwrap();
+        assert_eq!(ranks_of(&e, 0), ranks_of(&e, 1));
         let bad = coverage(&["x"], vec![vec![(1, 1.0)]]);
         assert!(encode(&bad, 1, 6).is_err());
     }
