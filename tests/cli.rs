@@ -154,6 +154,28 @@ fn bad_arguments_exit_2_without_output() {
             "--rmax-quantile".into(),
             "1".into(),
         ],
+        // the file options: out of range, lossy, unknown
+        vec![
+            scene("cornell.toml"),
+            "-o".into(),
+            exr.to_str().unwrap().into(),
+            "--cryptomatte-ranks".into(),
+            "0".into(),
+        ],
+        vec![
+            scene("cornell.toml"),
+            "-o".into(),
+            exr.to_str().unwrap().into(),
+            "--exr-compression".into(),
+            "b44".into(),
+        ],
+        vec![
+            scene("cornell.toml"),
+            "-o".into(),
+            exr.to_str().unwrap().into(),
+            "--aov-precision".into(),
+            "double".into(),
+        ],
     ] {
         let out = lucent().arg("render").args(&args).output().unwrap();
         assert_eq!(
