@@ -20,7 +20,7 @@
 //! - **Deterministic bytes:** blocks are compressed and written
 //!   sequentially in increasing line order (the exr crate's parallel
 //!   writer emits them in the order they finish), and the header's
-//!   attributes are sorted by name after writing (the exr crate writes
+//!   attributes are sorted by name in the written file (the exr crate writes
 //!   them in hash-map order, different in every process; OpenEXR itself
 //!   keeps them sorted). Sorting keeps the header's length, so the offset
 //!   table stays valid. Same inputs → the same bytes, except that the
@@ -196,7 +196,7 @@ pub fn stage_frame(
     let attributes = header.attributes(film.width, film.height);
     let mut files: Vec<File> = vec![File {
         path: path.to_path_buf(),
-        planes: beauty_planes(film),
+        planes: beauty_planes(film)?,
         attributes: attributes.clone(),
     }];
     let mut add = |name: &str, planes: Vec<Plane>, extra: Vec<(String, AttributeValue)>| {
@@ -259,10 +259,6 @@ struct File {
 
 impl File {
     fn stage(self, width: u32, height: u32, compression: ExrCompression) -> Result<Staged, Error> {
-        let write_err = |problem: String| Error::Write {
-            path: self.path.clone(),
-            problem,
-        };
         let mut other = std::collections::HashMap::new();
         let mut software = None;
         for (name, value) in self.attributes {
@@ -296,31 +292,66 @@ impl File {
             AnyChannels::sort(channels),
         );
         let image = Image::from_layer(layer);
-        let mut bytes = Vec::new();
-        image
-            .write()
-            .non_parallel()
-            .to_buffered(std::io::Cursor::new(&mut bytes))
-            .map_err(|e| write_err(e.to_string()))?;
-        sort_header_attributes(&mut bytes).map_err(write_err)?;
         Staged::write(&self.path, |tmp| {
-            std::fs::write(tmp, &bytes).map_err(|e| e.to_string())
+            image
+                .write()
+                .non_parallel()
+                .to_file(tmp)
+                .map_err(|e| e.to_string())?;
+            sort_header_in_file(tmp)
         })
     }
 }
 
-/// Beauty: `R`, `G`, `B` from the film, `A` = 1, 32-bit float.
-fn beauty_planes(film: &Film) -> Vec<Plane> {
-    let plane = |name: &str, f: fn(&crate::geometry::Vec3) -> f32| Plane {
-        name: name.into(),
-        samples: FlatSamples::F32(film.pixels.iter().map(f).collect()),
+/// [`sort_header_attributes`] on the file at `path`, reading only its
+/// header (the first 64 kB, more if the header is longer), so the pixels
+/// are never held in memory twice.
+fn sort_header_in_file(path: &Path) -> Result<(), String> {
+    use std::io::{Read, Seek, SeekFrom, Write};
+    let io = |e: std::io::Error| e.to_string();
+    let mut f = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(path)
+        .map_err(io)?;
+    let len = f.metadata().map_err(io)?.len() as usize;
+    let mut n = len.min(1 << 16);
+    loop {
+        let mut head = vec![0u8; n];
+        f.seek(SeekFrom::Start(0)).map_err(io)?;
+        f.read_exact(&mut head).map_err(io)?;
+        match sort_header_attributes(&mut head) {
+            Ok(end) => {
+                f.seek(SeekFrom::Start(0)).map_err(io)?;
+                return f.write_all(&head[..end]).map_err(io);
+            }
+            Err(_) if n < len => n = (2 * n).min(len),
+            Err(e) => return Err(e),
+        }
+    }
+}
+
+/// Beauty: `R`, `G`, `B` from the film, `A` = 1, 32-bit float (16 bytes a
+/// pixel beside the film's 12; failing with a message, not aborting, when
+/// that cannot be allocated).
+fn beauty_planes(film: &Film) -> Result<Vec<Plane>, Error> {
+    let n = film.pixels.len();
+    let plane = |name: &str, f: fn(&crate::geometry::Vec3) -> f32| {
+        let mut v = Vec::new();
+        v.try_reserve_exact(n)
+            .map_err(|_| super::out_of_memory("the EXR's beauty channels", n.saturating_mul(16)))?;
+        v.extend(film.pixels.iter().map(f));
+        Ok::<_, Error>(Plane {
+            name: name.into(),
+            samples: FlatSamples::F32(v),
+        })
     };
-    vec![
-        plane("R", |p| p.x),
-        plane("G", |p| p.y),
-        plane("B", |p| p.z),
-        plane("A", |_| 1.0),
-    ]
+    Ok(vec![
+        plane("R", |p| p.x)?,
+        plane("G", |p| p.y)?,
+        plane("B", |p| p.z)?,
+        plane("A", |_| 1.0)?,
+    ])
 }
 
 /// A pass's channels `layer.channel`, half only for light passes at half
@@ -393,8 +424,9 @@ fn check_layers(layers: &[Layer], coverage: &[Coverage], pixels: usize) -> Resul
 /// Sorts the attributes of a single-part OpenEXR file's header by name, in
 /// place. Each attribute is `name\0 type\0 size:i32 value[size]`, the list
 /// ends with an empty name; the header's length, hence the offset table
-/// after it, is unchanged.
-fn sort_header_attributes(bytes: &mut [u8]) -> Result<(), String> {
+/// after it, is unchanged. Returns where the attribute list ends (the
+/// bytes before it are all this changes); fails on a list cut short.
+fn sort_header_attributes(bytes: &mut [u8]) -> Result<usize, String> {
     let malformed = || "malformed EXR header".to_string();
     if bytes.len() < 8 || bytes[..4] != [0x76, 0x2f, 0x31, 0x01] {
         return Err(malformed());
@@ -437,7 +469,7 @@ fn sort_header_attributes(bytes: &mut [u8]) -> Result<(), String> {
         sorted.extend_from_slice(&bytes[start..end]);
     }
     bytes[8..at].copy_from_slice(&sorted);
-    Ok(())
+    Ok(at)
 }
 
 /// The header attributes of a file, for tests and tools: (name, value).
@@ -673,6 +705,28 @@ mod tests {
         assert_eq!(Film::read_exr(&p).unwrap(), film());
         assert!(sort_header_attributes(&mut bytes[..20].to_vec()).is_err());
         assert!(sort_header_attributes(&mut b"not an exr".to_vec()).is_err());
+    }
+
+    #[test]
+    fn a_header_longer_than_the_first_read_is_sorted_too() {
+        // a manifest of 4000 names: a header of about 100 kB
+        let mut c = coverage();
+        c[0].names = (0..4000).map(|i| format!("object_number_{i}")).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.exr"), dir.path().join("b.exr"));
+        for p in [&a, &b] {
+            write_frame(p, &film(), &[], &c, &header(), &OutputOptions::default()).unwrap();
+        }
+        let bytes = std::fs::read(&a).unwrap();
+        assert!(bytes.len() > 100_000);
+        assert_eq!(bytes, std::fs::read(&b).unwrap());
+        let key = cryptomatte::metadata_key("CryptoObject");
+        let m = text_attribute(
+            &read_attributes(&a).unwrap(),
+            &format!("cryptomatte/{key}/manifest"),
+        );
+        assert_eq!(m, Some(cryptomatte::manifest(&c[0].names)));
+        assert_eq!(Film::read_exr(&a).unwrap(), film());
     }
 
     #[test]
