@@ -407,7 +407,14 @@ fn run_render(
     let accel = accel::build(&scene.meshes, backend)?;
     stop_if_interrupted()?;
     let (film, stats) = render::render(&scene, accel.as_ref(), opts)?;
-    let header = frame_header(scene_path, &scene, backend, opts, stats.seconds)?;
+    let header = frame_header(
+        scene_path,
+        &scene,
+        accel.name(),
+        backend,
+        opts,
+        stats.seconds,
+    )?;
     let mut out = file.over(scene.output.over(OutputOptions::default()));
     out.preview = Some(preview);
     exr_layers::write_frame(output, &film, &[], &[], &header, &out)?;
@@ -433,6 +440,7 @@ fn run_render(
 fn frame_header(
     scene_path: &Path,
     scene: &scene::Scene,
+    accel_name: &str,
     backend: Backend,
     opts: &RenderOptions,
     seconds: f64,
@@ -470,7 +478,7 @@ fn frame_header(
         spp: Some(opts.spp.unwrap_or(scene.settings.spp)),
         seed: Some(opts.seed.unwrap_or(scene.settings.seed)),
         max_depth: Some(scene.settings.max_depth),
-        backend: Some(backend.name().into()),
+        backend: Some(accel_name.into()),
         backend_version: Some(backend_version(backend)),
         integrator: Some(
             match opts.integrator {
