@@ -2,11 +2,12 @@
 # Installs what lucent needs on Debian 12 and skips what is already there:
 # Embree 3 (Debian's libembree-dev, the production ray-query backend),
 # pkg-config (to find it), a C compiler (for the FFI layout test), the
-# DejaVu Sans font (text in `lucent study` plots, read by path), and an
-# Embree 4 for the tests of the `embree4` backend (Debian 12 has none: the
-# 4.4.0 library and the TBB it needs, from the `embreex` wheel on PyPI,
-# unpacked into .cache/embree4/, which scripts/test.sh points
-# LUCENT_EMBREE4 at). Safe to run any number of times.
+# DejaVu Sans font (text in `lucent study` plots, read by path),
+# OpenImageIO's tools (`oiiotool`, `iinfo`: tests/exr_oiio.rs reads the EXR
+# files back with them), and an Embree 4 for the tests of the `embree4`
+# backend (Debian 12 has none: the 4.4.0 library and the TBB it needs, from
+# the `embreex` wheel on PyPI, unpacked into .cache/embree4/, which
+# scripts/test.sh points LUCENT_EMBREE4 at). Safe to run any number of times.
 set -euo pipefail
 
 need=()
@@ -14,6 +15,7 @@ dpkg -s libembree-dev >/dev/null 2>&1 || need+=(libembree-dev)
 command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
 command -v cc >/dev/null 2>&1 || need+=(gcc libc6-dev)
 [ -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || need+=(fonts-dejavu-core)
+command -v oiiotool >/dev/null 2>&1 || need+=(openimageio-tools)
 
 if ((${#need[@]})); then
   sudo=""

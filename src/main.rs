@@ -10,6 +10,10 @@ use clap::{Parser, Subcommand, ValueEnum};
 use lucent::accel::{self, Backend};
 use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
 use lucent::error::{Param, ParamError};
+use lucent::film::cryptomatte;
+use lucent::film::exr_layers::{
+    self, ExrCompression, FrameHeader, OutputOptions, Precision, Preview,
+};
 use lucent::film::passes::PassSet;
 use lucent::film::ToneMap;
 use lucent::integrator::IntegratorKind;
@@ -102,6 +106,8 @@ enum Command {
         aov: Option<PassSet>,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
+        #[command(flatten)]
+        file: FileArgs,
     },
     /// Benchmark the ray-query backends on the same meshes and rays: build
     /// time and memory, Mrays/s of camera, incoherent, shadow and probe
@@ -150,6 +156,71 @@ struct SubsurfaceArgs {
     /// Fresnel transmission with light sampling at the exit; another model).
     #[arg(long, value_enum)]
     boundary: Option<BoundaryArg>,
+}
+
+/// How the EXR is stored (docs/output.md); each overrides the scene's
+/// `[output]` key of the same name.
+#[derive(clap::Args)]
+struct FileArgs {
+    /// Precision of light passes: half | float (data passes, IDs and beauty
+    /// are always float).
+    #[arg(long, value_enum)]
+    aov_precision: Option<PrecisionArg>,
+    /// Lossless EXR compression: none | rle | zips | zip (default) | piz.
+    #[arg(long, value_enum)]
+    exr_compression: Option<CompressionArg>,
+    /// One file per pass (OUT.PASS.exr beside OUT.exr) instead of one
+    /// multi-layer file.
+    #[arg(long, num_args = 0..=1, default_missing_value = "true")]
+    aov_split: Option<bool>,
+    /// Cryptomatte ranks per pixel, 1 to 64 (default 6).
+    #[arg(long)]
+    cryptomatte_ranks: Option<usize>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PrecisionArg {
+    Half,
+    Float,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum CompressionArg {
+    None,
+    Rle,
+    Zips,
+    Zip,
+    Piz,
+}
+
+impl FileArgs {
+    /// The command line's settings, in the scene's form (they override it).
+    fn settings(&self) -> Result<scene::OutputSettings, Error> {
+        if let Some(n) = self
+            .cryptomatte_ranks
+            .filter(|n| !(1..=cryptomatte::MAX_RANKS).contains(n))
+        {
+            return Err(Error::Argument {
+                argument: "--cryptomatte-ranks".into(),
+                problem: format!("{n} is not in 1 to {}", cryptomatte::MAX_RANKS),
+            });
+        }
+        Ok(scene::OutputSettings {
+            precision: self.aov_precision.map(|p| match p {
+                PrecisionArg::Half => Precision::Half,
+                PrecisionArg::Float => Precision::Float,
+            }),
+            compression: self.exr_compression.map(|c| match c {
+                CompressionArg::None => ExrCompression::None,
+                CompressionArg::Rle => ExrCompression::Rle,
+                CompressionArg::Zips => ExrCompression::Zips,
+                CompressionArg::Zip => ExrCompression::Zip,
+                CompressionArg::Piz => ExrCompression::Piz,
+            }),
+            split: self.aov_split,
+            cryptomatte_ranks: self.cryptomatte_ranks,
+        })
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -224,6 +295,7 @@ fn main() -> ExitCode {
             integrator,
             aov,
             subsurface,
+            file,
         } => {
             let backend = accel
                 .map(Backend::from)
@@ -239,17 +311,19 @@ fn main() -> ExitCode {
                 progress: !quiet,
                 integrator,
             };
-            run_render(
-                &scene,
-                &output,
-                backend,
-                &opts,
-                aov,
-                &subsurface.overrides(),
-                tonemap,
-                exposure,
-                quiet,
-            )
+            file.settings().and_then(|file| {
+                run_render(
+                    &scene,
+                    &output,
+                    backend,
+                    &opts,
+                    aov,
+                    &subsurface.overrides(),
+                    &file,
+                    Preview { tonemap, exposure },
+                    quiet,
+                )
+            })
         }
         Command::Study(args) => run_study(args),
         Command::Bench(args) => run_bench(args),
@@ -312,8 +386,8 @@ fn run_render(
     opts: &RenderOptions,
     aov: Option<PassSet>,
     overrides: &SubsurfaceOverrides,
-    tonemap: ToneMap,
-    exposure: f32,
+    file: &scene::OutputSettings,
+    preview: Preview,
     quiet: bool,
 ) -> Result<(), Error> {
     if output
@@ -363,16 +437,17 @@ fn run_render(
         coverage,
         stats,
     } = render::render_passes(&scene, accel.as_ref(), opts, passes)?;
-    film.write_exr_and_preview(output, tonemap, exposure)?;
-    if !layers.is_empty() || !coverage.is_empty() {
-        // The multi-layer writer takes these at its merge.
-        eprintln!(
-            "warning: {} pass layers and {} coverage sets were computed, but this build \
-             writes the beauty only",
-            layers.len(),
-            coverage.len()
-        );
-    }
+    let header = frame_header(
+        scene_path,
+        &scene,
+        accel.name(),
+        backend,
+        opts,
+        stats.seconds,
+    )?;
+    let mut out = file.over(scene.output.file.over(OutputOptions::default()));
+    out.preview = Some(preview);
+    exr_layers::write_frame(output, &film, &layers, &coverage, &header, &out)?;
     if !quiet {
         eprintln!(
             "{}: {}x{} at {} spp, {} triangles: {}",
@@ -386,6 +461,77 @@ fn run_render(
     }
     report_rejected_rays(accel.as_ref());
     Ok(())
+}
+
+/// What the EXR header records about this render (docs/output.md): the
+/// scene file and its SHA-256, samples, seed, depth, backend and version,
+/// integrator, every subsurface material's sampling options (named by the
+/// objects that use it) and the render time.
+fn frame_header(
+    scene_path: &Path,
+    scene: &scene::Scene,
+    accel_name: &str,
+    backend: Backend,
+    opts: &RenderOptions,
+    seconds: f64,
+) -> Result<FrameHeader, Error> {
+    use sha2::{Digest, Sha256};
+    let text =
+        scene::load::read_regular_file(scene_path, scene::load::MAX_SCENE_BYTES).map_err(|e| {
+            Error::Read {
+                path: scene_path.to_path_buf(),
+                problem: e.to_string(),
+            }
+        })?;
+    let sha: String = Sha256::digest(text.as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let mut sampling = Vec::new();
+    for (i, m) in scene.materials.iter().enumerate() {
+        let lucent::materials::Material::Subsurface(ss) = m else {
+            continue;
+        };
+        let users: Vec<&str> = scene
+            .objects
+            .iter()
+            .filter(|o| o.material == i)
+            .map(|o| o.name.as_str())
+            .collect();
+        if !users.is_empty() {
+            sampling.push((users.join(","), ss.sampling_description()));
+        }
+    }
+    Ok(FrameHeader {
+        scene_path: Some(scene_path.display().to_string()),
+        scene_sha256: Some(sha),
+        spp: Some(opts.spp.unwrap_or(scene.settings.spp)),
+        seed: Some(opts.seed.unwrap_or(scene.settings.seed)),
+        max_depth: Some(scene.settings.max_depth),
+        backend: Some(accel_name.into()),
+        backend_version: Some(backend_version(backend)?),
+        integrator: Some(
+            match opts.integrator {
+                IntegratorKind::Path => "path",
+                IntegratorKind::RandomWalk => "randomwalk",
+            }
+            .into(),
+        ),
+        sampling,
+        render_seconds: Some(seconds),
+    })
+}
+
+/// The backend's version: the Embree in use (the one `backend` resolves
+/// to), or lucent's for its own BVH.
+fn backend_version(backend: Backend) -> Result<String, Error> {
+    Ok(match backend.resolve()? {
+        #[cfg(feature = "embree")]
+        Backend::Embree3 => format!("Embree {}", accel::embree::version()),
+        #[cfg(feature = "embree4")]
+        Backend::Embree4 => format!("Embree {}", accel::embree4::version()?),
+        _ => format!("lucent {}", env!("CARGO_PKG_VERSION")),
+    })
 }
 
 /// `s` with every control character (from a file name, an OBJ line or a

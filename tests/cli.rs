@@ -67,6 +67,19 @@ fn renders_the_cornell_box_end_to_end() {
     assert_eq!(names, ["cornell.exr", "cornell.png"]);
 }
 
+/// The EXR's bytes with the value of its one run-dependent header
+/// attribute, `lucent/renderTime` (a 4-byte float), set to zero.
+fn without_render_time(mut bytes: Vec<u8>) -> Vec<u8> {
+    let key = b"lucent/renderTime\0float\0\x04\0\0\0";
+    let at = bytes
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("no lucent/renderTime attribute")
+        + key.len();
+    bytes[at..at + 4].fill(0);
+    bytes
+}
+
 #[test]
 fn exr_is_bitwise_identical_for_one_and_two_threads() {
     let dir = tempfile::tempdir().unwrap();
@@ -84,7 +97,10 @@ fn exr_is_bitwise_identical_for_one_and_two_threads() {
             "--quiet",
         ]);
     }
-    let (fa, fb) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let (fa, fb) = (
+        without_render_time(std::fs::read(&a).unwrap()),
+        without_render_time(std::fs::read(&b).unwrap()),
+    );
     assert!(fa.len() > 1000);
     assert!(fa == fb, "EXRs differ between --threads 1 and --threads 2");
     // and a different seed really changes the image
@@ -137,6 +153,28 @@ fn bad_arguments_exit_2_without_output() {
             exr.to_str().unwrap().into(),
             "--rmax-quantile".into(),
             "1".into(),
+        ],
+        // the file options: out of range, lossy, unknown
+        vec![
+            scene("cornell.toml"),
+            "-o".into(),
+            exr.to_str().unwrap().into(),
+            "--cryptomatte-ranks".into(),
+            "0".into(),
+        ],
+        vec![
+            scene("cornell.toml"),
+            "-o".into(),
+            exr.to_str().unwrap().into(),
+            "--exr-compression".into(),
+            "b44".into(),
+        ],
+        vec![
+            scene("cornell.toml"),
+            "-o".into(),
+            exr.to_str().unwrap().into(),
+            "--aov-precision".into(),
+            "double".into(),
         ],
     ] {
         let out = lucent().arg("render").args(&args).output().unwrap();

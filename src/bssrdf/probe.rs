@@ -154,6 +154,16 @@ pub enum ChannelStrategy {
     Mis,
 }
 
+impl ChannelStrategy {
+    /// The name the scene format and the command line use.
+    pub fn name(self) -> &'static str {
+        match self {
+            ChannelStrategy::Single => "single",
+            ChannelStrategy::Mis => "mis",
+        }
+    }
+}
+
 /// Options of the probe estimator; `Default` is the recommended setting.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProbeOptions {

@@ -65,6 +65,24 @@ impl RadiusSampler {
         }
     }
 
+    /// "uniform", "table:N" (tail-spaced), "table-uniform:N", "analytic",
+    /// "mixture": the names [`RadiusSampler::parse`] reads.
+    pub fn name(self) -> String {
+        match self {
+            RadiusSampler::Uniform => "uniform".into(),
+            RadiusSampler::Table {
+                size,
+                spacing: TableSpacing::Tail,
+            } => format!("table:{size}"),
+            RadiusSampler::Table {
+                size,
+                spacing: TableSpacing::Uniform,
+            } => format!("table-uniform:{size}"),
+            RadiusSampler::Analytic => "analytic".into(),
+            RadiusSampler::Mixture => "mixture".into(),
+        }
+    }
+
     /// Checks parameters (table size in [2, 2²⁴]).
     pub fn validate(&self) -> Result<(), ParamError> {
         if let RadiusSampler::Table { size, .. } = *self {

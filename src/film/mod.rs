@@ -5,6 +5,9 @@
 //! the outputs of one command are committed together ([`commit_all`]), so a
 //! failure never leaves an EXR without its PNG.
 
+pub mod cryptomatte;
+pub mod exr_attributes;
+pub mod exr_layers;
 pub mod layers;
 pub mod passes;
 pub mod tonemap;

@@ -183,6 +183,28 @@ pub struct SubsurfaceOverrides {
     pub roughness: Option<f32>,
 }
 
+impl Subsurface {
+    /// Every sampling option, `key=value` separated by spaces, with the
+    /// names the scene format and the command line use (for the EXR
+    /// header).
+    pub fn sampling_description(&self) -> String {
+        let o = self.probe.options();
+        format!(
+            "radius={} rmax_quantile={} axes={} channel={} renormalize={} exit_sw={} \
+             specular={} roughness={} boundary={}",
+            o.radius.name(),
+            o.rmax_quantile,
+            o.axes.name(),
+            o.channel.name(),
+            o.renormalize,
+            self.exit_sw,
+            self.specular,
+            self.roughness,
+            self.boundary.name()
+        )
+    }
+}
+
 impl SubsurfaceOverrides {
     pub fn is_empty(&self) -> bool {
         *self == SubsurfaceOverrides::default()

@@ -76,7 +76,8 @@ pub struct SceneFile {
     #[serde(default)]
     pub shapes: Vec<Spanned<ShapeDef>>,
     pub environment: Option<Spanned<EnvironmentDef>>,
-    pub output: Option<Spanned<OutputDef>>,
+    #[serde(default)]
+    pub output: OutputDef,
 }
 
 /// `[camera]`.
@@ -103,6 +104,23 @@ pub struct RenderDef {
     pub seed: Option<u64>,
 }
 
+/// `[output]`: the passes and how the frame is stored; every key is
+/// optional (the CLI's options override them).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputDef {
+    /// Pass names (`crate::film::passes`), as `--aov` takes them.
+    pub aovs: Option<Vec<Spanned<String>>>,
+    /// `"half"` or `"float"`: light passes' precision.
+    pub aov_precision: Option<Spanned<String>>,
+    /// A lossless EXR compression name.
+    pub exr_compression: Option<Spanned<String>>,
+    /// One file per pass.
+    pub aov_split: Option<bool>,
+    /// Cryptomatte ranks per pixel.
+    pub cryptomatte_ranks: Option<Spanned<u32>>,
+}
+
 /// `[environment]`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -111,14 +129,6 @@ pub struct EnvironmentDef {
     pub radiance: Option<Spanned<Triple3>>,
     /// The light group of the environment's light (`RGBA_<group>` pass).
     pub light_group: Option<Spanned<String>>,
-}
-
-/// `[output]`: what the render writes besides the beauty.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OutputDef {
-    /// Pass names (`crate::film::passes`), as `--aov` takes them.
-    pub aovs: Option<Vec<Spanned<String>>>,
 }
 
 /// The `type` of a `[materials.NAME]` table.

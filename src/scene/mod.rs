@@ -12,6 +12,7 @@ mod material;
 pub mod obj;
 mod objects;
 mod output;
+mod output_file;
 mod regular_file;
 pub mod shapes;
 pub mod transform;
@@ -22,6 +23,7 @@ use std::sync::Arc;
 pub use camera::Camera;
 pub use load::{load, load_str};
 pub use output::{Output, DEFAULT_GROUP};
+pub use output_file::OutputSettings;
 
 use crate::geometry::{Mesh, Vec3};
 use crate::materials::Material;

@@ -12,6 +12,7 @@ use std::collections::BTreeSet;
 use super::checked::{Cx, Res};
 use super::format::{SceneFile, Spanned};
 use super::key_path::quoted;
+use super::output_file::{output_file, OutputSettings};
 use super::Object;
 use crate::film::passes::PassSet;
 
@@ -34,6 +35,9 @@ pub struct Output {
     pub environment_group: u32,
     /// Material names by material index, as the scene file gives them.
     pub material_names: Vec<String>,
+    /// How the frame is stored (`[output]`'s storage keys; the CLI's
+    /// options override them).
+    pub file: OutputSettings,
 }
 
 impl Output {
@@ -76,7 +80,7 @@ fn group_name(cx: &Cx, name: &Spanned<String>, field: &str) -> Res<String> {
 /// `[output]`, the `light_group` keys and the material names of `def`,
 /// whose shapes became `objects`.
 pub(super) fn output(cx: &Cx, def: &SceneFile, objects: &[Object]) -> Res<Output> {
-    let aovs = match def.output.as_ref().and_then(|o| o.get_ref().aovs.as_ref()) {
+    let aovs = match def.output.aovs.as_ref() {
         Some(names) => {
             PassSet::from_names(names.iter().map(|n| n.get_ref().as_str())).map_err(|e| {
                 cx.err(
@@ -127,5 +131,6 @@ pub(super) fn output(cx: &Cx, def: &SceneFile, objects: &[Object]) -> Res<Output
         environment_group: index(&env_group),
         light_groups: light_groups.clone(),
         material_names: def.materials.keys().cloned().collect(),
+        file: output_file(cx, &def.output)?,
     })
 }

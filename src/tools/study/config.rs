@@ -89,19 +89,7 @@ pub struct Config {
 /// "uniform", "table:N" (tail-spaced), "table-uniform:N", "analytic",
 /// "mixture": the names [`RadiusSampler::parse`] reads.
 pub fn radius_name(r: RadiusSampler) -> String {
-    match r {
-        RadiusSampler::Uniform => "uniform".into(),
-        RadiusSampler::Table {
-            size,
-            spacing: TableSpacing::Tail,
-        } => format!("table:{size}"),
-        RadiusSampler::Table {
-            size,
-            spacing: TableSpacing::Uniform,
-        } => format!("table-uniform:{size}"),
-        RadiusSampler::Analytic => "analytic".into(),
-        RadiusSampler::Mixture => "mixture".into(),
-    }
+    r.name()
 }
 
 pub fn integrator_name(i: IntegratorKind) -> &'static str {
@@ -124,10 +112,7 @@ fn axes_name(a: ProbeAxes) -> &'static str {
 }
 
 fn channel_name(c: ChannelStrategy) -> &'static str {
-    match c {
-        ChannelStrategy::Single => "single",
-        ChannelStrategy::Mis => "mis",
-    }
+    c.name()
 }
 
 /// The baseline's probe options: the recommended defaults (exact analytic

@@ -1,0 +1,349 @@
+//! The EXR files lucent writes, read back by a real VFX tool: OpenImageIO's
+//! `oiiotool --info -v` (Debian package `openimageio-tools`, installed by
+//! scripts/install-deps.sh). Checks the layer and channel names, the
+//! channel count, each channel's data type (half or float) and the header
+//! attributes as that tool reports them, for a multi-layer frame with
+//! Cryptomatte, a split frame, and a real render's beauty-only file.
+//!
+//! Without `oiiotool` on the PATH these tests fail (they do not skip): CI
+//! installs it, and a file only the exr crate can read would pass
+//! otherwise.
+
+use std::path::Path;
+use std::process::Command;
+
+use lucent::film::cryptomatte::{self, metadata_key};
+use lucent::film::exr_layers::{self, ExrCompression, FrameHeader, OutputOptions, Precision};
+use lucent::film::layers::{Coverage, Layer, LayerKind};
+use lucent::film::Film;
+use lucent::geometry::Vec3;
+
+/// `oiiotool --info -v PATH`, or a failure saying how to install it.
+fn oiio_info(path: &Path) -> String {
+    let out = Command::new("oiiotool")
+        .args(["--info", "-v"])
+        .arg(path)
+        .output()
+        .unwrap_or_else(|e| {
+            panic!(
+                "cannot run oiiotool ({e}): install OpenImageIO's tools \
+                 (Debian: apt-get install openimageio-tools; scripts/install-deps.sh does)"
+            )
+        });
+    assert!(
+        out.status.success(),
+        "oiiotool --info -v {} failed: {}",
+        path.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// What `oiiotool --info -v` says about a file.
+struct Info {
+    width: u32,
+    height: u32,
+    /// (channel name, data type) in file order; the type of a channel
+    /// without its own annotation is the file's format.
+    channels: Vec<(String, String)>,
+    /// (attribute name, value as printed).
+    attributes: Vec<(String, String)>,
+}
+
+impl Info {
+    fn parse(text: &str) -> Info {
+        // "Reading PATH" first
+        let mut lines = text.lines().skip_while(|l| l.starts_with("Reading "));
+        // "PATH :  640 x  480, 4 channel, float openexr" (the format is
+        // "half/float" or the like when channels differ)
+        let first = lines.next().expect("empty oiiotool output");
+        let (_, dims) = first.rsplit_once(" : ").expect(first);
+        let mut parts = dims.split(',');
+        let wh: Vec<u32> = parts
+            .next()
+            .unwrap()
+            .split('x')
+            .map(|s| s.trim().parse().unwrap())
+            .collect();
+        let format = parts
+            .nth(1)
+            .unwrap()
+            .trim()
+            .split(' ')
+            .next()
+            .unwrap()
+            .to_string();
+        let mut channels = Vec::new();
+        let mut attributes = Vec::new();
+        for line in lines {
+            let line = line.trim();
+            if let Some(list) = line.strip_prefix("channel list: ") {
+                for c in list.split(", ") {
+                    channels.push(match c.split_once(" (") {
+                        Some((name, ty)) => {
+                            (name.to_string(), ty.trim_end_matches(')').to_string())
+                        }
+                        None => (c.to_string(), format.clone()),
+                    });
+                }
+            } else if let Some((k, v)) = line.split_once(": ") {
+                attributes.push((k.to_string(), v.to_string()));
+            }
+        }
+        Info {
+            width: wh[0],
+            height: wh[1],
+            channels,
+            attributes,
+        }
+    }
+
+    fn attribute(&self, name: &str) -> Option<&str> {
+        self.attributes
+            .iter()
+            .find(|a| a.0 == name)
+            .map(|a| a.1.as_str())
+    }
+
+    fn type_of(&self, channel: &str) -> &str {
+        &self
+            .channels
+            .iter()
+            .find(|c| c.0 == channel)
+            .unwrap_or_else(|| panic!("no channel {channel} in {:?}", self.channels))
+            .1
+    }
+}
+
+fn film() -> Film {
+    let mut f = Film::new(5, 3);
+    for (i, p) in f.pixels.iter_mut().enumerate() {
+        *p = Vec3::new(i as f32 * 0.25, 0.5, 2.0);
+    }
+    f
+}
+
+fn layers(pixels: usize) -> Vec<Layer> {
+    let layer = |name: &str, channels: &[&str], kind| Layer {
+        name: name.into(),
+        channels: channels.iter().map(|s| s.to_string()).collect(),
+        kind,
+        values: (0..pixels * channels.len())
+            .map(|i| i as f32 / 8.0)
+            .collect(),
+    };
+    vec![
+        layer("diffuse_direct", &["R", "G", "B"], LayerKind::Light),
+        layer("sss_indirect", &["R", "G", "B"], LayerKind::Light),
+        layer("N", &["X", "Y", "Z"], LayerKind::Data),
+        layer("depth", &["Z"], LayerKind::Data),
+        layer("object_id", &["id"], LayerKind::Id),
+    ]
+}
+
+fn coverage(pixels: usize) -> Vec<Coverage> {
+    let names = vec!["bunny".to_string(), "floor".to_string(), "lamp".to_string()];
+    let per_pixel = |p: usize| match p % 3 {
+        0 => vec![(0, 1.0)],
+        1 => vec![(0, 0.5), (1, 0.25), (2, 0.25)],
+        _ => vec![],
+    };
+    ["object", "material"]
+        .iter()
+        .map(|k| Coverage {
+            kind: k.to_string(),
+            names: names.clone(),
+            pixels: (0..pixels).map(per_pixel).collect(),
+        })
+        .collect()
+}
+
+fn header() -> FrameHeader {
+    FrameHeader {
+        scene_path: Some("scenes/marble-bunny.toml".into()),
+        scene_sha256: Some("ab".repeat(32)),
+        spp: Some(64),
+        seed: Some(12345678901234),
+        max_depth: Some(8),
+        backend: Some("bvh".into()),
+        backend_version: Some("lucent 0.1.0".into()),
+        integrator: Some("path".into()),
+        sampling: vec![("bunny".into(), "axes=curvature roughness=0.3".into())],
+        render_seconds: Some(12.5),
+    }
+}
+
+/// The attributes every file carries, as OpenImageIO prints them.
+fn assert_header(info: &Info) {
+    let want = [
+        (
+            "software",
+            format!("\"lucent {}\"", env!("CARGO_PKG_VERSION")),
+        ),
+        ("lucent/scene", "\"scenes/marble-bunny.toml\"".into()),
+        ("lucent/sceneSha256", format!("\"{}\"", "ab".repeat(32))),
+        ("lucent/resolution", "5, 3".into()),
+        ("lucent/spp", "64".into()),
+        ("lucent/seed", "\"12345678901234\"".into()),
+        ("lucent/maxDepth", "8".into()),
+        ("lucent/backend", "\"bvh\"".into()),
+        ("lucent/backendVersion", "\"lucent 0.1.0\"".into()),
+        ("lucent/integrator", "\"path\"".into()),
+        (
+            "lucent/sampling",
+            "\"bunny: axes=curvature roughness=0.3\"".into(),
+        ),
+        ("lucent/renderTime", "12.5".into()),
+    ];
+    for (name, value) in want {
+        assert_eq!(
+            info.attribute(name),
+            Some(value.as_str()),
+            "{name} in {:?}",
+            info.attributes
+        );
+    }
+}
+
+#[test]
+fn oiiotool_reads_every_layer_type_and_attribute_of_a_multilayer_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("frame.exr");
+    let f = film();
+    let n = f.pixels.len();
+    let opts = OutputOptions {
+        precision: Precision::Half,
+        compression: ExrCompression::Piz,
+        ..OutputOptions::default()
+    };
+    exr_layers::write_frame(&path, &f, &layers(n), &coverage(n), &header(), &opts).unwrap();
+    let info = Info::parse(&oiio_info(&path));
+    assert_eq!((info.width, info.height), (5, 3));
+    // beauty 4 + two light passes 6 + N 3 + depth 1 + id 1 + 2 × 3 RGBA
+    assert_eq!(
+        info.channels.len(),
+        4 + 6 + 3 + 1 + 1 + 24,
+        "{:?}",
+        info.channels
+    );
+    for c in ["R", "G", "B", "A"] {
+        assert_eq!(info.type_of(c), "float", "{c}");
+    }
+    for c in ["diffuse_direct.R", "diffuse_direct.B", "sss_indirect.G"] {
+        assert_eq!(info.type_of(c), "half", "{c}");
+    }
+    for c in ["N.X", "N.Z", "depth.Z", "object_id.id"] {
+        assert_eq!(info.type_of(c), "float", "{c}");
+    }
+    for kind in ["CryptoObject", "CryptoMaterial"] {
+        for layer in 0..3 {
+            for c in ["R", "G", "B", "A"] {
+                assert_eq!(info.type_of(&format!("{kind}{layer:02}.{c}")), "float");
+            }
+        }
+        let key = metadata_key(kind);
+        let attr = |f: &str| info.attribute(&format!("cryptomatte/{key}/{f}"));
+        assert_eq!(attr("name"), Some(format!("\"{kind}\"").as_str()));
+        assert_eq!(attr("hash"), Some("\"MurmurHash3_32\""));
+        assert_eq!(attr("conversion"), Some("\"uint32_to_float32\""));
+        let manifest = attr("manifest").unwrap();
+        let bunny = format!("{:08x}", cryptomatte::name_id("bunny").to_bits());
+        assert!(manifest.contains(&bunny), "{manifest}");
+    }
+    assert_eq!(info.attribute("compression"), Some("\"piz\""));
+    assert_header(&info);
+}
+
+#[test]
+fn oiiotool_reads_each_file_of_a_split_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("frame.exr");
+    let f = film();
+    let n = f.pixels.len();
+    let opts = OutputOptions {
+        split: true,
+        ..OutputOptions::default()
+    };
+    exr_layers::write_frame(&path, &f, &layers(n), &coverage(n), &header(), &opts).unwrap();
+    let beauty = Info::parse(&oiio_info(&path));
+    assert_eq!(beauty.channels.len(), 4);
+    assert_header(&beauty);
+    assert_eq!(beauty.attribute("compression"), Some("\"zip\""));
+    let pass = Info::parse(&oiio_info(&dir.path().join("frame.diffuse_direct.exr")));
+    let names: Vec<&str> = pass.channels.iter().map(|c| c.0.as_str()).collect();
+    assert_eq!(
+        names,
+        ["diffuse_direct.R", "diffuse_direct.G", "diffuse_direct.B"]
+    );
+    assert_eq!(pass.type_of("diffuse_direct.G"), "float");
+    assert_eq!(pass.attribute("lucent/pass"), Some("\"diffuse_direct\""));
+    assert_header(&pass);
+    let crypto = Info::parse(&oiio_info(&dir.path().join("frame.CryptoObject.exr")));
+    assert_eq!(crypto.channels.len(), 12);
+    let key = metadata_key("CryptoObject");
+    assert_eq!(
+        crypto.attribute(&format!("cryptomatte/{key}/name")),
+        Some("\"CryptoObject\"")
+    );
+}
+
+#[test]
+fn oiiotool_reads_the_header_of_a_real_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\nlook_from = [0, 0, 4]\nlook_at = [0, 0, 0]\nresolution = [8, 6]\n\
+         [render]\nspp = 2\nseed = 5\n[environment]\nradiance = [0.5, 0.5, 0.5]\n\
+         [materials.wax]\ntype = \"subsurface\"\npreset = \"marble\"\n\
+         [[shapes]]\ntype = \"sphere\"\nmaterial = \"wax\"\n\
+         [output]\nexr_compression = \"rle\"\n",
+    )
+    .unwrap();
+    let exr = dir.path().join("r.exr");
+    let out = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args([
+            "render", "--quiet", "--accel", "bvh", "--axes", "mis3", "-o",
+        ])
+        .arg(&exr)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let info = Info::parse(&oiio_info(&exr));
+    let names: Vec<&str> = info.channels.iter().map(|c| c.0.as_str()).collect();
+    assert_eq!(names, ["R", "G", "B", "A"]);
+    assert_eq!(info.type_of("R"), "float");
+    assert_eq!(info.attribute("compression"), Some("\"rle\""));
+    assert_eq!(info.attribute("lucent/spp"), Some("2"));
+    assert_eq!(info.attribute("lucent/seed"), Some("\"5\""));
+    assert_eq!(info.attribute("lucent/resolution"), Some("8, 6"));
+    assert_eq!(info.attribute("lucent/backend"), Some("\"bvh\""));
+    assert_eq!(info.attribute("lucent/integrator"), Some("\"path\""));
+    let sampling = info.attribute("lucent/sampling").unwrap();
+    assert!(sampling.contains("axes=mis3"), "{sampling}");
+    let sha = info
+        .attribute("lucent/sceneSha256")
+        .unwrap()
+        .trim_matches('"');
+    assert_eq!(sha.len(), 64);
+    assert!(info.attribute("lucent/renderTime").is_some());
+    // the command line overrides the scene's [output]
+    let out = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["render", "--quiet", "--exr-compression", "piz", "-o"])
+        .arg(&exr)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let info = Info::parse(&oiio_info(&exr));
+    assert_eq!(info.attribute("compression"), Some("\"piz\""));
+}
