@@ -36,6 +36,10 @@ pub struct Context<'a> {
     pub ray_epsilon: f32,
     /// Per mesh, what [`Interaction::new`] reads.
     pub shading: Vec<interaction::MeshShading>,
+    /// Subsurface hits at depths below this sample an antithetic pair of
+    /// entry points ([`path::PAIR_DEPTH`], the default); 0 turns the pair
+    /// off (one probe per hit), for measurements and tests.
+    pub pair_depth: u32,
 }
 
 impl<'a> Context<'a> {
@@ -59,6 +63,7 @@ impl<'a> Context<'a> {
             plan: Plan::new(scene),
             ray_epsilon: extent * 1e-6,
             shading,
+            pair_depth: path::PAIR_DEPTH,
         }
     }
 

@@ -11,9 +11,36 @@
 //! twice — by sampling a point on an area light (next-event estimation)
 //! and by sampling the lobe — and the two are combined with the power
 //! heuristic (Veach 1997, §9.2). The area integral is estimated with one
-//! probe ray (King et al. 2013; [`crate::bssrdf::probe`]). Paths end at
+//! probe ray (King et al. 2013; [`crate::bssrdf::probe`]), or at the
+//! camera vertex with an antithetic pair of them (below). Paths end at
 //! `max_depth` bounces or by Russian roulette once their throughput is
 //! small (pbrt-v4 §13.1.1).
+//!
+//! **The antithetic probe pair** ([`PAIR_DEPTH`]). At a subsurface hit xo
+//! of the camera path, one probe's random numbers (channel, radius r, axis
+//! V, angle φ) give two probes, at φ and at φ + π, and so two entry points
+//! x₁, x₂ with the probe weights W_k = Rd(|xo − x_k|) / p(x_k) × (hits on
+//! its segment). With β the throughput into the medium,
+//!
+//!   L̂(xo) = β · [ ½ Σ_k W_k · L̂_nee(x_k)  +  W_K · L̂_lobe(x_K) ],
+//!   K ∈ {1, 2} with probability ½ each,
+//!
+//! L̂_nee the light sampled at x_k (MIS-weighted) and L̂_lobe the path
+//! continued from x_K by sampling its lobe (emission it finds MIS-weighted
+//! against the light sample at x_K). A probe that finds nothing
+//! contributes 0: when only x_k exists, L̂ = β · ½ W_k · (L̂_nee(x_k) +
+//! L̂_lobe(x_k)). Unbiased: φ + π is uniform when φ is, so each x_k alone
+//! has the density p the one-probe estimator divides by, and the two
+//! halves average two such estimators (the continuation by choosing one,
+//! weight 2 · ½). Why: light at the entry point that changes linearly
+//! across the profile, L(xo + δ) ≈ L(xo) + ∇L·δ, cancels exactly between
+//! δ and −δ on a plane (to first order in κr on a surface of curvature
+//! κ), and that change — the irradiance turning across a lit curved body,
+//! and the probe weights' own spread — is most of one probe's noise on a
+//! smoothly lit body: on scenes/smooth-sphere.toml the pair has 0.36× the
+//! relMSE per sample for 1.34× the rays (docs/accuracy.md, "Smooth
+//! sphere"). Deeper vertices use one probe: their share of the image is
+//! small and the second probe and light sample cost the same there.
 //!
 //! **Coated subsurface hits.** The coat at xo reflects a fraction (Fr for
 //! the smooth coat, E(μo) for the rough one) and passes the rest into the
@@ -58,6 +85,14 @@ const RR_START: u32 = 3;
 /// reflection sampled every time, besides next-event estimation) lowered
 /// relMSE by 8–10 % for 24 % more rays, a loss, so it chooses.
 pub(crate) const COAT_SPLIT_DEPTH: u32 = 1;
+
+/// Subsurface hits at depths below this sample two entry points from one
+/// probe's randoms, the second at the opposite angle φ + π (antithetic),
+/// and sample light at both, each weighted ½; the path goes on from one of
+/// them, chosen with probability ½ (module docs). Light varying linearly
+/// across the profile cancels between the two. 1: the camera vertex only
+/// (the default of [`Context::pair_depth`]).
+pub const PAIR_DEPTH: u32 = 1;
 
 /// Paths waiting to be traced after the current one ends; more than this
 /// many at once never happens with [`COAT_SPLIT_DEPTH`] ≤ 4.
@@ -146,6 +181,10 @@ pub(crate) struct Vertex<'a> {
 /// that event for the light-path passes, [`aov`]), or the end of the
 /// path. Both integrators share one bounce loop, [`trace`], and differ only
 /// in how they produce this.
+// Returned by value once per subsurface hit and read in place (the loop
+// borrows the vertex from it); boxing the large variant would allocate in
+// the hot path.
+#[allow(clippy::large_enum_variant)]
 pub(crate) enum Scatter<'a> {
     Vertex(Vertex<'a>),
     Continue(Ray, Event),
@@ -168,6 +207,10 @@ pub(crate) struct Coated<'a> {
     /// there and `reflected` waits on the stack; None: this path goes on
     /// along `reflected`, or ends.
     pub(crate) entry: Option<Vertex<'a>>,
+    /// The other entry point of an antithetic pair ([`PAIR_DEPTH`]) and the
+    /// throughput light sampled there is weighted by; when Some, light
+    /// sampled at `entry` counts ½ too.
+    pub(crate) pair: Option<(Vertex<'a>, Vec3)>,
 }
 
 /// A ray the coat reflected: the ray, its throughput, and the vertex and
@@ -213,8 +256,8 @@ impl Branches {
 }
 
 /// The radiance arriving along `camera_ray`: one sample of L, with the
-/// BSSRDF estimated by one probe ray per subsurface hit; its parts go to
-/// `rec` ([`aov`]).
+/// BSSRDF estimated by one probe ray per subsurface hit (an antithetic pair
+/// at the camera vertex); its parts go to `rec` ([`aov`]).
 pub fn radiance<R: Recorder>(
     ctx: &Context,
     camera_ray: Ray,
@@ -383,6 +426,9 @@ fn follow<'s, R: Recorder>(
                 subsurface(ss, &si, wo, &mut beta, rng, counters, depth)
             }
         };
+        // Light sampled at the vertex counts this much (½ at an entry
+        // point of an antithetic pair, whose twin is sampled too).
+        let mut nee_scale = 1.0;
         // Borrowed, not moved out: the vertex stays where it was built.
         // At the first hit the path's class becomes that of what scattered;
         // the coat's reflections are specular.
@@ -414,6 +460,9 @@ fn follow<'s, R: Recorder>(
                     l += c;
                     rec.light(c, aov::sampled(coat_event, depth), Source::Light(light));
                 }
+                // What the entry's throughput was multiplied by here (2 when
+                // it alone goes on for both); its pair's the same.
+                let mut entry_mul = 1.0;
                 let (next, follow_reflected) = match (&c.entry, c.reflected) {
                     (Some(v), Some((r, mut b, p))) => {
                         // Both: this path enters the medium, the reflection
@@ -431,6 +480,7 @@ fn follow<'s, R: Recorder>(
                             Some(false) if rng.uniform() < 0.5 => (None, Some((r, 2.0 * b, p))),
                             Some(false) => {
                                 beta *= 2.0;
+                                entry_mul = 2.0;
                                 (Some(v), None)
                             }
                             _ => (Some(v), None),
@@ -443,6 +493,15 @@ fn follow<'s, R: Recorder>(
                     (Some(v), _) => {
                         if first {
                             event = v.lobe.event();
+                        }
+                        if let Some((pv, b)) = &c.pair {
+                            if ctx.plan.area_lights {
+                                let (d, light) = direct_lighting(ctx, pv, rng, counters);
+                                let c = (entry_mul * *b) * d;
+                                l += c;
+                                rec.light(c, aov::sampled(event, depth), Source::Light(light));
+                            }
+                            nee_scale = 0.5;
                         }
                         v
                     }
@@ -461,7 +520,7 @@ fn follow<'s, R: Recorder>(
         // Next-event estimation, then continue by sampling the lobe.
         if ctx.plan.area_lights {
             let (d, light) = direct_lighting(ctx, vertex, rng, counters);
-            let c = beta * d;
+            let c = (nee_scale * beta) * d;
             l += c;
             rec.light(c, aov::sampled(event, depth), Source::Light(light));
         }
@@ -546,20 +605,20 @@ fn subsurface_probe<'s>(
         } else if split {
             *beta *= 1.0 - fr;
             let reflected = Some((mirror(ctx, si, wo, n_out), beta_in * fr, None));
-            let entry = probe_entry(ctx, ss, si, wo, beta, rng, scratch, counters);
+            let (entry, pair) = entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth);
             return Scatter::Coated(Coated {
                 coat: None,
                 reflected,
                 entry,
+                pair,
             });
         } else if rng.uniform() < fr {
             // Specular reflection with probability Fr: weight 1.
             return Scatter::Continue(mirror(ctx, si, wo, n_out), Event::Specular);
         }
-        return match probe_entry(ctx, ss, si, wo, beta, rng, scratch, counters) {
-            Some(v) => Scatter::Vertex(v),
-            None => Scatter::Absorbed,
-        };
+        return entry_scatter(entries(
+            ctx, ss, si, wo, beta, rng, scratch, counters, depth,
+        ));
     };
     // The rough coat. Where the shading normal faces away from ωo it
     // reflects nothing and everything enters.
@@ -572,10 +631,9 @@ fn subsurface_probe<'s>(
     };
     if !ss.specular || e <= 0.0 {
         *beta *= 1.0 - e;
-        return match probe_entry(ctx, ss, si, wo, beta, rng, scratch, counters) {
-            Some(v) => Scatter::Vertex(v),
-            None => Scatter::Absorbed,
-        };
+        return entry_scatter(entries(
+            ctx, ss, si, wo, beta, rng, scratch, counters, depth,
+        ));
     }
     let v = Vertex {
         p: si.p,
@@ -595,13 +653,15 @@ fn subsurface_probe<'s>(
             coat: Some((v, beta_in)),
             reflected,
             entry: None,
+            pair: None,
         });
     }
-    let entry = probe_entry(ctx, ss, si, wo, beta, rng, scratch, counters);
+    let (entry, pair) = entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth);
     Scatter::Coated(Coated {
         coat: Some((v, beta_in)),
         reflected: None,
         entry,
+        pair,
     })
 }
 
@@ -640,10 +700,12 @@ fn coat_reflection(
     Some((ray, beta * weight, Some((v.p, pdf))))
 }
 
-/// The area integral at xo: one entry point xi from a probe ray, with the
-/// probe's weight applied to `beta`; None when the probe finds nothing.
+/// The entry vertices the path goes on from at a subsurface hit at
+/// `depth`, `beta` scaled by the chosen one's probe weight: one probe, or
+/// below `ctx.pair_depth` an antithetic pair ([`PAIR_DEPTH`]), whose second
+/// vertex comes back with its own throughput for light sampling.
 #[allow(clippy::too_many_arguments)]
-fn probe_entry<'s>(
+fn entries<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
     si: &Interaction,
@@ -652,9 +714,76 @@ fn probe_entry<'s>(
     rng: &mut SampleRng,
     scratch: &mut Scratch,
     counters: &mut Counters,
-) -> Option<Vertex<'s>> {
+    depth: u32,
+) -> (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>) {
     let frame_o = si.shading_frame_facing(wo);
     let u = ProbeRandoms::from_rng(rng);
+    let kappa = exit_curvature(&ctx.scene.meshes[si.geom as usize], si.prim);
+    if depth >= ctx.pair_depth {
+        let e = probe_entry(ctx, ss, si, &frame_o, kappa, &u, scratch, counters);
+        return match e {
+            Some((v, w)) => {
+                *beta *= w;
+                (Some(v), None)
+            }
+            None => (None, None),
+        };
+    }
+    let twin = ProbeRandoms {
+        angle: (u.angle + 0.5).fract(),
+        ..u
+    };
+    let a = probe_entry(ctx, ss, si, &frame_o, kappa, &u, scratch, counters);
+    let b = probe_entry(ctx, ss, si, &frame_o, kappa, &twin, scratch, counters);
+    match (a, b) {
+        (Some((va, wa)), Some((vb, wb))) => {
+            // Go on from one, chosen with probability ½ (weight 2 × ½);
+            // light is sampled at both, each weighted ½.
+            let beta0 = *beta;
+            let (go, (other, w_other), w_go) = if rng.uniform() < 0.5 {
+                (va, (vb, wb), wa)
+            } else {
+                (vb, (va, wa), wb)
+            };
+            *beta = beta0 * w_go;
+            (Some(go), Some((other, 0.5 * beta0 * w_other)))
+        }
+        (Some((v, w)), None) | (None, Some((v, w))) => {
+            *beta *= 0.5 * w;
+            (Some(v), None)
+        }
+        (None, None) => (None, None),
+    }
+}
+
+/// What [`entries`] found as a [`Scatter`]: the entry vertex (with its
+/// pair's, if any), or the end of the path.
+fn entry_scatter<'s>(e: (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>)) -> Scatter<'s> {
+    match e {
+        (Some(v), None) => Scatter::Vertex(v),
+        (entry @ Some(_), pair) => Scatter::Coated(Coated {
+            coat: None,
+            reflected: None,
+            entry,
+            pair,
+        }),
+        (None, _) => Scatter::Absorbed,
+    }
+}
+
+/// The area integral at xo: one entry point xi from a probe ray with
+/// randoms `u`, and the probe's weight; None when the probe finds nothing.
+#[allow(clippy::too_many_arguments)]
+fn probe_entry<'s>(
+    ctx: &Context,
+    ss: &'s Subsurface,
+    si: &Interaction,
+    frame_o: &Frame,
+    kappa: f32,
+    u: &ProbeRandoms,
+    scratch: &mut Scratch,
+    counters: &mut Counters,
+) -> Option<(Vertex<'s>, Vec3)> {
     counters.rays += 1;
     let target = ProbeTarget {
         accel: ctx.accel,
@@ -664,21 +793,23 @@ fn probe_entry<'s>(
     let ps = sample_entry(
         &ss.probe,
         si.p,
-        &frame_o,
-        exit_curvature(target.mesh, si.prim),
-        &u,
+        frame_o,
+        kappa,
+        u,
         &target,
         &mut scratch.probe_hits,
     )?;
-    *beta *= ps.weight;
     let n_in = if si.front { ps.normal } else { -ps.normal };
-    Some(Vertex {
-        p: ps.point,
-        ng: n_in,
-        frame: Frame::from_normal(n_in),
-        wo_local: Vec3::Z,
-        lobe: Lobe::SubsurfaceEntry(ss),
-    })
+    Some((
+        Vertex {
+            p: ps.point,
+            ng: n_in,
+            frame: Frame::from_normal(n_in),
+            wo_local: Vec3::Z,
+            lobe: Lobe::SubsurfaceEntry(ss),
+        },
+        ps.weight,
+    ))
 }
 
 /// Russian roulette after `RR_START` bounces: survive with probability
