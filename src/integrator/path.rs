@@ -33,6 +33,7 @@ use super::interaction::offset_along;
 use super::probe::{exit_curvature, sample_entry, ProbeTarget};
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
+use crate::bssrdf::curvature_correction::mean_curvature;
 use crate::bssrdf::ProbeRandoms;
 use crate::fresnel;
 use crate::geometry::{Frame, Ray, Vec3};
@@ -602,6 +603,15 @@ fn probe_entry<'s>(
         &mut scratch.probe_hits,
     )?;
     *beta *= ps.weight;
+    // The curvature correction (bssrdf::curvature_correction): None, and
+    // the weight untouched, on flat and concave surfaces.
+    if let Some(cc) = ss.curvature_correction() {
+        let k_o = mean_curvature(target.mesh, si.prim);
+        let k_i = mean_curvature(target.mesh, ps.hit.prim);
+        if let Some(f) = cc.weight(k_o, k_i) {
+            *beta *= f;
+        }
+    }
     let n_in = if si.front { ps.normal } else { -ps.normal };
     Some(Vertex {
         p: ps.point,
