@@ -5,10 +5,16 @@
 //! (`lucent::tools::sphere_albedo`; `docs/bssrdf.md` §10).
 //!
 //!     cargo run --release --example curvature_table [-- OUT.csv [--quick]]
+//!     cargo run --release --example curvature_table -- --check
 //!
+//! `--check` measures the embedded table's interpolation error instead: at
+//! η = 1.3 and 1.5, new walks at points between the nodes (geometric
+//! midpoints in ρ, midpoints in x), A_sphere = 1 − h (1 − A_slab)
+//! interpolated against simulated.
 //! `scripts/curvature-table.sh` runs it. Deterministic for any thread count.
 
-use lucent::tools::sphere_albedo::{generate, Settings};
+use lucent::bssrdf::curvature_table::CurvatureTable;
+use lucent::tools::sphere_albedo::{escape, generate, Body, Settings};
 use std::fmt::Write as _;
 
 fn main() {
@@ -19,6 +25,10 @@ fn main() {
         .cloned()
         .unwrap_or_else(|| "src/bssrdf/curvature_table.csv".into());
     let mut s = Settings::default();
+    if args.iter().any(|a| a == "--check") {
+        check(&s);
+        return;
+    }
     if args.iter().any(|a| a == "--quick") {
         s.walks_sphere /= 20;
         s.walks_slab /= 20;
@@ -68,4 +78,55 @@ fn main() {
     std::fs::write(&tmp, csv).expect("write table");
     std::fs::rename(&tmp, &out).expect("rename table");
     eprintln!("wrote {out}");
+}
+
+/// Interpolation check (module docs): prints each point and the largest
+/// |interpolated − simulated| A_sphere with the simulation's standard error.
+fn check(s: &Settings) {
+    let t = CurvatureTable::get().expect("embedded table");
+    let (mut worst, mut worst_se) = (0.0f64, 0.0f64);
+    for eta in [1.3, 1.5] {
+        // x midpoints at ρ nodes 1, 4, 16 ld; ρ midpoints at x nodes.
+        let mut points = Vec::new();
+        for w in t.xs.windows(2).step_by(2) {
+            for rho in [1.0, 4.0] {
+                points.push((0.5 * (w[0] + w[1]), rho));
+            }
+        }
+        for &x in &[0.03, 0.2, 0.6] {
+            for w in t.rhos.windows(2).step_by(3) {
+                points.push((x, (w[0] * w[1]).sqrt()));
+            }
+        }
+        for (k, &(x, rho)) in points.iter().enumerate() {
+            let alpha = 1.0 - x * x;
+            let stream = 1_000_000 + k as u64 * 2;
+            let (slab, se_l, _) = escape(
+                Body::HalfSpace,
+                alpha,
+                eta as f32,
+                s.walks_slab,
+                s.seed + 1,
+                stream,
+            );
+            let radius = rho / (3f64.sqrt() * x);
+            let (sph, se_s, _) = escape(
+                Body::Sphere(radius),
+                alpha,
+                eta as f32,
+                s.walks_sphere * 2,
+                s.seed + 1,
+                stream + 1,
+            );
+            let interp = 1.0 - t.h(rho, x, eta) * (1.0 - slab);
+            let err = (interp - sph).abs();
+            let se = (se_s * se_s + se_l * se_l).sqrt();
+            println!("eta {eta} x {x:.3} rho {rho:.3}: A_sphere {sph:.4} ± {se_s:.4}, interpolated {interp:.4}, |diff| {err:.4} ({:.1} se)", err / se);
+            if err > worst {
+                worst = err;
+                worst_se = se;
+            }
+        }
+    }
+    println!("largest |interpolated - simulated| A_sphere: {worst:.4} (standard error of that difference {worst_se:.4})");
 }
