@@ -129,7 +129,7 @@ fn sphere_case(k: f32, bound: f64, uncorrected_below: f64) {
         let s = scene(material(p, mode), mesh.clone(), eye, Vec3::Y, fov, spp);
         disk_mean(&run(&s, integrator), disk as f64)
     };
-    let (walk, se_w) = render_with(CurvatureMode::Off, IntegratorKind::RandomWalk, 64);
+    let (walk, se_w) = render_with(CurvatureMode::Off, IntegratorKind::RandomWalk, 256);
     let (on, se_on) = render_with(CurvatureMode::Auto, IntegratorKind::Path, 64);
     let (off, _) = render_with(CurvatureMode::Off, IntegratorKind::Path, 16);
     for c in 0..3 {
