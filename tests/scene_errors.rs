@@ -474,9 +474,9 @@ fn cases() -> Vec<Case> {
         ),
         case(
             "subsurface unknown curvature correction",
-            format!("{CAM}{SSS}preset = \"skin1\"\ncurvature_correction = \"on\"\n"),
-            "expected \"auto\" or \"off\", found \"on\"",
-            Some("on"),
+            format!("{CAM}{SSS}preset = \"skin1\"\ncurvature_correction = \"always\"\n"),
+            "expected \"auto\" or \"off\", found \"always\"",
+            Some("always"),
             Some("materials.skin.curvature_correction"),
         ),
         case(
