@@ -16,9 +16,11 @@
 //! **The correction.** At a point where the surface's mean curvature is
 //! κ > 0, read R = 1/κ and, per channel of diffusion length ℓd, ρ = R/ℓd:
 //!
-//!     f(κ) = A_sphere(ρ) / (A · g(R)),
-//!     A_sphere(ρ) = 1 − h(ρ, √(1 − α'), η)·(1 − A),
-//!     g(R) = CDF(min(2R, Rmax)) / CDF(Rmax),
+//! ```text
+//! f(κ) = A_sphere(ρ) / (A · g(R)),
+//! A_sphere(ρ) = 1 − h(ρ, √(1 − α'), η)·(1 − A),
+//! g(R) = CDF(min(2R, Rmax)) / CDF(Rmax),
+//! ```
 //!
 //! so that on a sphere under uniform light the estimator's mean becomes
 //! A_sphere (times the same truncation CDF(Rmax) as on a flat surface, or
@@ -185,7 +187,7 @@ impl CurvatureCorrection {
     /// 1 for κ ≤ 0 (and NaN).
     pub fn factor(&self, kappa: f32) -> [f32; 3] {
         let kl = kappa * self.ld_max as f32;
-        if !(kl > 0.0) || self.lut.is_empty() {
+        if kl.is_nan() || kl <= 0.0 || self.lut.is_empty() {
             return [1.0; 3];
         }
         let t = (kl.log2() - LOG2_FIRST) * STEPS_PER_OCTAVE;
@@ -208,7 +210,7 @@ impl CurvatureCorrection {
     /// equations of the module docs; exactly 1 for κ ≤ 0 and inactive
     /// channels.
     pub fn exact_factor(&self, k: f64) -> [f64; 3] {
-        if !(k > 0.0) {
+        if k.is_nan() || k <= 0.0 {
             return [1.0; 3];
         }
         std::array::from_fn(|c| match &self.channels[c] {

@@ -1,7 +1,9 @@
 //! What a convex body absorbs against the half-space of the same medium
 //! (`docs/bssrdf.md` §10): a table of
 //!
-//!     h(ρ, x, η) = (1 − A_sphere) / (1 − A_slab),    x = √(1 − α'),
+//! ```text
+//! h(ρ, x, η) = (1 − A_sphere) / (1 − A_slab),    x = √(1 − α'),
+//! ```
 //!
 //! the ratio of the fractions of entering diffuse light that a sphere of
 //! radius ρ diffusion lengths (ℓd = 1/σtr) and the half-space absorb, both

@@ -12,7 +12,9 @@
 //! A_slab is the same fraction for the half-space (the albedo table's R).
 //! Tabulated is the ratio of what the two absorb,
 //!
-//!     h(ρ, x, η) = (1 − A_sphere) / (1 − A_slab),    x = √(1 − α'),
+//! ```text
+//! h(ρ, x, η) = (1 − A_sphere) / (1 − A_slab),    x = √(1 − α'),
+//! ```
 //!
 //! which tends to a function of ρ alone as α' → 1 (diffusion theory has no
 //! length but ℓd there), where A_sphere and A_slab both tend to 1 and
