@@ -2,11 +2,13 @@
 //! standard error (pixels treated as independent), for the accuracy report
 //! of `scripts/albedo-report.py`:
 //!
-//!     cargo run --release --example image_mean -- IMAGE.exr [CX CY R]
+//!     cargo run --release --example image_mean -- IMAGE.exr [CX CY R [left|right]]
 //!
 //! Prints `mean_r mean_g mean_b se_r se_g se_b pixels`. Without a disk
 //! (pixel coordinates of its centre and its radius) every pixel counts.
-//! A pixel counts if its whole square lies inside the disk.
+//! A pixel counts if its whole square lies inside the disk; with `left`
+//! or `right`, only the half of the disk left (x < CX) or right of its
+//! centre (the lit and dark sides of a sphere lit from one side).
 
 use lucent::film::Film;
 use std::path::Path;
@@ -35,6 +37,11 @@ fn main() {
     } else {
         None
     };
+    let half = args.get(4).map(String::as_str);
+    if !matches!(half, None | Some("left") | Some("right")) {
+        eprintln!("error: expected left or right, found {}", args[4]);
+        std::process::exit(2)
+    }
     let (w, h) = (film.width as usize, film.height as usize);
     let mut vals: Vec<[f64; 3]> = Vec::new();
     for y in 0..h {
@@ -44,6 +51,11 @@ fn main() {
                 let dx = (x as f64 - cx).abs().max((x as f64 + 1.0 - cx).abs());
                 let dy = (y as f64 - cy).abs().max((y as f64 + 1.0 - cy).abs());
                 if dx * dx + dy * dy > r * r {
+                    continue;
+                }
+                let left = (x as f64 + 1.0) <= cx;
+                let right = x as f64 >= cx;
+                if (half == Some("left") && !left) || (half == Some("right") && !right) {
                     continue;
                 }
             }

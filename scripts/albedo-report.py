@@ -13,6 +13,13 @@ Gauss-Legendre rule in mu^2, cameras at 70.1, 45 and 19.6 degrees).
 
     python3 scripts/albedo-report.py [--presets marble,skin1] [--spp-walk 64]
                                      [--spp-diffusion 64] [--out DIR]
+    python3 scripts/albedo-report.py --curvature [--presets ...] [--reuse]
+
+`--curvature` measures the curvature correction instead (docs/accuracy.md,
+"Curvature correction"): spheres only, the diffusion estimator with
+`curvature_correction = "off"` and `"auto"` against the random walk.
+`--reuse` keeps random-walk renders already in DIR (they do not depend on
+the correction).
 
 Needs `cargo build --release --example image_mean` and the release binary.
 Prints a markdown table; renders stay in DIR (default out/albedo-report).
@@ -20,7 +27,7 @@ Prints a markdown table; renders stay in DIR (default out/albedo-report).
 import argparse, math, os, subprocess, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-LUCENT = os.path.join(ROOT, "target/release/lucent")
+LUCENT = os.environ.get("LUCENT", os.path.join(ROOT, "target/release/lucent"))
 MEAN = os.path.join(ROOT, "target/release/examples/image_mean")
 
 # Jensen et al. 2001 (src/bssrdf/params.rs PRESETS): sigma_s', sigma_a (1/mm).
@@ -50,9 +57,13 @@ def ld_max(name):
     return max(1.0 / math.sqrt(3 * a[c] * (s[c] + a[c])) for c in range(3) if a[c] > 0)
 
 
+CURVATURE = None  # set by --curvature: "auto" or "off" per render
+
+
 def material(name, source):
+    extra = f'curvature_correction = "{CURVATURE}"\n' if CURVATURE else ""
     return (f'[materials.m]\ntype = "subsurface"\npreset = "{name}"\n'
-            f'albedo_source = "{source}"\nrenormalize = true\n')
+            f'albedo_source = "{source}"\nrenormalize = true\n' + extra)
 
 
 def slab_scene(name, source, theta):
@@ -83,20 +94,24 @@ def sphere_scene(name, source, k):
     return text, (RES / 2, RES / 2, disk)
 
 
+REUSE = False
+
+
 def render(out, tag, text, spp, walk, disk=None):
     toml = os.path.join(out, tag + ".toml")
     exr = os.path.join(out, tag + ".exr")
-    with open(toml, "w") as f:
-        f.write(text)
-    cmd = [LUCENT, "render", toml, "-o", exr, "--spp", str(spp), "--seed", "1"]
-    if walk:
-        cmd += ["--integrator", "randomwalk"]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit(f"{' '.join(cmd)} failed:\n{r.stderr}")
     note = ""
-    if "capped" in r.stderr or "escaped" in r.stderr:
-        note = r.stderr.strip().splitlines()[-1]
+    if not (REUSE and walk and os.path.exists(exr)):
+        with open(toml, "w") as f:
+            f.write(text)
+        cmd = [LUCENT, "render", toml, "-o", exr, "--spp", str(spp), "--seed", "1"]
+        if walk:
+            cmd += ["--integrator", "randomwalk"]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            sys.exit(f"{' '.join(cmd)} failed:\n{r.stderr}")
+        if "capped" in r.stderr or "escaped" in r.stderr:
+            note = r.stderr.strip().splitlines()[-1]
     args = [MEAN, exr] + ([str(x) for x in disk] if disk else [])
     v = subprocess.run(args, capture_output=True, text=True, check=True).stdout.split()
     return [float(x) for x in v[:3]], [float(x) for x in v[3:6]], note
@@ -110,14 +125,43 @@ def fmt(r):
     return "/".join(f"{100 * x:+.1f}" for x in r)
 
 
+def curvature_report(a):
+    """Spheres at 4, 1, 0.25 ld: diffusion with the correction off / auto
+    against the random walk, per channel in per cent."""
+    global CURVATURE
+    print("| preset | ld (mm) | 4 ld: off | 4 ld: auto | 1 ld: off | 1 ld: auto "
+          "| 0.25 ld: off | 0.25 ld: auto |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name in a.presets.split(","):
+        cells = [name, f"{ld_max(name):.2f}"]
+        for k in (4.0, 1.0, 0.25):
+            CURVATURE = None
+            text, disk = sphere_scene(name, "table", k)
+            walk, _, _ = render(a.out, f"{name}-sphere{k}-walk", text, a.spp_walk, True, disk)
+            for mode in ("off", "auto"):
+                CURVATURE = mode
+                text, disk = sphere_scene(name, "table", k)
+                m, _, _ = render(a.out, f"{name}-sphere{k}-{mode}", text, a.spp_diffusion,
+                                 False, disk)
+                cells.append(fmt(rel(m, walk)))
+        print("| " + " | ".join(cells) + " |", flush=True)
+
+
 def main():
+    global REUSE
     ap = argparse.ArgumentParser()
     ap.add_argument("--presets", default="marble,skin1,wholemilk,ketchup,skin2,apple")
     ap.add_argument("--spp-walk", type=int, default=64)
     ap.add_argument("--spp-diffusion", type=int, default=64)
     ap.add_argument("--out", default=os.path.join(ROOT, "out/albedo-report"))
+    ap.add_argument("--curvature", action="store_true")
+    ap.add_argument("--reuse", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
+    REUSE = a.reuse
+    if a.curvature:
+        curvature_report(a)
+        return
     print("| preset | ld (mm) | slab: table A | slab: old A | 4 ld: table | 4 ld: old | 1 ld: table | 0.25 ld: table |")
     print("|---|---|---|---|---|---|---|---|")
     for name in a.presets.split(","):

@@ -473,6 +473,13 @@ fn cases() -> Vec<Case> {
             Some("materials.skin.boundary"),
         ),
         case(
+            "subsurface unknown curvature correction",
+            format!("{CAM}{SSS}preset = \"skin1\"\ncurvature_correction = \"always\"\n"),
+            "expected \"auto\" or \"off\", found \"always\"",
+            Some("always"),
+            Some("materials.skin.curvature_correction"),
+        ),
+        case(
             "subsurface unknown fit",
             format!("{CAM}{SSS}preset = \"skin1\"\nfit = \"dipole\"\n"),
             "unknown fit \"dipole\"",
@@ -708,6 +715,16 @@ fn cli_exits_2_on_scene_errors_without_writing_output() {
             format!("{CAM}{SSS}preset = \"skin1\"\nboundary = \"rough\"\n"),
             None,
             "scene.toml:8: field `materials.skin.boundary`: expected \"dielectric\" or \"diffuse\"",
+        ),
+        (
+            format!("{CAM}{SSS}preset = \"skin1\"\ncurvature_correction = 1\n"),
+            None,
+            "scene.toml:8: field `materials.skin.curvature_correction`",
+        ),
+        (
+            format!("{CAM}{SSS}preset = \"skin1\"\ncurvature_correction = \"sometimes\"\n"),
+            None,
+            "scene.toml:8: field `materials.skin.curvature_correction`: expected \"auto\" or \"off\"",
         ),
         (
             format!("{CAM}{SSS}preset = \"skin1\"\nroughness = 2\n"),

@@ -8,6 +8,9 @@
 //! - [`params`]: presets, measured and artist parameters → per-channel (A, d);
 //! - [`albedo_table`]: what a medium behind its boundary reflects, R(α', η),
 //!   the A that `params` uses by default;
+//! - [`curvature_table`], [`curvature_correction`]: what a convex body
+//!   returns beyond the half-space's profile, and the weight factor from
+//!   the surface's curvature that restores it;
 //! - [`dipole`]: the classical dipole's total diffuse reflectance;
 //! - [`radius`]: the four radius samplers with their disk pdfs;
 //! - [`probe`]: the probe-ray estimator: samples probe segments and weighs
@@ -40,6 +43,8 @@
 //! materials: the integrator's `probe` module runs the query.
 
 pub mod albedo_table;
+pub mod curvature_correction;
+pub mod curvature_table;
 pub mod density;
 pub mod dipole;
 pub mod fresnel_moment;

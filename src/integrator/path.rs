@@ -61,6 +61,7 @@ use super::interaction::offset_along;
 use super::probe::{exit_curvature, sample_entry, ProbeTarget};
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
+use crate::bssrdf::curvature_correction::mean_curvature;
 use crate::bssrdf::ProbeRandoms;
 use crate::film::passes::Pass;
 use crate::fresnel;
@@ -799,6 +800,16 @@ fn probe_entry<'s>(
         &target,
         &mut scratch.probe_hits,
     )?;
+    // The curvature correction (bssrdf::curvature_correction): None, and
+    // the weight untouched, on flat and concave surfaces.
+    let mut weight = ps.weight;
+    if let Some(cc) = ss.curvature_correction() {
+        let k_o = mean_curvature(target.mesh, si.prim);
+        let k_i = mean_curvature(target.mesh, ps.hit.prim);
+        if let Some(f) = cc.weight(k_o, k_i) {
+            weight *= f;
+        }
+    }
     let n_in = if si.front { ps.normal } else { -ps.normal };
     Some((
         Vertex {
@@ -808,7 +819,7 @@ fn probe_entry<'s>(
             wo_local: Vec3::Z,
             lobe: Lobe::SubsurfaceEntry(ss),
         },
-        ps.weight,
+        weight,
     ))
 }
 

@@ -11,7 +11,7 @@ pub mod subsurface;
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
-pub use subsurface::{Subsurface, SubsurfaceOverrides, WalkBoundary};
+pub use subsurface::{CurvatureMode, Subsurface, SubsurfaceOverrides, WalkBoundary};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {

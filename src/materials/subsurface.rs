@@ -26,6 +26,7 @@
 //! light is lost, for either roughness.
 
 use super::microfacet::{alpha_from_roughness, RoughCoat, SMOOTH_ALPHA};
+use crate::bssrdf::curvature_correction::CurvatureCorrection;
 use crate::bssrdf::{sw_normalization, ProbeOptions, ProbeSampler, SubsurfaceParams};
 use crate::error::{Constraint, Param, ParamError};
 use crate::geometry::Vec3;
@@ -48,6 +49,33 @@ pub struct Subsurface {
     coat: Option<RoughCoat>,
     /// c = 1 − 2 FM1(1/η), Sw's normalization (for a rough coat, 1 − Ē).
     sw_c: f32,
+    /// Whether the diffusion weight is corrected for the surface's
+    /// curvature (`bssrdf::curvature_correction`).
+    pub curvature_mode: CurvatureMode,
+    /// The correction, when the mode is on and the parameters record a
+    /// medium.
+    curvature: Option<CurvatureCorrection>,
+}
+
+/// The scene's `curvature_correction` setting.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CurvatureMode {
+    /// Correct the diffusion weight on convex surfaces (the default).
+    #[default]
+    Auto,
+    /// The half-space profile everywhere.
+    Off,
+}
+
+impl CurvatureMode {
+    /// "auto" or "off" (case-insensitive).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "auto" => Some(CurvatureMode::Auto),
+            "off" => Some(CurvatureMode::Off),
+            _ => None,
+        }
+    }
 }
 
 impl PartialEq for Subsurface {
@@ -58,6 +86,7 @@ impl PartialEq for Subsurface {
             && self.specular == o.specular
             && self.boundary == o.boundary
             && self.roughness == o.roughness
+            && self.curvature_mode == o.curvature_mode
     }
 }
 
@@ -69,6 +98,7 @@ impl Subsurface {
         specular: bool,
     ) -> Result<Self, ParamError> {
         let probe = ProbeSampler::new(&params, opts)?;
+        let curvature = curvature_for(&params, &probe, CurvatureMode::default());
         Ok(Subsurface {
             sw_c: sw_normalization(params.eta),
             params,
@@ -78,7 +108,21 @@ impl Subsurface {
             boundary: WalkBoundary::Dielectric,
             roughness: 0.0,
             coat: None,
+            curvature_mode: CurvatureMode::default(),
+            curvature,
         })
+    }
+
+    /// The material with the curvature correction `mode`.
+    pub fn with_curvature_mode(mut self, mode: CurvatureMode) -> Self {
+        self.curvature_mode = mode;
+        self.curvature = curvature_for(&self.params, &self.probe, mode);
+        self
+    }
+
+    /// The curvature correction of the diffusion weight, if on.
+    pub fn curvature_correction(&self) -> Option<&CurvatureCorrection> {
+        self.curvature.as_ref()
     }
 
     /// The material with a coat of `roughness` ∈ [0, 1] (NaN is refused);
@@ -130,6 +174,21 @@ impl Subsurface {
     pub fn albedo(&self) -> Vec3 {
         let a = self.params.albedo;
         Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
+    }
+}
+
+/// The correction for `mode`. The table is embedded and checked by the
+/// unit tests of `bssrdf::curvature_table`, so a failure to load it is a
+/// build defect, not bad input; the message names the file, line and field.
+fn curvature_for(
+    params: &SubsurfaceParams,
+    probe: &ProbeSampler,
+    mode: CurvatureMode,
+) -> Option<CurvatureCorrection> {
+    match mode {
+        CurvatureMode::Off => None,
+        CurvatureMode::Auto => CurvatureCorrection::new(params, probe)
+            .unwrap_or_else(|e| panic!("embedded curvature table: {e}")),
     }
 }
 
@@ -224,7 +283,8 @@ impl SubsurfaceOverrides {
             self.exit_sw.unwrap_or(ss.exit_sw),
             self.specular.unwrap_or(ss.specular),
         )?
-        .with_roughness(self.roughness.unwrap_or(ss.roughness))?;
+        .with_roughness(self.roughness.unwrap_or(ss.roughness))?
+        .with_curvature_mode(ss.curvature_mode);
         out.boundary = self.boundary.unwrap_or(ss.boundary);
         Ok(out)
     }

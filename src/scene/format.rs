@@ -178,6 +178,8 @@ pub struct MaterialDef {
     pub specular: Option<Spanned<bool>>,
     // subsurface: the random walk's boundary model
     pub boundary: Option<Spanned<String>>,
+    // subsurface: the diffusion weight's curvature correction
+    pub curvature_correction: Option<Spanned<String>>,
     pub roughness: Option<Spanned<f64>>,
 }
 
@@ -216,6 +218,10 @@ impl MaterialDef {
         add("exit_sw", self.exit_sw.as_ref().map(|x| x.span()));
         add("specular", self.specular.as_ref().map(|x| x.span()));
         add("boundary", self.boundary.as_ref().map(|x| x.span()));
+        add(
+            "curvature_correction",
+            self.curvature_correction.as_ref().map(|x| x.span()),
+        );
         add("roughness", self.roughness.as_ref().map(|x| x.span()));
         v
     }

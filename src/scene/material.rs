@@ -19,7 +19,7 @@ use crate::bssrdf::{
     SubsurfaceParams,
 };
 use crate::error::{Constraint, InputError, Param, ParamError};
-use crate::materials::{Material, Subsurface, WalkBoundary};
+use crate::materials::{CurvatureMode, Material, Subsurface, WalkBoundary};
 
 /// The keys a `type = "subsurface"` material accepts.
 const SUBSURFACE_KEYS: &[&str] = &[
@@ -41,6 +41,7 @@ const SUBSURFACE_KEYS: &[&str] = &[
     "specular",
     "boundary",
     "roughness",
+    "curvature_correction",
 ];
 
 /// The parameter forms, for messages.
@@ -106,6 +107,16 @@ pub(super) fn material(
                         format!("expected \"dielectric\" or \"diffuse\", found \"{s}\""),
                     )
                 })?;
+            }
+            if let Some((s, span)) = text(&d.curvature_correction) {
+                let mode = CurvatureMode::parse(s).ok_or_else(|| {
+                    cx.err(
+                        span,
+                        &format!("{field}.curvature_correction"),
+                        format!("expected \"auto\" or \"off\", found \"{s}\""),
+                    )
+                })?;
+                ss = ss.with_curvature_mode(mode);
             }
             check_rmax(cx, &field, m, &ss, units_per_mm, units_def)?;
             Ok(Material::Subsurface(Arc::new(ss)))

@@ -9,6 +9,8 @@
 //!   reference: error against time.
 //! - [`halfspace`]: the albedo table's generator — the random walk's
 //!   physics in a plane-parallel half-space (`docs/bssrdf.md` §9).
+//! - [`sphere_albedo`]: the curvature table's generator — the same physics
+//!   in a sphere, against the half-space (`docs/bssrdf.md` §10).
 //! - [`plot`]: the PNG canvas, font, palette and log axes both draw with.
 //!
 //! The rule: the tools use the renderer, never the other way round. No
@@ -19,4 +21,5 @@
 pub mod bench;
 pub mod halfspace;
 pub mod plot;
+pub mod sphere_albedo;
 pub mod study;

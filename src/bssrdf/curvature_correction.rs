@@ -1,0 +1,368 @@
+//! A curvature correction of the diffusion BSSRDF's weight
+//! (`docs/bssrdf.md` §10): the profile Rd describes a half-space, and on a
+//! convex body it returns too little light.
+//!
+//! **The deficit.** Under uniform light a sphere of radius R returns, per
+//! unit area, what the probe estimator integrates: ∫ Rd(|xo − xi|) dA over
+//! the sphere. With chord distance r = |xo − xi| the sphere's area element
+//! is exactly 2πr dr for r ≤ 2R (Archimedes' hat-box theorem), so the
+//! integral is A·CDF(min(2R, Rmax)) — the half-space's A·CDF(Rmax), less
+//! what lies beyond the sphere's diameter. The medium itself returns more
+//! than the half-space, A_sphere = 1 − h·(1 − A) with h < 1 the ratio of
+//! what the sphere and the half-space absorb ([`super::curvature_table`],
+//! computed by the random walk's physics). Neither d nor A can fix this:
+//! the deficit depends on the size of the body.
+//!
+//! **The correction.** At a point where the surface's mean curvature is
+//! κ > 0, read R = 1/κ and, per channel of diffusion length ℓd, ρ = R/ℓd:
+//!
+//! ```text
+//! f(κ) = A_sphere(ρ) / (A · g(R)),
+//! A_sphere(ρ) = 1 − h(ρ, √(1 − α'), η)·(1 − A),
+//! g(R) = CDF(min(2R, Rmax)) / CDF(Rmax),
+//! ```
+//!
+//! so that on a sphere under uniform light the estimator's mean becomes
+//! A_sphere (times the same truncation CDF(Rmax) as on a flat surface, or
+//! exactly A_sphere when renormalizing). The weight of a probe hit from
+//! exit point xo to entry point xi is multiplied by √(f(κo)·f(κi)), which
+//! keeps the BSSRDF symmetric in xo and xi (reciprocity), and is f(κ) on
+//! a sphere. f = 1 exactly where κ ≤ 0: flat or concave surfaces, and
+//! meshes without shading normals, are weighted as before, bit for bit.
+//!
+//! **Curvature** ([`mean_curvature`]): from a triangle's vertex positions
+//! p and shading normals n, the normal curvature along each edge,
+//! (n_i − n_j)·(p_i − p_j) / |p_i − p_j|² (exactly 1/R on a sphere whose
+//! normals are radial; positive where the normals spread, i.e. convex),
+//! averaged over the three edges: for a near-equilateral triangle the mean
+//! of the normal curvatures along three directions 60° apart is the mean
+//! curvature (κ1 + κ2)/2 (Euler), so a cylinder of radius R reads 1/(2R).
+//!
+//! **Precision and bound.** On a sphere under uniform light the corrected
+//! estimator's mean is the random walk's to the table's error (standard
+//! error of A_sphere in the data file's header, ≲ 2e-3, plus interpolation
+//! between nodes) — measured per preset in `docs/accuracy.md`. On other
+//! shapes and under directional light it is a first-order model: it
+//! rescales the half-space profile by how much more light the local
+//! curvature returns; it does not move light to the far side of a thin
+//! body (`docs/accuracy.md` reports the lit and dark halves). f is clamped
+//! to [[`MIN_FACTOR`], [`MAX_FACTOR`]], so every weight bound of the probe
+//! estimator (`ProbeAxes::weight_bound`) grows by at most [`MAX_FACTOR`].
+//! Media without a recorded medium (hand-built parameters) get no
+//! correction: α' and ℓd are unknown.
+
+use super::albedo_table::TableError;
+use super::curvature_table::CurvatureTable;
+use super::params::{diffuse_mfp, SubsurfaceParams};
+use super::probe::ProbeSampler;
+use super::profile;
+use crate::geometry::{Mesh, Vec3};
+
+/// The largest factor applied to a weight (on a body far smaller than the
+/// diffusion length, where the half-space profile has nothing left to
+/// rescale): the estimator's weight bounds grow by at most this.
+pub const MAX_FACTOR: f64 = 4.0;
+
+/// The smallest factor (h slightly above 1 within the table's noise on
+/// large bodies).
+pub const MIN_FACTOR: f64 = 0.9;
+
+/// The convex mean curvature of triangle `prim` of `mesh` (1/scene units)
+/// from its shading normals (module docs); 0 without shading normals, on
+/// flat or concave triangles, and for degenerate edges.
+pub fn mean_curvature(mesh: &Mesh, prim: u32) -> f32 {
+    let Some(normals) = &mesh.normals else {
+        return 0.0;
+    };
+    let idx = mesh.indices[prim as usize];
+    let p = mesh.vertices(idx);
+    let n = idx.map(|i| normals[i as usize]);
+    let (mut sum, mut edges) = (0.0f32, 0);
+    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+        let e = p[i] - p[j];
+        let len2 = e.length_squared();
+        if len2 > 0.0 {
+            let k = (n[i] - n[j]).dot(e) / len2;
+            if k.is_finite() {
+                sum += k;
+                edges += 1;
+            }
+        }
+    }
+    if edges == 0 {
+        0.0
+    } else {
+        (sum / edges as f32).max(0.0)
+    }
+}
+
+/// One channel's data: A, d, ℓd, and h at the table's ρ nodes.
+#[derive(Clone, Debug, PartialEq)]
+struct Channel {
+    albedo: f64,
+    d: f64,
+    ld: f64,
+    h: Vec<f64>,
+}
+
+/// The correction of one material (module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CurvatureCorrection {
+    table: &'static CurvatureTable,
+    /// None for an inactive channel (factor 1).
+    channels: [Option<Channel>; 3],
+    rmax: f64,
+    /// The longest active channel's ℓd: κ is tabulated as κ·ℓd.
+    ld_max: f64,
+    /// f per channel at κ·ℓd = 2^(LOG2_FIRST + j/STEPS_PER_OCTAVE),
+    /// j = 0 … LUT_LEN − 1 ([`Self::exact_factor`] at the nodes).
+    lut: Vec<[f32; 3]>,
+}
+
+/// The lookup table's first node, κ·ℓd = 2^LOG2_FIRST (a sphere of 1024
+/// diffusion lengths of the longest channel).
+const LOG2_FIRST: f32 = -10.0;
+/// 1 / 2^LOG2_FIRST.
+const FIRST_NODE_INV: f32 = 1024.0;
+/// Nodes per factor 2 in κ.
+const STEPS_PER_OCTAVE: f32 = 16.0;
+/// 2^-10 … 2^6 (a sphere of 1/64 ℓd, where f is at its clamp).
+const LUT_LEN: usize = 16 * 16 + 1;
+
+impl CurvatureCorrection {
+    /// The correction for `params` sampled by `sampler` (its Rmax); None
+    /// when the parameters record no medium. Err only if the embedded
+    /// table does not load (a build defect; the message names the line).
+    pub fn new(
+        params: &SubsurfaceParams,
+        sampler: &ProbeSampler,
+    ) -> Result<Option<Self>, &'static TableError> {
+        let table = CurvatureTable::get()?;
+        let Some(m) = params.medium else {
+            return Ok(None);
+        };
+        let channels = std::array::from_fn(|c| {
+            if !params.active(c) {
+                return None;
+            }
+            let ss = m.sigma_s[c] * (1.0 - m.g);
+            let sa = m.sigma_a[c];
+            let alpha = ss / (ss + sa);
+            // Media that absorb nothing clamp to the table's first x node.
+            let x = (1.0 - alpha).max(0.0).sqrt();
+            Some(Channel {
+                albedo: params.albedo[c],
+                d: params.d[c],
+                ld: diffuse_mfp(ss, sa),
+                h: table.row(x, params.eta as f64),
+            })
+        });
+        let ld_max = channels
+            .iter()
+            .flatten()
+            .map(|c: &Channel| c.ld)
+            .fold(0.0, f64::max);
+        let mut cc = CurvatureCorrection {
+            table,
+            channels,
+            rmax: sampler.rmax(),
+            ld_max,
+            lut: Vec::new(),
+        };
+        if ld_max > 0.0 && ld_max.is_finite() {
+            cc.lut = (0..LUT_LEN)
+                .map(|j| {
+                    let kl = (LOG2_FIRST + j as f32 / STEPS_PER_OCTAVE).exp2() as f64;
+                    cc.exact_factor(kl / ld_max).map(|f| f as f32)
+                })
+                .collect();
+        }
+        Ok(Some(cc))
+    }
+
+    /// f(κ) per channel from the lookup table: linear in log2 κ between
+    /// nodes (relative error against [`Self::exact_factor`] below 2e-3,
+    /// 1e-2 next to the clamp at [`MAX_FACTOR`]; tested), linear in κ from 1 at κ = 0 to the first node (the
+    /// table's first-order tail), the last node beyond the last. Exactly
+    /// 1 for κ ≤ 0 (and NaN).
+    pub fn factor(&self, kappa: f32) -> [f32; 3] {
+        let kl = kappa * self.ld_max as f32;
+        if kl.is_nan() || kl <= 0.0 || self.lut.is_empty() {
+            return [1.0; 3];
+        }
+        let t = (kl.log2() - LOG2_FIRST) * STEPS_PER_OCTAVE;
+        if t <= 0.0 {
+            // kl / 2^LOG2_FIRST ∈ (0, 1]
+            let w = kl * FIRST_NODE_INV;
+            return self.lut[0].map(|f| 1.0 + (f - 1.0) * w);
+        }
+        let last = LUT_LEN - 1;
+        if t >= last as f32 {
+            return self.lut[last];
+        }
+        let j = t as usize;
+        let w = t - j as f32;
+        let (a, b) = (self.lut[j], self.lut[j + 1]);
+        std::array::from_fn(|c| a[c] + (b[c] - a[c]) * w)
+    }
+
+    /// f(κ) per channel, for a mean curvature κ (1/scene units), by the
+    /// equations of the module docs; exactly 1 for κ ≤ 0 and inactive
+    /// channels.
+    pub fn exact_factor(&self, k: f64) -> [f64; 3] {
+        if k.is_nan() || k <= 0.0 {
+            return [1.0; 3];
+        }
+        std::array::from_fn(|c| match &self.channels[c] {
+            None => 1.0,
+            Some(ch) => {
+                let radius = 1.0 / k;
+                let h = self.table.at_rho(&ch.h, radius / ch.ld);
+                let a_sphere = 1.0 - h * (1.0 - ch.albedo);
+                let g = profile::cdf((2.0 * radius).min(self.rmax), ch.d)
+                    / profile::cdf(self.rmax, ch.d);
+                let f = a_sphere / (ch.albedo * g);
+                if f.is_finite() {
+                    f.clamp(MIN_FACTOR, MAX_FACTOR)
+                } else {
+                    MAX_FACTOR
+                }
+            }
+        })
+    }
+
+    /// The factor of a probe hit from a point of curvature `kappa_o` to
+    /// one of curvature `kappa_i`: √(f(κo)·f(κi)) per channel; None when
+    /// both are ≤ 0 (the weight stays as it is, bit for bit).
+    pub fn weight(&self, kappa_o: f32, kappa_i: f32) -> Option<Vec3> {
+        if !(kappa_o > 0.0 || kappa_i > 0.0) {
+            return None;
+        }
+        let (fo, fi) = (self.factor(kappa_o), self.factor(kappa_i));
+        Some(Vec3::new(
+            (fo[0] * fi[0]).sqrt(),
+            (fo[1] * fi[1]).sqrt(),
+            (fo[2] * fi[2]).sqrt(),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bssrdf::{Fit, ProbeOptions};
+
+    fn marble(scale: f64) -> (SubsurfaceParams, CurvatureCorrection) {
+        let p = SubsurfaceParams::from_preset("marble", scale, Fit::Searchlight).unwrap();
+        let s = ProbeSampler::new(&p, &ProbeOptions::default()).unwrap();
+        (p, CurvatureCorrection::new(&p, &s).unwrap().unwrap())
+    }
+
+    #[test]
+    fn flat_and_concave_surfaces_are_untouched() {
+        let (_, cc) = marble(1.0);
+        assert_eq!(cc.factor(0.0), [1.0; 3]);
+        assert_eq!(cc.factor(-0.3), [1.0; 3]);
+        assert_eq!(cc.factor(f32::NAN), [1.0; 3]);
+        assert_eq!(cc.weight(0.0, 0.0), None);
+        assert_eq!(cc.weight(-1.0, 0.0), None);
+        // a curvature far below 1/ℓd: f → 1 continuously
+        let f = cc.factor(1e-7);
+        assert!(f.iter().all(|&v| (v - 1.0).abs() < 1e-4), "{f:?}");
+    }
+
+    /// On a sphere f is what turns the estimator's mean A·g(R) into the
+    /// table's A_sphere, it exceeds 1 and grows as the sphere shrinks, and
+    /// the hit's factor is symmetric in xo and xi.
+    #[test]
+    fn factor_restores_the_sphere_albedo() {
+        let (p, cc) = marble(1.0);
+        let t = CurvatureTable::get().unwrap();
+        let m = p.medium.unwrap();
+        let ld: [f64; 3] = std::array::from_fn(|c| diffuse_mfp(m.sigma_s[c], m.sigma_a[c]));
+        let ld_max = ld.iter().cloned().fold(0.0, f64::max);
+        let mut prev = [0.0; 3];
+        for k in [4.0, 1.0, 0.25] {
+            let radius = k * ld_max;
+            let f = cc.exact_factor(1.0 / radius);
+            for c in 0..3 {
+                let alpha = m.sigma_s[c] / (m.sigma_s[c] + m.sigma_a[c]);
+                let h = t.h(radius / ld[c], (1.0 - alpha).sqrt(), p.eta as f64);
+                let want = 1.0 - h * (1.0 - p.albedo[c]);
+                let mean = p.albedo[c] * profile::cdf((2.0 * radius).min(cc.rmax), p.d[c])
+                    / profile::cdf(cc.rmax, p.d[c]);
+                let got = mean * f[c];
+                if f[c] < MAX_FACTOR {
+                    assert!(
+                        (got - want).abs() < 1e-4 * want,
+                        "k {k} c {c}: {got} vs {want}"
+                    );
+                }
+                assert!(
+                    f[c] > 1.0 && f[c] > prev[c],
+                    "k {k} c {c}: {f:?} after {prev:?}"
+                );
+            }
+            prev = f;
+        }
+        let w = cc.weight(0.3, 0.05).unwrap();
+        assert_eq!(w, cc.weight(0.05, 0.3).unwrap());
+        let (fo, fi) = (cc.factor(0.3), cc.factor(0.05));
+        assert!((w.x - (fo[0] * fi[0]).sqrt()).abs() < 1e-6);
+    }
+
+    /// The lookup the renderer uses against the equations, over curvatures
+    /// from a sphere of 10⁵ diffusion lengths to one of 1/100, for two
+    /// materials (marble, skin1) at two scales.
+    #[test]
+    fn lookup_matches_the_exact_factor() {
+        for (name, scale) in [("marble", 1.0), ("skin1", 1.0), ("skin1", 0.01)] {
+            let p = SubsurfaceParams::from_preset(name, scale, Fit::Searchlight).unwrap();
+            let s = ProbeSampler::new(&p, &ProbeOptions::default()).unwrap();
+            let cc = CurvatureCorrection::new(&p, &s).unwrap().unwrap();
+            let mut worst = 0.0f64;
+            for i in 0..=2000 {
+                let kl = 10f64.powf(-5.0 + 7.0 * i as f64 / 2000.0);
+                let k = kl / cc.ld_max;
+                let (got, want) = (cc.factor(k as f32), cc.exact_factor(k));
+                for c in 0..3 {
+                    let e = (got[c] as f64 / want[c] - 1.0).abs();
+                    // Next to the clamp at MAX_FACTOR f has a kink that
+                    // linear interpolation rounds off: 1 % there.
+                    if want[c] > 0.9 * MAX_FACTOR {
+                        assert!(e < 1e-2, "{name}: κℓd {kl:e} ch{c}: {got:?} vs {want:?}");
+                    } else {
+                        worst = worst.max(e);
+                    }
+                }
+            }
+            assert!(worst < 2e-3, "{name} at {scale}: {worst}");
+        }
+    }
+
+    #[test]
+    fn mean_curvature_of_a_sphere_and_a_flat_mesh() {
+        let r = 2.5f32;
+        // one triangle of a sphere of radius r, radial normals
+        let dirs = [
+            Vec3::new(1.0, 0.1, 0.0).normalize(),
+            Vec3::new(0.9, 0.3, 0.2).normalize(),
+            Vec3::new(0.95, 0.0, 0.3).normalize(),
+        ];
+        let mesh = Mesh::new(
+            dirs.map(|d| d * r).to_vec(),
+            vec![[0, 1, 2]],
+            Some(dirs.to_vec()),
+        );
+        assert!((mean_curvature(&mesh, 0) * r - 1.0).abs() < 1e-4);
+        // the same triangle seen from inside (normals flipped): concave, 0
+        let inside = Mesh::new(
+            dirs.map(|d| d * r).to_vec(),
+            vec![[0, 1, 2]],
+            Some(dirs.map(|d| -d).to_vec()),
+        );
+        assert_eq!(mean_curvature(&inside, 0), 0.0);
+        let flat = Mesh::new(dirs.map(|d| d * r).to_vec(), vec![[0, 1, 2]], None);
+        assert_eq!(mean_curvature(&flat, 0), 0.0);
+    }
+}

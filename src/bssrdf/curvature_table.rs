@@ -1,0 +1,278 @@
+//! What a convex body absorbs against the half-space of the same medium
+//! (`docs/bssrdf.md` §10): a table of
+//!
+//! ```text
+//! h(ρ, x, η) = (1 − A_sphere) / (1 − A_slab),    x = √(1 − α'),
+//! ```
+//!
+//! the ratio of the fractions of entering diffuse light that a sphere of
+//! radius ρ diffusion lengths (ℓd = 1/σtr) and the half-space absorb, both
+//! behind a smooth dielectric of index η, computed by the random walk's
+//! own physics (generator `tools::sphere_albedo`, run by
+//! `examples/curvature_table.rs`; the data file's header states its seed,
+//! walk counts and largest errors). A convex body absorbs less than the
+//! half-space (h < 1): light that would have wandered into the depth of a
+//! half-space meets the boundary of the curved body sooner and leaves.
+//!
+//! **Why h.** As α' → 1, A_sphere and A_slab both tend to 1 and their
+//! ratio to 1, while the ratio of what they absorb tends to a function of
+//! ρ alone (diffusion theory has no other length); h varies little with x
+//! at fixed ρ (compare the rows of the data file), so linear interpolation
+//! in x is accurate, and x below the first node is clamped to it.
+//!
+//! **Interpolation.** Linear in η, in x and in ln ρ between nodes. Outside
+//! the grid: η and x are clamped to it; below the smallest ρ, h is taken
+//! at the smallest ρ; beyond the largest ρ_N, h = 1 − (1 − h(ρ_N))·ρ_N/ρ,
+//! first order in the curvature 1/ρ, so h → 1 (the half-space) as the
+//! curvature vanishes.
+
+use std::sync::OnceLock;
+
+use super::albedo_table::TableError;
+
+/// The data file, embedded.
+pub const DATA: &str = include_str!("curvature_table.csv");
+
+/// Where the data file is, for messages.
+pub const DATA_PATH: &str = "src/bssrdf/curvature_table.csv";
+
+/// The data file's columns, in order.
+pub const COLUMNS: [&str; 7] = ["eta", "x", "rho", "h", "se_h", "a_sphere", "a_slab"];
+
+/// h on a regular grid in (η, x, ln ρ).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CurvatureTable {
+    pub etas: Vec<f64>,
+    pub xs: Vec<f64>,
+    pub rhos: Vec<f64>,
+    /// h, indexed `[i_eta][i_x][i_rho]`.
+    pub h: Vec<Vec<Vec<f64>>>,
+    /// The largest standard error of 1 − h·(1 − A_slab) = A_sphere.
+    pub max_se_sphere: f64,
+}
+
+/// The index i of the cell [v[i], v[i+1]] holding `t` (clamped to the
+/// grid) and the weight of v[i+1].
+fn cell(v: &[f64], t: f64) -> (usize, f64) {
+    let n = v.len();
+    if t <= v[0] {
+        return (0, 0.0);
+    }
+    if t >= v[n - 1] {
+        return (n - 2, 1.0);
+    }
+    let i = v.partition_point(|&x| x <= t).clamp(1, n - 1) - 1;
+    (i, (t - v[i]) / (v[i + 1] - v[i]))
+}
+
+impl CurvatureTable {
+    /// The embedded table, parsed once.
+    pub fn get() -> Result<&'static CurvatureTable, &'static TableError> {
+        static TABLE: OnceLock<Result<CurvatureTable, TableError>> = OnceLock::new();
+        TABLE
+            .get_or_init(|| CurvatureTable::parse(DATA, DATA_PATH))
+            .as_ref()
+    }
+
+    /// Parses the CSV text: `#` comment lines, a header naming
+    /// [`COLUMNS`], then rows sorted by η, then x, then ρ, on a full grid
+    /// (each increasing, at least two nodes each).
+    pub fn parse(text: &str, file: &'static str) -> Result<CurvatureTable, TableError> {
+        let err = |line: usize, field: &str, problem: String| TableError {
+            file,
+            line,
+            field: field.to_string(),
+            problem,
+        };
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| (i + 1, l.trim()))
+            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+        let (hl, header) = lines
+            .next()
+            .ok_or_else(|| err(0, "header", "no header line".into()))?;
+        let names: Vec<&str> = header.split(',').map(str::trim).collect();
+        if names != COLUMNS {
+            return Err(err(hl, "header", format!("expected {}", COLUMNS.join(","))));
+        }
+        let mut rows: Vec<(usize, [f64; 7])> = Vec::new();
+        for (ln, l) in lines {
+            let f: Vec<&str> = l.split(',').map(str::trim).collect();
+            if f.len() != COLUMNS.len() {
+                return Err(err(
+                    ln,
+                    "row",
+                    format!("{} fields, expected {}", f.len(), COLUMNS.len()),
+                ));
+            }
+            let mut v = [0.0; 7];
+            for (k, s) in f.iter().enumerate() {
+                v[k] = s
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| err(ln, COLUMNS[k], format!("not a finite number: \"{s}\"")))?;
+            }
+            let ok = [
+                v[0] >= 1.0,
+                v[1] > 0.0 && v[1] <= 1.0,
+                v[2] > 0.0,
+                v[3] >= 0.0,
+                v[4] >= 0.0,
+                (0.0..=1.0).contains(&v[5]),
+                (0.0..=1.0).contains(&v[6]),
+            ];
+            if let Some(k) = ok.iter().position(|&o| !o) {
+                return Err(err(ln, COLUMNS[k], format!("{} out of range", v[k])));
+            }
+            rows.push((ln, v));
+        }
+        let distinct = |k: usize| {
+            let mut out: Vec<f64> = Vec::new();
+            for (_, v) in &rows {
+                if !out.contains(&v[k]) {
+                    out.push(v[k]);
+                }
+            }
+            out
+        };
+        let (etas, xs, rhos) = (distinct(0), distinct(1), distinct(2));
+        let (ne, nx, nr) = (etas.len(), xs.len(), rhos.len());
+        let last = rows.last().map_or(hl, |r| r.0);
+        if ne < 2 || nx < 2 || nr < 2 || ne * nx * nr != rows.len() {
+            return Err(err(
+                last,
+                "row",
+                format!(
+                    "{} rows do not form a grid over {ne} eta, {nx} x, {nr} rho",
+                    rows.len()
+                ),
+            ));
+        }
+        for (name, v) in [("eta", &etas), ("x", &xs), ("rho", &rhos)] {
+            if v.windows(2).any(|w| w[1] <= w[0]) {
+                return Err(err(last, name, "not increasing".into()));
+            }
+        }
+        let mut h = vec![vec![vec![0.0; nr]; nx]; ne];
+        let mut max_se_sphere = 0.0f64;
+        for (n, (ln, v)) in rows.iter().enumerate() {
+            let (ie, ix, ir) = (n / (nx * nr), (n / nr) % nx, n % nr);
+            for (k, want) in [(0, etas[ie]), (1, xs[ix]), (2, rhos[ir])] {
+                if v[k] != want {
+                    return Err(err(
+                        *ln,
+                        COLUMNS[k],
+                        format!("expected {want} (rows sorted by eta, x, rho)"),
+                    ));
+                }
+            }
+            h[ie][ix][ir] = v[3];
+            max_se_sphere = max_se_sphere.max(v[4] * (1.0 - v[6]));
+        }
+        Ok(CurvatureTable {
+            etas,
+            xs,
+            rhos,
+            h,
+            max_se_sphere,
+        })
+    }
+
+    /// h at the table's ρ nodes for one medium (x, η interpolated,
+    /// clamped to the grid): the row a material keeps.
+    pub fn row(&self, x: f64, eta: f64) -> Vec<f64> {
+        let (ie, se) = cell(&self.etas, eta);
+        let (ix, sx) = cell(&self.xs, x);
+        (0..self.rhos.len())
+            .map(|ir| {
+                let at = |e: usize, i: usize| self.h[e][i][ir];
+                let lo = at(ie, ix) * (1.0 - sx) + at(ie, ix + 1) * sx;
+                let hi = at(ie + 1, ix) * (1.0 - sx) + at(ie + 1, ix + 1) * sx;
+                lo * (1.0 - se) + hi * se
+            })
+            .collect()
+    }
+
+    /// h(ρ) from a [`row`](Self::row): linear in ln ρ between nodes,
+    /// clamped below the grid, 1 − (1 − h_N)·ρ_N/ρ beyond it (module docs).
+    pub fn at_rho(&self, row: &[f64], rho: f64) -> f64 {
+        let n = self.rhos.len();
+        let last = self.rhos[n - 1];
+        if rho >= last {
+            return 1.0 - (1.0 - row[n - 1]) * last / rho;
+        }
+        if rho <= self.rhos[0] {
+            return row[0];
+        }
+        let i = self.rhos.partition_point(|&r| r <= rho).clamp(1, n - 1) - 1;
+        let t = (rho / self.rhos[i]).ln() / (self.rhos[i + 1] / self.rhos[i]).ln();
+        row[i] * (1.0 - t) + row[i + 1] * t
+    }
+
+    /// h(ρ, x, η).
+    pub fn h(&self, rho: f64, x: f64, eta: f64) -> f64 {
+        self.at_rho(&self.row(x, eta), rho)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn embedded_table_parses_and_is_physical() {
+        let t = CurvatureTable::get().expect("embedded table");
+        assert!(t.etas.len() >= 2 && t.xs.len() >= 2 && t.rhos.len() >= 2);
+        // A convex body absorbs less than the half-space, and the less the
+        // larger it is: h < 1 at the smallest sphere, rising with ρ.
+        for (ie, row_e) in t.h.iter().enumerate() {
+            for (ix, row) in row_e.iter().enumerate() {
+                assert!(row[0] < 0.5, "eta {} x {}: {row:?}", t.etas[ie], t.xs[ix]);
+                let big = *row.last().unwrap();
+                assert!(
+                    big > 0.85 && big < 1.06,
+                    "eta {} x {}: {big}",
+                    t.etas[ie],
+                    t.xs[ix]
+                );
+            }
+        }
+        assert!(t.max_se_sphere < 3e-3, "{}", t.max_se_sphere);
+    }
+
+    #[test]
+    fn interpolation_hits_nodes_and_tends_to_one() {
+        let t = CurvatureTable::get().unwrap();
+        let (ie, ix, ir) = (1, 2, 5);
+        let h = t.h(t.rhos[ir], t.xs[ix], t.etas[ie]);
+        assert!((h - t.h[ie][ix][ir]).abs() < 1e-12);
+        let row = t.row(t.xs[ix], t.etas[ie]);
+        // continuous at the last node, → 1 as ρ → ∞
+        let n = t.rhos.len() - 1;
+        assert!((t.at_rho(&row, t.rhos[n]) - row[n]).abs() < 1e-12);
+        assert!((t.at_rho(&row, 1e12) - 1.0).abs() < 1e-9);
+        // between two nodes: between their values
+        let mid = t.at_rho(&row, (t.rhos[3] * t.rhos[4]).sqrt());
+        assert!(mid >= row[3].min(row[4]) && mid <= row[3].max(row[4]));
+    }
+
+    #[test]
+    fn bad_files_name_line_and_field() {
+        let head = "eta,x,rho,h,se_h,a_sphere,a_slab\n";
+        let e = CurvatureTable::parse("eta,x\n", "f.csv").unwrap_err();
+        assert_eq!((e.line, e.field.as_str()), (1, "header"));
+        let e = CurvatureTable::parse(&format!("{head}1.0,0.5,1.0,nan,0,0.5,0.4\n"), "f.csv")
+            .unwrap_err();
+        assert_eq!((e.line, e.field.as_str()), (2, "h"));
+        let e = CurvatureTable::parse(&format!("{head}1.0,0.5,1.0,0.5,0,1.5,0.4\n"), "f.csv")
+            .unwrap_err();
+        assert_eq!((e.line, e.field.as_str()), (2, "a_sphere"));
+        // three rows cannot fill a 2×2×2 grid
+        let rows = "1.0,0.5,1,0.5,0,0.5,0.4\n1.0,0.5,2,0.6,0,0.5,0.4\n2.0,0.5,1,0.5,0,0.5,0.4\n";
+        let e = CurvatureTable::parse(&format!("{head}{rows}"), "f.csv").unwrap_err();
+        assert_eq!((e.line, e.field.as_str()), (4, "row"));
+        assert!(e.to_string().starts_with("f.csv:4: row:"));
+    }
+}
