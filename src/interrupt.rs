@@ -59,6 +59,14 @@ pub fn requested() -> Option<i32> {
     }
 }
 
+/// [`crate::Error::Interrupted`] once a signal asked the process to stop.
+pub fn stop_if_requested() -> Result<(), crate::Error> {
+    match requested() {
+        Some(sig) => Err(crate::Error::Interrupted(sig)),
+        None => Ok(()),
+    }
+}
+
 /// Records `signal` as if it had been received (the first one wins): for
 /// callers that stop work for their own reasons, and for tests.
 pub fn request(signal: i32) {

@@ -9,7 +9,9 @@ use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
 use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
-use lucent::error::{Param, ParamError};
+use lucent::error::{InputError, Param, ParamError};
+use lucent::farm::part::{self, Identity};
+use lucent::film::region::Region;
 use lucent::film::ToneMap;
 use lucent::integrator::IntegratorKind;
 use lucent::materials::{SubsurfaceOverrides, WalkBoundary};
@@ -85,6 +87,30 @@ enum Command {
         integrator: IntegratorArg,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
+        #[command(flatten)]
+        split: SplitArgs,
+    },
+    /// Merge parts (`render --crop/--tile/--samples`) into the frame they
+    /// split: bitwise the frame one uncut render gives. Checks that they
+    /// are of one scene, seed, spp, options and lucent version and cover
+    /// the frame's pixels and samples exactly once; writes the EXR and its
+    /// PNG preview, or nothing.
+    Merge {
+        /// The part files.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output OpenEXR path; the preview goes to the same path with `.png`.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Tone map of the PNG preview (the EXR is always linear).
+        #[arg(long, value_enum, default_value = "filmic")]
+        tonemap: ToneMap,
+        /// Exposure of the PNG preview in stops.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        exposure: f32,
+        /// No summary line.
+        #[arg(short, long)]
+        quiet: bool,
     },
     /// Benchmark the ray-query backends on the same meshes and rays: build
     /// time and memory, Mrays/s of camera, incoherent, shadow and probe
@@ -98,6 +124,62 @@ enum Command {
     /// subsurface estimator: results.csv, plots and report.md in the output
     /// directory (resumes from results.csv; see src/tools/study/mod.rs).
     Study(StudyArgs),
+}
+
+/// Splitting a frame into parts, checkpoints and resuming (docs/farm.md).
+#[derive(clap::Args)]
+struct SplitArgs {
+    /// Render only the pixels X0 ≤ x < X1, Y0 ≤ y < Y1; the output is a
+    /// part for `lucent merge`.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop, conflicts_with = "tile")]
+    crop: Option<Region>,
+    /// Render band I (0-based) of N balanced horizontal bands; the output
+    /// is a part for `lucent merge`.
+    #[arg(long, value_name = "I/N", value_parser = parse_tile)]
+    tile: Option<(u32, u32)>,
+    /// Render only the sample indices A ≤ s < B of each pixel; the output
+    /// is a part for `lucent merge`.
+    #[arg(long, value_name = "A..B", value_parser = parse_samples)]
+    samples: Option<std::ops::Range<u32>>,
+    /// Every SECONDS (at the end of a pass), save the finished samples to
+    /// OUT.partial.exr, atomically, for --resume.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_checkpoint)]
+    checkpoint: Option<f64>,
+    /// Continue from a part this same render left (at a signal or a
+    /// checkpoint): the result is bitwise the uninterrupted render's.
+    #[arg(long, value_name = "PART.exr")]
+    resume: Option<PathBuf>,
+}
+
+impl SplitArgs {
+    /// Whether the output is a part rather than a frame.
+    fn is_part(&self) -> bool {
+        self.crop.is_some() || self.tile.is_some() || self.samples.is_some()
+    }
+}
+
+fn parse_crop(s: &str) -> Result<Region, String> {
+    Region::parse(s)
+        .filter(|r| !r.is_empty())
+        .ok_or_else(|| format!("expected X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1, found \"{s}\""))
+}
+
+fn parse_tile(s: &str) -> Result<(u32, u32), String> {
+    s.split_once('/')
+        .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)))
+        .filter(|&(i, n)| i < n)
+        .ok_or_else(|| format!("expected I/N with 0 ≤ I < N, found \"{s}\""))
+}
+
+fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
+    part::parse_samples(s).ok_or_else(|| format!("expected A..B with A < B, found \"{s}\""))
+}
+
+fn parse_checkpoint(s: &str) -> Result<f64, String> {
+    s.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("expected a positive number of seconds, found \"{s}\""))
 }
 
 /// Subsurface sampling choices that override every subsurface material's
@@ -202,6 +284,7 @@ fn main() -> ExitCode {
             quiet,
             integrator,
             subsurface,
+            split,
         } => {
             let backend = accel
                 .map(Backend::from)
@@ -223,11 +306,19 @@ fn main() -> ExitCode {
                 backend,
                 &opts,
                 &subsurface.overrides(),
+                &split,
                 tonemap,
                 exposure,
                 quiet,
             )
         }
+        Command::Merge {
+            parts,
+            output,
+            tonemap,
+            exposure,
+            quiet,
+        } => run_merge(&parts, &output, tonemap, exposure, quiet),
         Command::Study(args) => run_study(args),
         Command::Bench(args) => run_bench(args),
         Command::Info => {
@@ -239,7 +330,9 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             let shown = match lucent::interrupt::requested() {
-                Some(sig) if !matches!(e, Error::Interrupted(_)) => {
+                Some(sig)
+                    if !matches!(e, Error::Interrupted(_) | Error::InterruptedKept { .. }) =>
+                {
                     Error::Interrupted(sig).to_string()
                 }
                 _ => e.to_string(),
@@ -281,17 +374,8 @@ fn option_error(e: ParamError) -> Error {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn run_render(
-    scene_path: &Path,
-    output: &Path,
-    backend: Backend,
-    opts: &RenderOptions,
-    overrides: &SubsurfaceOverrides,
-    tonemap: ToneMap,
-    exposure: f32,
-    quiet: bool,
-) -> Result<(), Error> {
+/// An output path that ends in `.exr` and lies in an existing directory.
+fn check_exr_output(output: &Path) -> Result<(), Error> {
     if output
         .extension()
         .and_then(|e| e.to_str())
@@ -313,6 +397,28 @@ fn run_render(
             problem: "does not exist".into(),
         });
     }
+    Ok(())
+}
+
+/// Where a render keeps its finished samples for `--resume` (at a signal,
+/// at checkpoints): `OUT.partial.exr` beside `OUT.exr`.
+fn checkpoint_path(output: &Path) -> PathBuf {
+    output.with_extension("partial.exr")
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_render(
+    scene_path: &Path,
+    output: &Path,
+    backend: Backend,
+    opts: &RenderOptions,
+    overrides: &SubsurfaceOverrides,
+    split: &SplitArgs,
+    tonemap: ToneMap,
+    exposure: f32,
+    quiet: bool,
+) -> Result<(), Error> {
+    check_exr_output(output)?;
     if opts.spp == Some(0) {
         return Err(Error::Argument {
             argument: "--spp".into(),
@@ -326,26 +432,188 @@ fn run_render(
         });
     }
     let mut scene = scene::load(scene_path)?;
+    let scene_bytes = scene::load::read_regular_file(scene_path, scene::load::MAX_SCENE_BYTES)
+        .map_err(|e| InputError::new(scene_path, format!("cannot read scene file: {e}")))?;
     overrides
         .apply_all(&mut scene.materials)
         .map_err(option_error)?;
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let spp = opts.spp.unwrap_or(scene.settings.spp);
+    let region = match (split.crop, split.tile) {
+        (Some(c), _) if !c.within(&Region::full(w, h)) => {
+            return Err(Error::Argument {
+                argument: "--crop".into(),
+                problem: format!("{c} is not inside the {w}×{h} frame"),
+            })
+        }
+        (Some(c), _) => c,
+        (None, Some((i, n))) => Region::band(i, n, w, h).ok_or_else(|| Error::Argument {
+            argument: "--tile".into(),
+            problem: format!("{i}/{n}: the {w}×{h} frame splits into at most {h} bands"),
+        })?,
+        (None, None) => Region::full(w, h),
+    };
+    let samples = split.samples.clone().unwrap_or(0..spp);
+    if samples.end > spp {
+        return Err(Error::Argument {
+            argument: "--samples".into(),
+            problem: format!(
+                "{}..{} reaches beyond the {spp} samples per pixel",
+                samples.start, samples.end
+            ),
+        });
+    }
+    let identity = Identity {
+        version: env!("CARGO_PKG_VERSION").into(),
+        scene_hash: lucent::farm::scene_hash(scene_bytes.as_bytes(), &scene),
+        seed: opts.seed.unwrap_or(scene.settings.seed),
+        spp,
+        options: format!(
+            "accel={} integrator={:?} {overrides:?}",
+            backend.name(),
+            opts.integrator
+        ),
+        frame: (w, h),
+    };
+    let scene_name = scene_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let header = |sums: &render::Accumulated| part::Header {
+        identity: identity.clone(),
+        scene: scene_name.clone(),
+        region,
+        samples: sums.start..sums.done,
+        requested: samples.clone(),
+        layers: vec![part::beauty_layer()],
+        counters: sums.counters,
+    };
+    let job = render::Job {
+        region,
+        samples: samples.clone(),
+        pass_seconds: split.checkpoint.map_or(2.0, |c| (c / 2.0).min(2.0)),
+    };
+    let resume = match &split.resume {
+        Some(p) => Some(resumable(p, &identity, &job)?),
+        None => None,
+    };
     stop_if_interrupted()?;
     let accel = accel::build(&scene.meshes, backend)?;
     stop_if_interrupted()?;
-    let (film, stats) = render::render(&scene, accel.as_ref(), opts)?;
-    film.write_exr_and_preview(output, tonemap, exposure)?;
+    let keep = checkpoint_path(output);
+    let mut last = std::time::Instant::now();
+    let mut checkpoint = |sums: &render::Accumulated| -> Result<(), Error> {
+        match split.checkpoint {
+            Some(every) if last.elapsed().as_secs_f64() >= every && sums.done < samples.end => {
+                lucent::film::commit_all(vec![part::stage(&keep, &header(sums), sums)?])?;
+                last = std::time::Instant::now();
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    };
+    let r = render::render_job(&scene, accel.as_ref(), opts, &job, resume, &mut checkpoint)?;
+    if let Some(signal) = r.interrupted {
+        if r.sums.count() == 0 {
+            return Err(Error::Interrupted(signal));
+        }
+        let staged = part::stage(&keep, &header(&r.sums), &r.sums)?;
+        lucent::film::commit_even_if_interrupted(vec![staged])?;
+        return Err(Error::InterruptedKept {
+            signal,
+            part: keep,
+            samples: r.sums.start..r.sums.done,
+            requested: samples,
+        });
+    }
+    if split.is_part() {
+        lucent::film::commit_all(vec![part::stage(output, &header(&r.sums), &r.sums)?])?;
+    } else {
+        r.sums
+            .film()?
+            .write_exr_and_preview(output, tonemap, exposure)?;
+    }
+    // the finished output replaces what was kept to resume from
+    if keep.is_file() {
+        let _ = std::fs::remove_file(&keep);
+    }
     if !quiet {
         eprintln!(
-            "{}: {}x{} at {} spp, {} triangles: {}",
+            "{}: {}{region} of {w}×{h}, samples {}..{} of {spp}, {} triangles: {}",
             output.display(),
-            film.width,
-            film.height,
-            opts.spp.unwrap_or(scene.settings.spp),
+            if split.is_part() { "part, " } else { "" },
+            samples.start,
+            samples.end,
             scene.triangle_count(),
-            stats.summary(accel.name())
+            r.stats.summary(accel.name())
         );
     }
     report_rejected_rays(accel.as_ref());
+    Ok(())
+}
+
+/// The sums of the part at `path`, checked to be a start of `job` of the
+/// frame `identity`.
+fn resumable(
+    path: &Path,
+    identity: &Identity,
+    job: &render::Job,
+) -> Result<render::Accumulated, Error> {
+    let (h, sums) = part::read(path)?;
+    let located = |field: &str, problem: String| -> Error {
+        InputError::new(path, problem).in_field(field).into()
+    };
+    if let Some((field, theirs, ours)) = h.identity.difference(identity) {
+        return Err(located(
+            field,
+            format!("`{theirs}`, but this render has `{ours}`: not a part of this render"),
+        ));
+    }
+    if h.region != job.region {
+        return Err(located(
+            "lucent.region",
+            format!("{}, but this render covers {}", h.region, job.region),
+        ));
+    }
+    if h.samples.start != job.samples.start || h.samples.end > job.samples.end {
+        return Err(located(
+            "lucent.samples",
+            format!(
+                "{}..{}, not a start of this render's samples {}..{}",
+                h.samples.start, h.samples.end, job.samples.start, job.samples.end
+            ),
+        ));
+    }
+    Ok(sums)
+}
+
+fn run_merge(
+    parts: &[PathBuf],
+    output: &Path,
+    tonemap: ToneMap,
+    exposure: f32,
+    quiet: bool,
+) -> Result<(), Error> {
+    check_exr_output(output)?;
+    let start = std::time::Instant::now();
+    let m = lucent::farm::merge::merge(parts)?;
+    m.film.write_exr_and_preview(output, tonemap, exposure)?;
+    if !quiet {
+        eprintln!(
+            "{}: {} parts merged, {}×{} at {} spp, {:.2} s{}",
+            output.display(),
+            parts.len(),
+            m.film.width,
+            m.film.height,
+            m.identity.spp,
+            start.elapsed().as_secs_f64(),
+            if m.counters.nonfinite > 0 {
+                format!(", {} non-finite samples discarded", m.counters.nonfinite)
+            } else {
+                String::new()
+            }
+        );
+    }
     Ok(())
 }
 
