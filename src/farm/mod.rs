@@ -12,7 +12,7 @@
 //!   saying which frame, region and samples it holds);
 //! - [`cover`]: whether parts cover the frame exactly once;
 //! - [`merge`]: the checks and the sum;
-//! - [`scene_hash`]: which scene a part is of.
+//! - [`mod@scene_hash`]: which scene a part is of.
 
 pub mod cover;
 pub mod merge;

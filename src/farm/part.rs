@@ -17,7 +17,7 @@
 //! | `lucent.format_version` | [`FORMAT_VERSION`] |
 //! | `lucent.version` | the lucent version that rendered it |
 //! | `lucent.scene` | the scene file's name (for messages only) |
-//! | `lucent.scene_hash` | [`super::scene_hash`] of the scene |
+//! | `lucent.scene_hash` | [`super::scene_hash()`] of the scene |
 //! | `lucent.seed`, `lucent.spp` | the frame's seed and samples per pixel |
 //! | `lucent.options` | every option that changes the image, canonical |
 //! | `lucent.frame` | `W,H` |
