@@ -101,7 +101,17 @@ impl FixedPoint {
         // overflow: |x| < 2^128, 2^128 · 2^95 is far inside f64)
         let v = x as f64 * (2f64).powi(self.frac_bits as i32);
         let clamped = v.abs() > LIMIT;
-        let v = v.clamp(-LIMIT, LIMIT).round_ties_even();
+        // round half to even: below 2^52, adding and removing ±2^52 leaves
+        // an ulp of 1, and the hardware's default rounding does the rest
+        // (no call to the library's rint); from 2^52 on v is an integer
+        const TWO52: f64 = 4503599627370496.0;
+        let v = v.clamp(-LIMIT, LIMIT);
+        let v = if v.abs() < TWO52 {
+            let m = TWO52.copysign(v);
+            (v + m) - m
+        } else {
+            v
+        };
         // integer-valued and |v| ≤ 2^95, converted exactly without the
         // slow f64 → i128 library call: hi = v truncated to a multiple of
         // 2^48 (|hi| ≤ 2^47), lo = v − hi·2^48 (exact: the low bits of v,
