@@ -24,6 +24,15 @@ cargo clippy --no-default-features --all-targets -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 cargo test --all-targets
 
+# A real Slurm cluster of one node (this machine): a job array of parts and
+# a dependent merge, checked bitwise against one process. Needs root and
+# starts daemons, so only when asked (about 45 s after the build;
+# docs/farm.md). tests/farm.rs runs a multi-process split + merge always.
+if [ "${LUCENT_SLURM_TEST:-}" = 1 ]; then
+  echo "--- Slurm, one node (LUCENT_SLURM_TEST=1) ---"
+  scripts/slurm-local.sh
+fi
+
 # The BVH's portable box and triangle tests, which other architectures
 # run, forced on x86_64 (only lucent is rebuilt).
 echo "--- BVH portable path (--features bvh-portable) ---"

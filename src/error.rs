@@ -55,6 +55,20 @@ pub enum Error {
     /// nothing was written (see [`crate::interrupt`]).
     #[error("interrupted by {}: stopped, no output written", crate::interrupt::signal_name(*.0))]
     Interrupted(i32),
+    /// Stopped by a signal after the samples finished so far were written
+    /// to a part (`crate::farm`), from which `--resume` continues; nothing
+    /// else was written.
+    #[error(
+        "interrupted by {}: stopped; samples {}..{} of {}..{} kept in {} (continue with --resume {})",
+        crate::interrupt::signal_name(*signal), samples.start, samples.end,
+        requested.start, requested.end, part.display(), part.display()
+    )]
+    InterruptedKept {
+        signal: i32,
+        part: PathBuf,
+        samples: std::ops::Range<u32>,
+        requested: std::ops::Range<u32>,
+    },
 }
 
 impl Error {
@@ -72,7 +86,8 @@ impl Error {
             Error::Read { .. }
             | Error::Write { .. }
             | Error::Runtime(_)
-            | Error::Interrupted(_) => false,
+            | Error::Interrupted(_)
+            | Error::InterruptedKept { .. } => false,
         }
     }
 }

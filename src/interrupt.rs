@@ -6,11 +6,15 @@
 //! in an ordinary thread, not in a signal handler):
 //!
 //! - the **first** signal only records itself ([`requested`]). The renderer
-//!   checks the flag between pixels and stops; outputs are not committed
-//!   ([`crate::film::commit_all`] refuses once the flag is set), their
-//!   temporary files are removed as they are dropped, and the CLI exits
-//!   with [`exit_code`]: 128 + the signal's number, the shell's convention
-//!   (130 for SIGINT, 143 for SIGTERM).
+//!   checks the flag between pixels and stops, dropping the pass under way
+//!   (`crate::render`); the CLI writes the samples of the finished passes
+//!   to `OUT.partial.exr`, a part to `--resume` from (`crate::farm`; the
+//!   one commit allowed after a signal,
+//!   [`crate::film::commit_even_if_interrupted`]). Other outputs are not
+//!   committed ([`crate::film::commit_all`] refuses once the flag is set),
+//!   their temporary files are removed as they are dropped, and the CLI
+//!   exits with [`exit_code`]: 128 + the signal's number, the shell's
+//!   convention (130 for SIGINT, 143 for SIGTERM).
 //! - a **second** signal exits at once with the same code, after removing
 //!   every temporary file still registered ([`register_temporary`]).
 //!
@@ -56,6 +60,14 @@ pub fn requested() -> Option<i32> {
     match SIGNAL.load(Ordering::Relaxed) {
         0 => None,
         s => Some(s),
+    }
+}
+
+/// [`crate::Error::Interrupted`] once a signal asked the process to stop.
+pub fn stop_if_requested() -> Result<(), crate::Error> {
+    match requested() {
+        Some(sig) => Err(crate::Error::Interrupted(sig)),
+        None => Ok(()),
     }
 }
 

@@ -9,6 +9,7 @@
 pub mod accel;
 pub mod bssrdf;
 pub mod error;
+pub mod farm;
 pub mod film;
 pub mod fresnel;
 pub mod geometry;

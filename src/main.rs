@@ -9,12 +9,14 @@ use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
 use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
-use lucent::error::{Param, ParamError};
+use lucent::error::{InputError, Param, ParamError};
+use lucent::farm::part::{self, Identity};
 use lucent::film::cryptomatte;
 use lucent::film::exr_layers::{
     self, ExrCompression, FrameHeader, OutputOptions, Precision, Preview,
 };
 use lucent::film::passes::PassSet;
+use lucent::film::region::Region;
 use lucent::film::ToneMap;
 use lucent::integrator::IntegratorKind;
 use lucent::materials::{SubsurfaceOverrides, WalkBoundary};
@@ -108,6 +110,30 @@ enum Command {
         subsurface: SubsurfaceArgs,
         #[command(flatten)]
         file: FileArgs,
+        #[command(flatten)]
+        split: SplitArgs,
+    },
+    /// Merge parts (`render --crop/--tile/--samples`) into the frame they
+    /// split: bitwise the frame one uncut render gives. Checks that they
+    /// are of one scene, seed, spp, options and lucent version and cover
+    /// the frame's pixels and samples exactly once; writes the EXR and its
+    /// PNG preview, or nothing.
+    Merge {
+        /// The part files.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output OpenEXR path; the preview goes to the same path with `.png`.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Tone map of the PNG preview (the EXR is always linear).
+        #[arg(long, value_enum, default_value = "filmic")]
+        tonemap: ToneMap,
+        /// Exposure of the PNG preview in stops.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        exposure: f32,
+        /// No summary line.
+        #[arg(short, long)]
+        quiet: bool,
     },
     /// Benchmark the ray-query backends on the same meshes and rays: build
     /// time and memory, Mrays/s of camera, incoherent, shadow and probe
@@ -121,6 +147,75 @@ enum Command {
     /// subsurface estimator: results.csv, plots and report.md in the output
     /// directory (resumes from results.csv; see src/tools/study/mod.rs).
     Study(StudyArgs),
+}
+
+/// Splitting a frame into parts, checkpoints and resuming (docs/farm.md).
+#[derive(clap::Args)]
+struct SplitArgs {
+    /// Render only the pixels X0 ≤ x < X1, Y0 ≤ y < Y1; the output is a
+    /// part for `lucent merge`.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop, conflicts_with = "tile")]
+    crop: Option<Region>,
+    /// Render band I (0-based) of N balanced horizontal bands; the output
+    /// is a part for `lucent merge`.
+    #[arg(long, value_name = "I/N", value_parser = parse_tile)]
+    tile: Option<(u32, u32)>,
+    /// Render only the sample indices A ≤ s < B of each pixel; the output
+    /// is a part for `lucent merge`.
+    #[arg(long, value_name = "A..B", value_parser = parse_samples)]
+    samples: Option<std::ops::Range<u32>>,
+    /// Every SECONDS (at the end of a pass), save the finished samples to
+    /// OUT.partial.exr, atomically, for --resume.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_checkpoint)]
+    checkpoint: Option<f64>,
+    /// Continue from a part this same render left (at a signal or a
+    /// checkpoint): the result is bitwise the uninterrupted render's.
+    #[arg(long, value_name = "PART.exr")]
+    resume: Option<PathBuf>,
+}
+
+impl SplitArgs {
+    /// The first splitting, checkpoint or resume option given, by name.
+    fn option_given(&self) -> Option<&'static str> {
+        [
+            (self.crop.is_some(), "--crop"),
+            (self.tile.is_some(), "--tile"),
+            (self.samples.is_some(), "--samples"),
+            (self.checkpoint.is_some(), "--checkpoint"),
+            (self.resume.is_some(), "--resume"),
+        ]
+        .into_iter()
+        .find_map(|(given, name)| given.then_some(name))
+    }
+
+    /// Whether the output is a part rather than a frame.
+    fn is_part(&self) -> bool {
+        self.crop.is_some() || self.tile.is_some() || self.samples.is_some()
+    }
+}
+
+fn parse_crop(s: &str) -> Result<Region, String> {
+    Region::parse(s)
+        .filter(|r| !r.is_empty())
+        .ok_or_else(|| format!("expected X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1, found \"{s}\""))
+}
+
+fn parse_tile(s: &str) -> Result<(u32, u32), String> {
+    s.split_once('/')
+        .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)))
+        .filter(|&(i, n)| i < n)
+        .ok_or_else(|| format!("expected I/N with 0 ≤ I < N, found \"{s}\""))
+}
+
+fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
+    part::parse_samples(s).ok_or_else(|| format!("expected A..B with A < B, found \"{s}\""))
+}
+
+fn parse_checkpoint(s: &str) -> Result<f64, String> {
+    s.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("expected a positive number of seconds, found \"{s}\""))
 }
 
 /// Subsurface sampling choices that override every subsurface material's
@@ -296,6 +391,7 @@ fn main() -> ExitCode {
             aov,
             subsurface,
             file,
+            split,
         } => {
             let backend = accel
                 .map(Backend::from)
@@ -320,11 +416,19 @@ fn main() -> ExitCode {
                     aov,
                     &subsurface.overrides(),
                     &file,
+                    &split,
                     Preview { tonemap, exposure },
                     quiet,
                 )
             })
         }
+        Command::Merge {
+            parts,
+            output,
+            tonemap,
+            exposure,
+            quiet,
+        } => run_merge(&parts, &output, tonemap, exposure, quiet),
         Command::Study(args) => run_study(args),
         Command::Bench(args) => run_bench(args),
         Command::Info => {
@@ -336,7 +440,9 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             let shown = match lucent::interrupt::requested() {
-                Some(sig) if !matches!(e, Error::Interrupted(_)) => {
+                Some(sig)
+                    if !matches!(e, Error::Interrupted(_) | Error::InterruptedKept { .. }) =>
+                {
                     Error::Interrupted(sig).to_string()
                 }
                 _ => e.to_string(),
@@ -378,18 +484,8 @@ fn option_error(e: ParamError) -> Error {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn run_render(
-    scene_path: &Path,
-    output: &Path,
-    backend: Backend,
-    opts: &RenderOptions,
-    aov: Option<PassSet>,
-    overrides: &SubsurfaceOverrides,
-    file: &scene::OutputSettings,
-    preview: Preview,
-    quiet: bool,
-) -> Result<(), Error> {
+/// An output path that ends in `.exr` and lies in an existing directory.
+fn check_exr_output(output: &Path) -> Result<(), Error> {
     if output
         .extension()
         .and_then(|e| e.to_str())
@@ -411,6 +507,29 @@ fn run_render(
             problem: "does not exist".into(),
         });
     }
+    Ok(())
+}
+
+/// Where a render keeps its finished samples for `--resume` (at a signal,
+/// at checkpoints): `OUT.partial.exr` beside `OUT.exr`.
+fn checkpoint_path(output: &Path) -> PathBuf {
+    output.with_extension("partial.exr")
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_render(
+    scene_path: &Path,
+    output: &Path,
+    backend: Backend,
+    opts: &RenderOptions,
+    aov: Option<PassSet>,
+    overrides: &SubsurfaceOverrides,
+    file: &scene::OutputSettings,
+    split: &SplitArgs,
+    preview: Preview,
+    quiet: bool,
+) -> Result<(), Error> {
+    check_exr_output(output)?;
     if opts.spp == Some(0) {
         return Err(Error::Argument {
             argument: "--spp".into(),
@@ -424,39 +543,167 @@ fn run_render(
         });
     }
     let mut scene = scene::load(scene_path)?;
+    let scene_bytes = scene::load::read_regular_file(scene_path, scene::load::MAX_SCENE_BYTES)
+        .map_err(|e| InputError::new(scene_path, format!("cannot read scene file: {e}")))?;
     overrides
         .apply_all(&mut scene.materials)
         .map_err(option_error)?;
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let spp = opts.spp.unwrap_or(scene.settings.spp);
+    let region = match (split.crop, split.tile) {
+        (Some(c), _) if !c.within(&Region::full(w, h)) => {
+            return Err(Error::Argument {
+                argument: "--crop".into(),
+                problem: format!("{c} is not inside the {w}×{h} frame"),
+            })
+        }
+        (Some(c), _) => c,
+        (None, Some((i, n))) => Region::band(i, n, w, h).ok_or_else(|| Error::Argument {
+            argument: "--tile".into(),
+            problem: format!("{i}/{n}: the {w}×{h} frame splits into at most {h} bands"),
+        })?,
+        (None, None) => Region::full(w, h),
+    };
+    let samples = split.samples.clone().unwrap_or(0..spp);
+    if samples.end > spp {
+        return Err(Error::Argument {
+            argument: "--samples".into(),
+            problem: format!(
+                "{}..{} reaches beyond the {spp} samples per pixel",
+                samples.start, samples.end
+            ),
+        });
+    }
+    let identity = Identity {
+        version: env!("CARGO_PKG_VERSION").into(),
+        scene_hash: lucent::farm::scene_hash(scene_bytes.as_bytes(), &scene),
+        seed: opts.seed.unwrap_or(scene.settings.seed),
+        spp,
+        options: format!(
+            "accel={} integrator={:?} {overrides:?}",
+            backend.name(),
+            opts.integrator
+        ),
+        frame: (w, h),
+    };
+    let scene_name = scene_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let header = |sums: &render::Accumulated| part::Header {
+        identity: identity.clone(),
+        scene: scene_name.clone(),
+        region,
+        samples: sums.start..sums.done,
+        requested: samples.clone(),
+        layers: vec![part::beauty_layer()],
+        counters: sums.counters,
+    };
+    let job = render::Job {
+        region,
+        samples: samples.clone(),
+        pass_seconds: split.checkpoint.map_or(2.0, |c| (c / 2.0).min(2.0)),
+    };
+    let resume = match &split.resume {
+        Some(p) => Some(resumable(p, &identity, &job)?),
+        None => None,
+    };
     stop_if_interrupted()?;
     let accel = accel::build(&scene.meshes, backend)?;
     stop_if_interrupted()?;
     let passes = aov.unwrap_or(scene.output.aovs);
-    let render::RenderOutput {
-        film,
-        layers,
-        coverage,
-        stats,
-    } = render::render_passes(&scene, accel.as_ref(), opts, passes)?;
-    let header = frame_header(
-        scene_path,
-        &scene,
-        accel.name(),
-        backend,
-        opts,
-        stats.seconds,
-    )?;
     let mut out = file.over(scene.output.file.over(OutputOptions::default()));
     out.preview = Some(preview);
-    exr_layers::write_frame(output, &film, &layers, &coverage, &header, &out)?;
+    if !passes.is_empty() {
+        // passes are not yet carried by parts (docs/farm.md): a render with
+        // passes is one uncut run
+        if let Some(arg) = split.option_given() {
+            return Err(Error::Argument {
+                argument: arg.into(),
+                problem: "passes (--aov or the scene's [output] aovs) are not yet \
+                          carried by parts; render them in one run"
+                    .into(),
+            });
+        }
+        let render::RenderOutput {
+            film,
+            layers,
+            coverage,
+            stats,
+        } = render::render_passes(&scene, accel.as_ref(), opts, passes)?;
+        let header = frame_header(
+            scene_path,
+            &scene,
+            accel.name(),
+            backend,
+            opts,
+            stats.seconds,
+        )?;
+        exr_layers::write_frame(output, &film, &layers, &coverage, &header, &out)?;
+        if !quiet {
+            eprintln!(
+                "{}: {w}×{h} at {spp} spp, {} passes, {} triangles: {}",
+                output.display(),
+                layers.len() + coverage.len(),
+                scene.triangle_count(),
+                stats.summary(accel.name())
+            );
+        }
+        report_rejected_rays(accel.as_ref());
+        return Ok(());
+    }
+    let keep = checkpoint_path(output);
+    let mut last = std::time::Instant::now();
+    let mut checkpoint = |sums: &render::Accumulated| -> Result<(), Error> {
+        match split.checkpoint {
+            Some(every) if last.elapsed().as_secs_f64() >= every && sums.done < samples.end => {
+                lucent::film::commit_all(vec![part::stage(&keep, &header(sums), sums)?])?;
+                last = std::time::Instant::now();
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    };
+    let r = render::render_job(&scene, accel.as_ref(), opts, &job, resume, &mut checkpoint)?;
+    if let Some(signal) = r.interrupted {
+        if r.sums.count() == 0 {
+            return Err(Error::Interrupted(signal));
+        }
+        let staged = part::stage(&keep, &header(&r.sums), &r.sums)?;
+        lucent::film::commit_even_if_interrupted(vec![staged])?;
+        return Err(Error::InterruptedKept {
+            signal,
+            part: keep,
+            samples: r.sums.start..r.sums.done,
+            requested: samples,
+        });
+    }
+    if split.is_part() {
+        lucent::film::commit_all(vec![part::stage(output, &header(&r.sums), &r.sums)?])?;
+    } else {
+        let header = frame_header(
+            scene_path,
+            &scene,
+            accel.name(),
+            backend,
+            opts,
+            r.stats.seconds,
+        )?;
+        exr_layers::write_frame(output, &r.sums.film()?, &[], &[], &header, &out)?;
+    }
+    // the finished output replaces what was kept to resume from
+    if keep.is_file() {
+        let _ = std::fs::remove_file(&keep);
+    }
     if !quiet {
         eprintln!(
-            "{}: {}x{} at {} spp, {} triangles: {}",
+            "{}: {}{region} of {w}×{h}, samples {}..{} of {spp}, {} triangles: {}",
             output.display(),
-            film.width,
-            film.height,
-            opts.spp.unwrap_or(scene.settings.spp),
+            if split.is_part() { "part, " } else { "" },
+            samples.start,
+            samples.end,
             scene.triangle_count(),
-            stats.summary(accel.name())
+            r.stats.summary(accel.name())
         );
     }
     report_rejected_rays(accel.as_ref());
@@ -532,6 +779,71 @@ fn backend_version(backend: Backend) -> Result<String, Error> {
         Backend::Embree4 => format!("Embree {}", accel::embree4::version()?),
         _ => format!("lucent {}", env!("CARGO_PKG_VERSION")),
     })
+}
+
+/// The sums of the part at `path`, checked to be a start of `job` of the
+/// frame `identity`.
+fn resumable(
+    path: &Path,
+    identity: &Identity,
+    job: &render::Job,
+) -> Result<render::Accumulated, Error> {
+    let (h, sums) = part::read(path)?;
+    let located = |field: &str, problem: String| -> Error {
+        InputError::new(path, problem).in_field(field).into()
+    };
+    if let Some((field, theirs, ours)) = h.identity.difference(identity) {
+        return Err(located(
+            field,
+            format!("`{theirs}`, but this render has `{ours}`: not a part of this render"),
+        ));
+    }
+    if h.region != job.region {
+        return Err(located(
+            "lucent.region",
+            format!("{}, but this render covers {}", h.region, job.region),
+        ));
+    }
+    if h.samples.start != job.samples.start || h.samples.end > job.samples.end {
+        return Err(located(
+            "lucent.samples",
+            format!(
+                "{}..{}, not a start of this render's samples {}..{}",
+                h.samples.start, h.samples.end, job.samples.start, job.samples.end
+            ),
+        ));
+    }
+    Ok(sums)
+}
+
+fn run_merge(
+    parts: &[PathBuf],
+    output: &Path,
+    tonemap: ToneMap,
+    exposure: f32,
+    quiet: bool,
+) -> Result<(), Error> {
+    check_exr_output(output)?;
+    let start = std::time::Instant::now();
+    let m = lucent::farm::merge::merge(parts)?;
+    m.film.write_exr_and_preview(output, tonemap, exposure)?;
+    if !quiet {
+        eprintln!(
+            "{}: {} parts merged, {}×{} at {} spp, {:.2} s{}",
+            output.display(),
+            parts.len(),
+            m.film.width,
+            m.film.height,
+            m.identity.spp,
+            start.elapsed().as_secs_f64(),
+            if m.counters.nonfinite > 0 {
+                format!(", {} non-finite samples discarded", m.counters.nonfinite)
+            } else {
+                String::new()
+            }
+        );
+    }
+    Ok(())
 }
 
 /// `s` with every control character (from a file name, an OBJ line or a

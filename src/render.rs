@@ -1,15 +1,34 @@
-//! The render driver: splits the image into tiles, renders them on a rayon
-//! pool, and averages the samples of each pixel.
+//! The render driver: renders a region of the frame over a range of sample
+//! indices, in passes over tiles on a rayon pool, and sums each pixel's
+//! samples exactly.
 //!
 //! Each sample draws from its own counter-based stream keyed by (seed,
-//! pixel, sample index) and each pixel sums its samples in index order, so
-//! the image is bitwise identical for any thread count and tile order.
+//! pixel, sample index), and each pixel sums its samples in the fixed-point
+//! accumulator of [`crate::film::accumulate`], whose sums do not depend on
+//! order or grouping. So the image is bitwise identical for any thread
+//! count, tile order and pass size, and the sums of disjoint regions and
+//! sample ranges (parts rendered apart, or a render resumed from a saved
+//! part) add up to exactly the sums of one uninterrupted run: a frame
+//! merged from parts is the frame (docs/farm.md).
 //!
-//! [`render_passes`] also computes passes (AOVs, `crate::integrator::aov`);
-//! whether it does is decided once per render, by which instance of the
-//! tile loop runs: without passes it is the loop with a recorder that does
-//! nothing, so a render without passes costs what it did before passes.
+//! A render runs in **passes**: each pass adds the samples `s0..s1` to
+//! every pixel of the region, writing `previous sums + pass` into a second
+//! buffer, which replaces the first only once every tile finished. A signal
+//! ([`crate::interrupt`]) stops the pass under way at the next pixel and
+//! drops it, so what is left is the sums of whole passes, `start..done`:
+//! a valid part. Pass sizes adapt to take about
+//! [`Job::pass_seconds`] each (the first is one sample); they change when
+//! a render can stop, never what it computes.
+//!
+//! [`render_passes`] also computes passes (AOVs, `crate::integrator::aov`)
+//! in one uncut run over the whole frame (parts do not carry passes yet:
+//! docs/farm.md). Its beauty is summed in the same fixed point, in the
+//! same sample order, so it is bitwise the beauty of [`render`]. Whether
+//! passes are computed is decided once per render, by which instance of
+//! the tile loop runs: without passes the recorder does nothing, so a
+//! render without passes costs what it did before passes.
 
+use std::ops::Range;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -17,8 +36,10 @@ use rayon::prelude::*;
 
 use crate::accel::Accel;
 use crate::error::Error;
+use crate::film::accumulate::FixedPoint;
 use crate::film::layers::{Coverage, Layer};
 use crate::film::passes::PassSet;
+use crate::film::region::Region;
 use crate::film::Film;
 use crate::geometry::Vec3;
 use crate::integrator::aov::pixels::{assemble, Layout};
@@ -74,7 +95,7 @@ pub struct RenderStats {
 impl RenderStats {
     pub fn summary(&self, backend: &str) -> String {
         format!(
-            "{:.2} s wall, {:.3} Msamples/s, {:.2} Mrays/s ({} rays, {} threads, {backend}){}{}",
+            "{:.2} s wall, {:.3} Msamples/s, {:.2} Mrays/s ({} rays, {} threads, {backend}){}{}{}",
             self.seconds,
             self.samples as f64 / self.seconds / 1e6,
             self.counters.rays as f64 / self.seconds / 1e6,
@@ -85,12 +106,383 @@ impl RenderStats {
             } else {
                 String::new()
             },
+            if self.counters.clamped > 0 {
+                format!(
+                    ", {} sample channels beyond ±{:e} clamped",
+                    self.counters.clamped,
+                    Accumulated::FORMAT.max_sample()
+                )
+            } else {
+                String::new()
+            },
             match (self.counters.walks_capped, self.counters.walks_escaped) {
                 (0, 0) => String::new(),
                 (c, e) => format!(", random walks: {c} capped, {e} escaped through holes"),
             }
         )
     }
+}
+
+/// What to render: the pixels of `region` (frame coordinates) and the
+/// sample indices `samples` of each.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Job {
+    pub region: Region,
+    pub samples: Range<u32>,
+    /// The wall time a pass aims at (after a first pass of one sample):
+    /// how much work a signal may drop, and how often a checkpoint can be
+    /// written.
+    pub pass_seconds: f64,
+}
+
+impl Job {
+    /// The whole frame of `scene`, samples `0..spp`.
+    pub fn full(scene: &Scene, spp: u32) -> Job {
+        Job {
+            region: Region::full(scene.camera.width, scene.camera.height),
+            samples: 0..spp,
+            pass_seconds: 2.0,
+        }
+    }
+}
+
+/// The exact per-pixel sums of a region's samples `start..done`: beauty
+/// RGB, [`Accumulated::CHANNELS`] values a pixel in the format
+/// [`Accumulated::FORMAT`], stored tile by tile.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accumulated {
+    pub region: Region,
+    /// The first sample index summed.
+    pub start: u32,
+    /// One past the last sample index summed (`start` when none is).
+    pub done: u32,
+    /// Tallies of the summed samples.
+    pub counters: Counters,
+    sums: Vec<i128>,
+}
+
+impl Accumulated {
+    /// Channels a pixel: R, G, B.
+    pub const CHANNELS: usize = 3;
+    /// Their fixed-point format.
+    pub const FORMAT: FixedPoint = FixedPoint::RADIANCE;
+
+    /// Zero sums over `region`, no sample yet (from `start`); fails with a
+    /// runtime error, not an abort, when the memory is not there.
+    pub fn new(region: Region, start: u32) -> Result<Accumulated, Error> {
+        let n = region.area() as usize * Self::CHANNELS;
+        let mut sums = Vec::new();
+        sums.try_reserve_exact(n).map_err(|_| {
+            crate::film::out_of_memory(
+                &format!(
+                    "the sums of a {}×{} region",
+                    region.width(),
+                    region.height()
+                ),
+                n.saturating_mul(16),
+            )
+        })?;
+        sums.resize(n, 0);
+        Ok(Accumulated {
+            region,
+            start,
+            done: start,
+            counters: Counters::default(),
+            sums,
+        })
+    }
+
+    /// Samples summed in each pixel.
+    pub fn count(&self) -> u32 {
+        self.done - self.start
+    }
+
+    /// Where pixel (x, y)'s sums start in `sums` (tile-major layout: the
+    /// tiles of [`tiles`] in order, each row-major).
+    fn offset(&self, x: u32, y: u32) -> usize {
+        let r = &self.region;
+        let (lx, ly) = (x - r.x0, y - r.y0);
+        let (tx, ty) = (lx / TILE * TILE, ly / TILE * TILE);
+        // full rows of tiles above, then full tiles to the left in this row
+        let above = ty as usize * r.width() as usize;
+        let th = TILE.min(r.height() - ty) as usize;
+        let left = tx as usize * th;
+        let tw = TILE.min(r.width() - tx) as usize;
+        (above + left + (ly - ty) as usize * tw + (lx - tx) as usize) * Self::CHANNELS
+    }
+
+    /// Pixel (x, y)'s sums (frame coordinates, inside the region).
+    pub fn pixel(&self, x: u32, y: u32) -> &[i128] {
+        let o = self.offset(x, y);
+        &self.sums[o..o + Self::CHANNELS]
+    }
+
+    /// Pixel (x, y)'s sums, to set (merging, reading a part back).
+    pub fn pixel_mut(&mut self, x: u32, y: u32) -> &mut [i128] {
+        let o = self.offset(x, y);
+        &mut self.sums[o..o + Self::CHANNELS]
+    }
+
+    /// The region's image: each pixel the mean of its [`count`](Self::count)
+    /// samples ([`FixedPoint::mean`]).
+    pub fn film(&self) -> Result<Film, Error> {
+        let r = self.region;
+        let mut film = Film::try_new(r.width(), r.height())?;
+        let n = self.count() as u64;
+        for y in r.y0..r.y1 {
+            for x in r.x0..r.x1 {
+                let s = self.pixel(x, y);
+                let m = |c: usize| Self::FORMAT.mean(s[c], n);
+                film.set(x - r.x0, y - r.y0, Vec3::new(m(0), m(1), m(2)));
+            }
+        }
+        Ok(film)
+    }
+}
+
+/// The tiles of `region`, TILE × TILE from its top-left corner, row by
+/// row (the last row and column smaller).
+fn tiles(region: &Region) -> Vec<Region> {
+    let mut v = Vec::new();
+    for y0 in (region.y0..region.y1).step_by(TILE as usize) {
+        for x0 in (region.x0..region.x1).step_by(TILE as usize) {
+            v.push(Region {
+                x0,
+                y0,
+                x1: (x0 + TILE).min(region.x1),
+                y1: (y0 + TILE).min(region.y1),
+            });
+        }
+    }
+    v
+}
+
+/// A finished or stopped [`render_job`].
+#[derive(Debug)]
+pub struct Rendered {
+    /// The sums of every finished pass (and of the resumed part).
+    pub sums: Accumulated,
+    pub stats: RenderStats,
+    /// The signal that stopped the render before `job.samples.end`, if one
+    /// did; `sums` then holds the passes finished before it.
+    pub interrupted: Option<i32>,
+}
+
+/// The scene with `opts`' spp and seed overrides applied.
+fn with_overrides<'a>(scene: &'a Scene, opts: &RenderOptions) -> std::borrow::Cow<'a, Scene> {
+    let mut settings = scene.settings;
+    if let Some(s) = opts.spp {
+        settings.spp = s;
+    }
+    if let Some(s) = opts.seed {
+        settings.seed = s;
+    }
+    if settings != scene.settings {
+        std::borrow::Cow::Owned(Scene {
+            settings,
+            ..scene.clone()
+        })
+    } else {
+        std::borrow::Cow::Borrowed(scene)
+    }
+}
+
+/// Renders the whole frame at the scene's (or `opts`') spp: the image and
+/// its statistics; [`Error::Interrupted`] if a signal stopped it.
+pub fn render(
+    scene: &Scene,
+    accel: &dyn Accel,
+    opts: &RenderOptions,
+) -> Result<(Film, RenderStats), Error> {
+    let spp = opts.spp.unwrap_or(scene.settings.spp);
+    let r = render_job(
+        scene,
+        accel,
+        opts,
+        &Job::full(scene, spp),
+        None,
+        &mut |_| Ok(()),
+    )?;
+    if let Some(sig) = r.interrupted {
+        return Err(Error::Interrupted(sig));
+    }
+    Ok((r.sums.film()?, r.stats))
+}
+
+/// Renders `job`: continues `resume` (sums of the same region over
+/// `job.samples.start..resume.done`) when given, else starts at zero;
+/// calls `after_pass` with the sums after every finished pass (a checkpoint
+/// writer; its error stops the render). `opts.spp` is not used: the job
+/// says which samples.
+pub fn render_job(
+    scene: &Scene,
+    accel: &dyn Accel,
+    opts: &RenderOptions,
+    job: &Job,
+    resume: Option<Accumulated>,
+    after_pass: &mut dyn FnMut(&Accumulated) -> Result<(), Error>,
+) -> Result<Rendered, Error> {
+    let scene = with_overrides(scene, opts);
+    let scene = scene.as_ref();
+    if let Some(n) = opts.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
+        return Err(Error::Argument {
+            argument: "--threads".into(),
+            problem: format!("{n} is not a thread count (1 to {MAX_THREADS})"),
+        });
+    }
+    let frame = Region::full(scene.camera.width, scene.camera.height);
+    if job.region.is_empty() || !job.region.within(&frame) || job.samples.is_empty() {
+        return Err(Error::Input(format!(
+            "nothing to render: region {} of a {}×{} frame, samples {}..{}",
+            job.region, frame.x1, frame.y1, job.samples.start, job.samples.end
+        )));
+    }
+    let mut sums = match resume {
+        Some(a) => {
+            if a.region != job.region || a.start != job.samples.start || a.done > job.samples.end {
+                return Err(Error::Input(format!(
+                    "cannot resume: the saved sums cover region {} samples {}..{}, the job \
+                     region {} samples {}..{}",
+                    a.region, a.start, a.done, job.region, job.samples.start, job.samples.end
+                )));
+            }
+            a
+        }
+        None => Accumulated::new(job.region, job.samples.start)?,
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| Error::Runtime(format!("cannot start worker threads: {e}")))?;
+    let threads = pool.current_num_threads();
+    let ctx = Context::new(scene, accel);
+    let tiles = tiles(&job.region);
+    let mut next = Accumulated::new(job.region, job.samples.start)?;
+    let first = sums.done;
+
+    let total = job.region.area() * (job.samples.end - first) as u64;
+    let bar = if opts.progress {
+        let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
+                .unwrap()
+                .progress_chars("=> "),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+
+    let start = Instant::now();
+    let mut interrupted = None;
+    let mut pass = 1u32;
+    while sums.done < job.samples.end {
+        let s = sums.done..sums.done + pass.min(job.samples.end - sums.done);
+        let pass_start = Instant::now();
+        // each tile reads its previous sums and writes previous + pass
+        let mut chunks = Vec::with_capacity(tiles.len());
+        let (mut prev, mut rest) = (&sums.sums[..], &mut next.sums[..]);
+        for t in &tiles {
+            let n = t.area() as usize * Accumulated::CHANNELS;
+            let (a, b) = prev.split_at(n);
+            let (c, d) = rest.split_at_mut(n);
+            chunks.push((t, a, c));
+            (prev, rest) = (b, d);
+        }
+        let counters: Vec<Counters> = pool.install(|| {
+            chunks
+                .into_par_iter()
+                .map(|(t, prev, out)| {
+                    let c = render_tile(&ctx, opts.integrator, t, s.clone(), prev, out);
+                    bar.inc(t.area() * s.len() as u64);
+                    c
+                })
+                .collect()
+        });
+        // stopped by a signal: this pass is incomplete, drop it
+        if let Some(sig) = interrupt::requested() {
+            interrupted = Some(sig);
+            break;
+        }
+        std::mem::swap(&mut sums.sums, &mut next.sums);
+        sums.done = s.end;
+        for c in counters {
+            sums.counters += c;
+        }
+        after_pass(&sums)?;
+        let per_sample = pass_start.elapsed().as_secs_f64() / s.len() as f64;
+        pass = (job.pass_seconds / per_sample.max(1e-9)).clamp(1.0, u32::MAX as f64) as u32;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let stats = RenderStats {
+        seconds,
+        samples: job.region.area() * (sums.done - first) as u64,
+        threads,
+        counters: sums.counters,
+    };
+    Ok(Rendered {
+        sums,
+        stats,
+        interrupted,
+    })
+}
+
+// Kept out of line so profiles (scripts/profile.sh) can name the tile loop.
+/// Adds the samples `samples` of every pixel of `tile` to its sums `prev`
+/// (the tile's pixels row by row), writing the result to `out`. Stops at
+/// the next pixel once a signal came (the pass is then dropped).
+#[inline(never)]
+fn render_tile(
+    ctx: &Context,
+    integrator: IntegratorKind,
+    tile: &Region,
+    samples: Range<u32>,
+    prev: &[i128],
+    out: &mut [i128],
+) -> Counters {
+    const C: usize = Accumulated::CHANNELS;
+    let scene = ctx.scene;
+    let w = scene.camera.width;
+    let mut counters = Counters::default();
+    let mut scratch = Scratch::default();
+    let seed_key = Rng::seed_key(scene.settings.seed);
+    let mut i = 0;
+    for y in tile.y0..tile.y1 {
+        for x in tile.x0..tile.x1 {
+            // a signal stops the render between pixels (see crate::interrupt);
+            // the pass is then incomplete and dropped
+            if interrupt::requested().is_some() {
+                return counters;
+            }
+            let pixel = y as u64 * w as u64 + x as u64;
+            let pixel_key = Rng::pixel_key(seed_key, pixel);
+            let mut sum: [i128; C] = prev[i..i + C].try_into().unwrap();
+            for s in samples.clone() {
+                // = SampleRng::new(seed, pixel, s), hashing the seed and
+                // pixel once
+                let mut rng = SampleRng::for_sample(pixel_key, s as u64);
+                let [jx, jy] = rng.uniform2_packed();
+                let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
+                let l = integrator.radiance(
+                    ctx,
+                    ray,
+                    &mut rng,
+                    &mut scratch,
+                    &mut counters,
+                    &mut NoAov,
+                );
+                if l.is_finite() {
+                    counters.clamped += Accumulated::FORMAT.add(&mut sum, &[l.x, l.y, l.z]) as u64;
+                } else {
+                    counters.nonfinite += 1;
+                }
+            }
+            out[i..i + C].copy_from_slice(&sum);
+            i += C;
+        }
+    }
+    counters
 }
 
 /// A render's beauty, its passes (layers in output order, and ID
@@ -103,40 +495,25 @@ pub struct RenderOutput {
     pub stats: RenderStats,
 }
 
-/// Renders the beauty image alone.
-pub fn render(
-    scene: &Scene,
-    accel: &dyn Accel,
-    opts: &RenderOptions,
-) -> Result<(Film, RenderStats), Error> {
-    let out = render_passes(scene, accel, opts, PassSet::EMPTY)?;
-    Ok((out.film, out.stats))
-}
-
-/// Renders the beauty image and `passes` (none: exactly [`render`]).
+/// Renders the beauty image and `passes` over the whole frame in one run
+/// (none: exactly [`render`]).
 pub fn render_passes(
     scene: &Scene,
     accel: &dyn Accel,
     opts: &RenderOptions,
     passes: PassSet,
 ) -> Result<RenderOutput, Error> {
-    let mut scene_settings = scene.settings;
-    if let Some(s) = opts.spp {
-        scene_settings.spp = s;
+    if passes.is_empty() {
+        let (film, stats) = render(scene, accel, opts)?;
+        return Ok(RenderOutput {
+            film,
+            layers: Vec::new(),
+            coverage: Vec::new(),
+            stats,
+        });
     }
-    if let Some(s) = opts.seed {
-        scene_settings.seed = s;
-    }
-    let scene_local;
-    let scene = if scene_settings != scene.settings {
-        scene_local = Scene {
-            settings: scene_settings,
-            ..scene.clone()
-        };
-        &scene_local
-    } else {
-        scene
-    };
+    let scene = with_overrides(scene, opts);
+    let scene = scene.as_ref();
     if let Some(n) = opts.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
         return Err(Error::Argument {
             argument: "--threads".into(),
@@ -176,24 +553,15 @@ pub fn render_passes(
         pool: &pool,
         bar: &bar,
     };
-    let (done, layers, coverage) = if passes.is_empty() {
-        (
-            run.tiles(|_| NoAov)?.without_passes(),
-            Vec::new(),
-            Vec::new(),
-        )
-    } else {
-        let setup = Setup::new(scene, &ctx.lights, passes);
-        let layout = Layout::new(&setup);
-        let done = run.tiles(|pixels| TilePasses::new(&setup, &layout, pixels))?;
-        let tile_width = |x0: u32| TILE.min(w - x0);
-        let parts = tiles
-            .iter()
-            .zip(&done.passes)
-            .map(|(&(x0, y0), t)| ((x0, y0), tile_width(x0), t));
-        let (layers, coverage) = assemble(&setup, &layout, w, h, parts)?;
-        (done.without_passes(), layers, coverage)
-    };
+    let setup = Setup::new(scene, &ctx.lights, passes);
+    let layout = Layout::new(&setup);
+    let done = run.tiles(|pixels| TilePasses::new(&setup, &layout, pixels))?;
+    let tile_width = |x0: u32| TILE.min(w - x0);
+    let parts = tiles
+        .iter()
+        .zip(&done.passes)
+        .map(|(&(x0, y0), t)| ((x0, y0), tile_width(x0), t));
+    let (layers, coverage) = assemble(&setup, &layout, w, h, parts)?;
     let stats = RenderStats {
         seconds: done.seconds,
         samples: w as u64 * h as u64 * scene.settings.spp as u64,
@@ -215,17 +583,6 @@ struct Tiles<T> {
     counters: Counters,
     seconds: f64,
     passes: Vec<T>,
-}
-
-impl<T> Tiles<T> {
-    fn without_passes(self) -> Tiles<()> {
-        Tiles {
-            film: self.film,
-            counters: self.counters,
-            seconds: self.seconds,
-            passes: Vec::new(),
-        }
-    }
 }
 
 /// What rendering the tiles needs.
@@ -251,7 +608,7 @@ impl Run<'_> {
                 .par_iter()
                 .map(|&(x0, y0)| {
                     let pixels = (TILE.min(w - x0) * TILE.min(h - y0)) as usize;
-                    let r = render_tile(ctx, self.integrator, x0, y0, passes(pixels));
+                    let r = render_tile_passes(ctx, self.integrator, x0, y0, passes(pixels));
                     self.bar.inc(1);
                     r
                 })
@@ -284,9 +641,10 @@ impl Run<'_> {
     }
 }
 
-// Kept out of line so profiles (scripts/profile.sh) can name the tile loop.
+/// The tile loop of [`render_passes`]: every sample of every pixel of the
+/// tile at (x0, y0), recorded by `passes`.
 #[inline(never)]
-fn render_tile<P: PixelPasses>(
+fn render_tile_passes<P: PixelPasses>(
     ctx: &Context,
     integrator: IntegratorKind,
     x0: u32,
@@ -310,7 +668,7 @@ fn render_tile<P: PixelPasses>(
             }
             let pixel = y as u64 * w as u64 + x as u64;
             let pixel_key = Rng::pixel_key(seed_key, pixel);
-            let mut sum = [0f64; 3];
+            let mut sum = [0i128; Accumulated::CHANNELS];
             for s in 0..spp {
                 // = SampleRng::new(seed, pixel, s), hashing the seed and
                 // pixel once
@@ -321,21 +679,17 @@ fn render_tile<P: PixelPasses>(
                 let l = integrator.radiance(ctx, ray, &mut rng, &mut scratch, &mut counters, rec);
                 let finite = l.is_finite();
                 if finite {
-                    sum[0] += l.x as f64;
-                    sum[1] += l.y as f64;
-                    sum[2] += l.z as f64;
+                    counters.clamped += Accumulated::FORMAT.add(&mut sum, &[l.x, l.y, l.z]) as u64;
                 } else {
                     counters.nonfinite += 1;
                 }
                 passes.end_sample(l, finite);
             }
             passes.end_pixel();
-            let n = spp.max(1) as f64;
-            out.push(Vec3::new(
-                (sum[0] / n) as f32,
-                (sum[1] / n) as f32,
-                (sum[2] / n) as f32,
-            ));
+            // the mean as Accumulated::film takes it: the same beauty as
+            // render's, bit for bit
+            let m = |c: usize| Accumulated::FORMAT.mean(sum[c], spp as u64);
+            out.push(Vec3::new(m(0), m(1), m(2)));
         }
     }
     (out, counters, passes.finish())

@@ -1,8 +1,11 @@
-//! SIGINT and SIGTERM (issue 14, class 8): a render stops at the next
-//! pixel, nothing is committed, no temporary file remains, and the exit
-//! code is 128 + the signal (130, 143); outputs staged when the signal
-//! came are not committed. Its own test binary: the library test sets the
-//! process-wide flag of `lucent::interrupt`.
+//! SIGINT and SIGTERM (issue 14, class 8; issue 16): a render stops at the
+//! next pixel, drops the pass under way, keeps the finished samples in
+//! OUT.partial.exr and commits nothing else, no temporary file remains, and
+//! the exit code is 128 + the signal (130, 143); outputs staged when the
+//! signal came are not committed. A render killed at a random moment and
+//! resumed from what it kept is bitwise the uninterrupted render. Its own
+//! test binary: the library test sets the process-wide flag of
+//! `lucent::interrupt`.
 
 use std::fs;
 use std::path::Path;
@@ -75,7 +78,7 @@ fn finish(mut child: Child, limit: Duration) -> (Option<i32>, String) {
 }
 
 #[test]
-fn a_signal_stops_a_render_with_its_exit_code_and_leaves_nothing() {
+fn a_signal_stops_a_render_with_its_exit_code_keeping_only_the_finished_samples() {
     for (signal, code, name) in [("-INT", 130, "SIGINT"), ("-TERM", 143, "SIGTERM")] {
         let dir = tempfile::tempdir().unwrap();
         let child = start_render(dir.path());
@@ -84,14 +87,103 @@ fn a_signal_stops_a_render_with_its_exit_code_and_leaves_nothing() {
         kill(&child, signal);
         let (status, e) = finish(child, Duration::from_secs(10));
         assert_eq!(status, Some(code), "{signal}: {e}");
+        // the first pass (one sample a pixel) is done by now: kept
         assert!(
-            e.contains(&format!(
-                "interrupted by {name}: stopped, no output written"
-            )),
+            e.contains(&format!("interrupted by {name}: stopped; samples 0..")),
             "{e}"
         );
-        assert_eq!(names(dir.path()), ["scene.toml"], "{signal}");
+        assert!(e.contains("of 0..100000 kept in out.partial.exr"), "{e}");
+        assert_eq!(
+            names(dir.path()),
+            ["out.partial.exr", "scene.toml"],
+            "{signal}"
+        );
     }
+}
+
+/// The uninterrupted render, a render killed at a random moment (SIGTERM,
+/// or SIGKILL after checkpoints) and resumed from what it left: the same
+/// image, bitwise.
+#[test]
+fn a_render_killed_at_a_random_moment_and_resumed_is_bitwise_the_uninterrupted_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fs::write(
+        d.join("scene.toml"),
+        SCENE.replace("[256, 256]", "[64, 48]"),
+    )
+    .unwrap();
+    let render = |out: &str, extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            "scene.toml",
+            "--quiet",
+            "--spp",
+            "3000",
+            "--threads",
+            "2",
+            "-o",
+            out,
+        ];
+        a.extend_from_slice(extra);
+        Command::new(env!("CARGO_BIN_EXE_lucent"))
+            .args(a)
+            .current_dir(d)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (status, e) = finish(render("whole.exr", &[]), Duration::from_secs(120));
+    assert_eq!(status, Some(0), "{e}");
+    // pixels bit for bit (the EXR's header also records the render time)
+    let pixels = |p: &str| {
+        let f = lucent::film::Film::read_exr(&d.join(p)).unwrap();
+        f.pixels
+            .iter()
+            .flat_map(|v| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()])
+            .collect::<Vec<u32>>()
+    };
+    let whole = pixels("whole.exr");
+    // a seeded "random" moment: reproducible, yet not a round number
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .subsec_nanos();
+    for (k, signal) in [(0u32, "-TERM"), (1, "-KILL")] {
+        let wait = 300 + (nanos / 7 + k * 337) % 900;
+        let child = render("cut.exr", &["--checkpoint", "0.1"]);
+        std::thread::sleep(Duration::from_millis(wait as u64));
+        kill(&child, signal);
+        let (status, e) = finish(child, Duration::from_secs(10));
+        if signal == "-TERM" {
+            assert_eq!(status, Some(143), "{e}");
+        }
+        assert!(
+            d.join("cut.partial.exr").is_file(),
+            "{signal} after {wait} ms: nothing kept: {e}"
+        );
+        assert!(!d.join("cut.exr").exists());
+        let (status, e) = finish(
+            render("cut.exr", &["--resume", "cut.partial.exr"]),
+            Duration::from_secs(120),
+        );
+        assert_eq!(status, Some(0), "{signal} after {wait} ms: {e}");
+        assert!(
+            pixels("cut.exr") == whole,
+            "{signal} after {wait} ms: resumed image differs"
+        );
+        // done: what was kept to resume from is gone
+        assert!(!d.join("cut.partial.exr").exists());
+        fs::remove_file(d.join("cut.exr")).unwrap();
+        fs::remove_file(d.join("cut.png")).unwrap();
+    }
+    let left: Vec<String> = names(d)
+        .into_iter()
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
 }
 
 #[test]
@@ -107,7 +199,13 @@ fn a_second_signal_ends_the_process_at_once_leaving_nothing() {
         status == Some(130) || status == Some(143),
         "{status:?}: {e}"
     );
-    assert_eq!(names(dir.path()), ["scene.toml"]);
+    // the kept part, if the first signal's write finished; never a
+    // temporary file
+    let left = names(dir.path());
+    assert!(
+        left == ["scene.toml"] || left == ["out.partial.exr", "scene.toml"],
+        "{left:?}"
+    );
 }
 
 #[test]

@@ -5,11 +5,13 @@
 //! the outputs of one command are committed together ([`commit_all`]), so a
 //! failure never leaves an EXR without its PNG.
 
+pub mod accumulate;
 pub mod cryptomatte;
 pub mod exr_attributes;
 pub mod exr_layers;
 pub mod layers;
 pub mod passes;
+pub mod region;
 pub mod tonemap;
 
 use std::fs;
@@ -232,6 +234,14 @@ pub fn commit_all(files: Vec<Staged>) -> Result<(), Error> {
     if let Some(sig) = interrupt::requested() {
         return Err(Error::Interrupted(sig));
     }
+    commit_even_if_interrupted(files)
+}
+
+/// [`commit_all`] even after a signal: for the one output an interrupted
+/// command is meant to leave, the record of its finished work (a render's
+/// finished samples, `crate::farm`). A second signal still removes the
+/// temporary files and exits.
+pub fn commit_even_if_interrupted(files: Vec<Staged>) -> Result<(), Error> {
     let write_err = |path: &Path, problem: String| Error::Write {
         path: path.to_path_buf(),
         problem,

@@ -129,6 +129,9 @@ pub struct Counters {
     pub rays: u64,
     /// Samples whose radiance was not finite and was discarded.
     pub nonfinite: u64,
+    /// Sample channels beyond the accumulator's range, clamped to it
+    /// (`crate::film::accumulate`).
+    pub clamped: u64,
     /// Random walks stopped at the cap on events inside a medium.
     pub walks_capped: u64,
     /// Random walks that left an open mesh through a hole (no boundary hit).
@@ -139,6 +142,7 @@ impl std::ops::AddAssign for Counters {
     fn add_assign(&mut self, o: Self) {
         self.rays += o.rays;
         self.nonfinite += o.nonfinite;
+        self.clamped += o.clamped;
         self.walks_capped += o.walks_capped;
         self.walks_escaped += o.walks_escaped;
     }

@@ -31,8 +31,10 @@ pub use super::obj::load_obj;
 pub const MAX_RESOLUTION: u32 = 16384;
 
 /// Largest accepted image, in pixels (8192², or 16384 × 4096): a render
-/// holds about 28 bytes a pixel at its peak (the tiles' samples and the
-/// film, 12 bytes each, and the 3-byte preview), 1.9 GB at this bound.
+/// holds about 111 bytes a pixel at its peak (two buffers of exact RGB
+/// sums, 48 bytes each, `crate::render`; the film, 12; the 3-byte
+/// preview), 7.4 GB at this bound; an allocation that fails is a runtime
+/// error, not an abort.
 pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// Largest accepted scene file, in bytes: scenes are a few kB; anything

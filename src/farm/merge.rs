@@ -1,0 +1,167 @@
+//! `lucent merge`: adds parts into the frame they split.
+//!
+//! Every check runs on the headers before any pixel is read, and nothing
+//! is written unless every part was read whole: the parts must share one
+//! [`Identity`] (lucent version, scene hash, seed, spp, options, frame)
+//! and cover the frame's pixels × sample indices exactly once
+//! ([`super::cover`]). Then each part's integer sums are added into the
+//! frame's (exactly: integer addition, in any order), and the frame is the
+//! sums divided by spp, the same [`crate::render::Accumulated::film`] a
+//! single-machine render ends with — so the merged frame is bitwise the
+//! uncut render.
+
+use std::path::{Path, PathBuf};
+
+use super::cover::{self, CoverError, Piece};
+use super::part::{self, Header, Identity};
+use crate::error::{Error, InputError};
+use crate::film::region::Region;
+use crate::film::Film;
+use crate::render::Accumulated;
+
+/// A merged frame and what its parts say about it.
+#[derive(Debug)]
+pub struct Merged {
+    pub film: Film,
+    pub identity: Identity,
+    /// Summed over the parts.
+    pub counters: crate::integrator::Counters,
+}
+
+fn located(path: &Path, field: Option<&str>, problem: String) -> Error {
+    let e = InputError::new(path, problem);
+    match field {
+        Some(f) => e.in_field(f).into(),
+        None => e.into(),
+    }
+}
+
+/// Checks that the parts' headers belong together and cover the frame
+/// exactly once; the identity they share.
+pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
+    let Some((first_path, first)) = headers.first() else {
+        return Err(Error::Argument {
+            argument: "merge".into(),
+            problem: "no parts given".into(),
+        });
+    };
+    for (p, h) in &headers[1..] {
+        if let Some((field, a, b)) = h.identity.difference(&first.identity) {
+            return Err(located(
+                p,
+                Some(field),
+                format!(
+                    "`{a}`, but {} has `{b}`: the parts are of different frames",
+                    first_path.display()
+                ),
+            ));
+        }
+    }
+    let id = first.identity.clone();
+    let frame = Region::full(id.frame.0, id.frame.1);
+    let pieces: Vec<Piece> = headers
+        .iter()
+        .map(|(_, h)| Piece {
+            region: h.region,
+            samples: h.samples.clone(),
+        })
+        .collect();
+    let show = |r: &Region, s: &std::ops::Range<u32>| {
+        format!(
+            "pixels x {}..{}, y {}..{}, samples {}..{}",
+            r.x0, r.x1, r.y0, r.y1, s.start, s.end
+        )
+    };
+    match cover::check(&pieces, frame, id.spp) {
+        Ok(()) => Ok(id),
+        Err(CoverError::Outside(i)) => Err(located(
+            &headers[i].0,
+            Some("lucent.region"),
+            format!(
+                "{} lies outside the {}×{} frame at {} spp",
+                show(&pieces[i].region, &pieces[i].samples),
+                id.frame.0,
+                id.frame.1,
+                id.spp
+            ),
+        )),
+        Err(CoverError::Overlap {
+            a,
+            b,
+            region,
+            samples,
+        }) => Err(located(
+            &headers[b].0,
+            None,
+            format!(
+                "overlaps {}: both cover {}",
+                headers[a].0.display(),
+                show(&region, &samples)
+            ),
+        )),
+        Err(CoverError::Gap { region, samples }) => {
+            // name the part that stopped short, if one did
+            let short = headers
+                .iter()
+                .find(|(_, h)| {
+                    h.samples.end < h.requested.end && h.region.intersection(&region).is_some()
+                })
+                .map(|(p, h)| {
+                    format!(
+                        " ({} holds samples {}..{} of the {}..{} it was asked for: resume it)",
+                        p.display(),
+                        h.samples.start,
+                        h.samples.end,
+                        h.requested.start,
+                        h.requested.end
+                    )
+                })
+                .unwrap_or_default();
+            Err(Error::Input(format!(
+                "merge: the parts leave a gap: no part covers {}{short}",
+                show(&region, &samples)
+            )))
+        }
+    }
+}
+
+/// Reads, checks and merges the parts at `paths`.
+pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
+    let headers = paths
+        .iter()
+        .map(|p| Ok((p.clone(), part::read_header(p)?)))
+        .collect::<Result<Vec<_>, Error>>()?;
+    let identity = check(&headers)?;
+    let frame = Region::full(identity.frame.0, identity.frame.1);
+    let mut sums = Accumulated::new(frame, 0)?;
+    sums.done = identity.spp;
+    for (path, header) in &headers {
+        crate::interrupt::stop_if_requested()?;
+        let (h, part) = part::read(path)?;
+        if h != *header {
+            return Err(located(path, None, "changed while being merged".into()));
+        }
+        sums.counters += part.counters;
+        let r = part.region;
+        for y in r.y0..r.y1 {
+            for x in r.x0..r.x1 {
+                let from = part.pixel(x, y);
+                for (s, v) in sums.pixel_mut(x, y).iter_mut().zip(from) {
+                    // a forged part could hold sums no render makes
+                    *s = s.checked_add(*v).ok_or_else(|| {
+                        located(
+                            path,
+                            None,
+                            format!("pixel ({x}, {y}): sums beyond any render's range"),
+                        )
+                    })?;
+                }
+            }
+        }
+    }
+    Ok(Merged {
+        film: sums.film()?,
+        identity,
+        counters: sums.counters,
+    })
+}
