@@ -117,6 +117,55 @@ pub const COLUMNS: [&str; 6] = [
     "se_normal",
 ];
 
+/// A table row: its line number and its numbers.
+pub(crate) type Row<const N: usize> = (usize, [f64; N]);
+
+/// The numeric rows of an embedded CSV table: blank and `#` comment lines
+/// skipped, a header naming `columns` exactly, then rows of `N` finite
+/// numbers, each with its line number (from 1) for messages; and the
+/// header's line number.
+pub(crate) fn read_rows<const N: usize>(
+    text: &str,
+    file: &'static str,
+    columns: &[&str; N],
+) -> Result<(usize, Vec<Row<N>>), TableError> {
+    let err = |line: usize, field: &str, problem: String| TableError {
+        file,
+        line,
+        field: field.to_string(),
+        problem,
+    };
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let (hl, header) = lines
+        .next()
+        .ok_or_else(|| err(0, "header", "no header line".into()))?;
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    if names != columns {
+        return Err(err(hl, "header", format!("expected {}", columns.join(","))));
+    }
+    let mut rows = Vec::new();
+    for (ln, l) in lines {
+        let f: Vec<&str> = l.split(',').map(str::trim).collect();
+        if f.len() != N {
+            return Err(err(ln, "row", format!("{} fields, expected {N}", f.len())));
+        }
+        let mut v = [0.0; N];
+        for (k, s) in f.iter().enumerate() {
+            v[k] = s
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| err(ln, columns[k], format!("not a finite number: \"{s}\"")))?;
+        }
+        rows.push((ln, v));
+    }
+    Ok((hl, rows))
+}
+
 impl AlbedoTable {
     /// The embedded table, parsed once.
     pub fn get() -> Result<&'static AlbedoTable, &'static TableError> {
@@ -135,36 +184,9 @@ impl AlbedoTable {
             field: field.to_string(),
             problem,
         };
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .map(|(i, l)| (i + 1, l.trim()))
-            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-        let (hl, header) = lines
-            .next()
-            .ok_or_else(|| err(0, "header", "no header line".into()))?;
-        let names: Vec<&str> = header.split(',').map(str::trim).collect();
-        if names != COLUMNS {
-            return Err(err(hl, "header", format!("expected {}", COLUMNS.join(","))));
-        }
         let mut rows: Vec<(usize, [f64; 6])> = Vec::new();
-        for (ln, l) in lines {
-            let f: Vec<&str> = l.split(',').map(str::trim).collect();
-            if f.len() != COLUMNS.len() {
-                return Err(err(
-                    ln,
-                    "row",
-                    format!("{} fields, expected {}", f.len(), COLUMNS.len()),
-                ));
-            }
-            let mut v = [0.0; 6];
-            for (k, s) in f.iter().enumerate() {
-                v[k] = s
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|x| x.is_finite())
-                    .ok_or_else(|| err(ln, COLUMNS[k], format!("not a finite number: \"{s}\"")))?;
-            }
+        let (hl, read) = read_rows(text, file, &COLUMNS)?;
+        for (ln, v) in read {
             for (k, name) in COLUMNS.iter().enumerate().skip(2) {
                 let ok = if k % 2 == 0 {
                     (0.0..=1.0).contains(&v[k])

@@ -28,7 +28,7 @@
 
 use std::sync::OnceLock;
 
-use super::albedo_table::TableError;
+use super::albedo_table::{read_rows, TableError};
 
 /// The data file, embedded.
 pub const DATA: &str = include_str!("curvature_table.csv");
@@ -84,36 +84,9 @@ impl CurvatureTable {
             field: field.to_string(),
             problem,
         };
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .map(|(i, l)| (i + 1, l.trim()))
-            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-        let (hl, header) = lines
-            .next()
-            .ok_or_else(|| err(0, "header", "no header line".into()))?;
-        let names: Vec<&str> = header.split(',').map(str::trim).collect();
-        if names != COLUMNS {
-            return Err(err(hl, "header", format!("expected {}", COLUMNS.join(","))));
-        }
         let mut rows: Vec<(usize, [f64; 7])> = Vec::new();
-        for (ln, l) in lines {
-            let f: Vec<&str> = l.split(',').map(str::trim).collect();
-            if f.len() != COLUMNS.len() {
-                return Err(err(
-                    ln,
-                    "row",
-                    format!("{} fields, expected {}", f.len(), COLUMNS.len()),
-                ));
-            }
-            let mut v = [0.0; 7];
-            for (k, s) in f.iter().enumerate() {
-                v[k] = s
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|x| x.is_finite())
-                    .ok_or_else(|| err(ln, COLUMNS[k], format!("not a finite number: \"{s}\"")))?;
-            }
+        let (hl, read) = read_rows(text, file, &COLUMNS)?;
+        for (ln, v) in read {
             let ok = [
                 v[0] >= 1.0,
                 v[1] > 0.0 && v[1] <= 1.0,
