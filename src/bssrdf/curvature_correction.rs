@@ -96,6 +96,14 @@ pub fn mean_curvature(mesh: &Mesh, prim: u32) -> f32 {
     }
 }
 
+/// The exit point's curvature κo and its factor f(κo)
+/// ([`CurvatureCorrection::at_exit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExitFactor {
+    kappa: f32,
+    f: [f32; 3],
+}
+
 /// One channel's data: A, d, ℓd, and h at the table's ρ nodes.
 #[derive(Clone, Debug, PartialEq)]
 struct Channel {
@@ -235,10 +243,26 @@ impl CurvatureCorrection {
     /// one of curvature `kappa_i`: √(f(κo)·f(κi)) per channel; None when
     /// both are ≤ 0 (the weight stays as it is, bit for bit).
     pub fn weight(&self, kappa_o: f32, kappa_i: f32) -> Option<Vec3> {
-        if !(kappa_o > 0.0 || kappa_i > 0.0) {
+        self.weight_from(&self.at_exit(kappa_o), kappa_i)
+    }
+
+    /// The exit point's half of [`weight`](Self::weight): κo and f(κo),
+    /// computed once for all the probes from one exit point (the
+    /// antithetic pair's two; `crate::kernels`).
+    pub fn at_exit(&self, kappa_o: f32) -> ExitFactor {
+        ExitFactor {
+            kappa: kappa_o,
+            f: self.factor(kappa_o),
+        }
+    }
+
+    /// [`weight`](Self::weight) from the exit point's [`at_exit`](Self::at_exit):
+    /// the same value, bit for bit.
+    pub fn weight_from(&self, exit: &ExitFactor, kappa_i: f32) -> Option<Vec3> {
+        if !(exit.kappa > 0.0 || kappa_i > 0.0) {
             return None;
         }
-        let (fo, fi) = (self.factor(kappa_o), self.factor(kappa_i));
+        let (fo, fi) = (exit.f, self.factor(kappa_i));
         Some(Vec3::new(
             (fo[0] * fi[0]).sqrt(),
             (fo[1] * fi[1]).sqrt(),
@@ -364,5 +388,28 @@ mod tests {
         assert_eq!(mean_curvature(&inside, 0), 0.0);
         let flat = Mesh::new(dirs.map(|d| d * r).to_vec(), vec![[0, 1, 2]], None);
         assert_eq!(mean_curvature(&flat, 0), 0.0);
+    }
+
+    /// The exit half computed once gives the same weight as `weight`, bit
+    /// for bit, including the flat and concave cases where it is None.
+    #[test]
+    fn weight_from_the_exit_half_is_weight() {
+        let (_, cc) = marble(1.0);
+        let ks = [-1.0f32, 0.0, 1e-7, 0.01, 0.1, 0.5, 1.0, 3.0, 40.0, f32::NAN];
+        for &ko in &ks {
+            let exit = cc.at_exit(ko);
+            for &ki in &ks {
+                let (got, want) = (cc.weight_from(&exit, ki), cc.weight(ko, ki));
+                assert_eq!(
+                    got.map(|v| v.to_array().map(f32::to_bits)),
+                    want.map(|v| v.to_array().map(f32::to_bits)),
+                    "{ko} {ki}"
+                );
+            }
+        }
+        // and it is not a constant: the exit point's curvature counts
+        let a = cc.weight_from(&cc.at_exit(0.1), 0.1).unwrap();
+        let b = cc.weight_from(&cc.at_exit(1.0), 0.1).unwrap();
+        assert_ne!(a, b);
     }
 }

@@ -268,6 +268,18 @@ pub struct ProbeSegment {
     channel: usize,
 }
 
+/// The part of a probe sample both probes of an antithetic pair share
+/// ([`ProbeSampler::sample_probe_pair`]): channel, radius, the axis
+/// probabilities and the axis V with the plane (T', B') ⟂ V.
+#[derive(Clone, Copy)]
+struct Shared {
+    channel: usize,
+    r: f64,
+    h: f64,
+    probs: [f64; 3],
+    axes: [DVec3; 3],
+}
+
 /// An entry point weighed by [`ProbeSampler::weigh`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProbeEntry {
@@ -410,6 +422,34 @@ impl ProbeSampler {
         curvature: f32,
         u: &ProbeRandoms,
     ) -> Option<ProbeSegment> {
+        let shared = self.sample_shared(frame, curvature, u)?;
+        Some(self.segment(xo, frame, &shared, u.angle))
+    }
+
+    /// The two probes of an antithetic pair from one set of randoms `u`:
+    /// [`sample_probe`](Self::sample_probe) at φ and at φ + π (angle
+    /// `(u.angle + ½).fract()` in turns), each bit for bit what
+    /// `sample_probe` gives for its angle. The channel, radius and axis —
+    /// the radius inverse CDF and the axis probabilities, most of a
+    /// probe's sampling work — are computed once for both (`crate::kernels`).
+    pub fn sample_probe_pair(
+        &self,
+        xo: Vec3,
+        frame: &Frame,
+        curvature: f32,
+        u: &ProbeRandoms,
+    ) -> Option<[ProbeSegment; 2]> {
+        let shared = self.sample_shared(frame, curvature, u)?;
+        Some([
+            self.segment(xo, frame, &shared, u.angle),
+            self.segment(xo, frame, &shared, (u.angle + 0.5).fract()),
+        ])
+    }
+
+    /// What a probe samples before its angle: the channel c, the radius r
+    /// and the axis V (with the plane T', B' ⟂ V).
+    #[inline(always)]
+    fn sample_shared(&self, frame: &Frame, curvature: f32, u: &ProbeRandoms) -> Option<Shared> {
         if self.n_active == 0 {
             return None;
         }
@@ -433,20 +473,40 @@ impl ProbeSampler {
             1 => (b, n, t),
             _ => (n, t, b),
         };
+        // The chord's half length h = √(Rmax² − r²).
+        let h = (self.rmax * self.rmax - r * r).max(0.0).sqrt();
+        Some(Shared {
+            channel,
+            r,
+            h,
+            probs,
+            axes: [v, t1, t2],
+        })
+    }
+
+    /// The probe of `shared` at angle `angle` (turns).
+    #[inline(always)]
+    fn segment(&self, xo: Vec3, frame: &Frame, shared: &Shared, angle: f64) -> ProbeSegment {
+        let Shared {
+            channel,
+            r,
+            h,
+            probs,
+            axes: [v, t1, t2],
+        } = *shared;
         // The angle in f32: its rounding moves p0 by ~1e-7·r, below the f32
         // rounding of p0 itself.
-        let (sin, cos) = crate::sampling::sin_cos_turns(u.angle as f32);
+        let (sin, cos) = crate::sampling::sin_cos_turns(angle as f32);
         // Step 2: p0 = xo + r (cos φ T' + sin φ B') + h V, segment p0 → p0 − 2h V.
-        let h = (self.rmax * self.rmax - r * r).max(0.0).sqrt();
         let p0 = xo.as_dvec3() + (t1 * cos as f64 + t2 * sin as f64) * r + v * h;
-        Some(ProbeSegment {
+        ProbeSegment {
             ray: Ray::new(p0.as_vec3(), (-v).as_vec3()),
             t_max: (2.0 * h) as f32,
             xo,
             frame: *frame,
             probs,
             channel,
-        })
+        }
     }
 
     /// Weighs the hit at distance `t` along `seg` on a triangle with unit
@@ -848,5 +908,56 @@ mod tests {
         }
         let s = ProbeSampler::new(&p, &ProbeOptions::default()).unwrap();
         assert!((s.rmax() - profile::quantile(0.999)).abs() < 1e-12);
+    }
+
+    /// The pair's two segments are, bit for bit, what `sample_probe` gives
+    /// at φ and at the twin's angle (φ + ½ turn): sharing the channel,
+    /// radius and axis between them changes nothing (`crate::kernels`).
+    #[test]
+    fn probe_pair_is_two_probes_at_opposite_angles_bit_for_bit() {
+        let params = SubsurfaceParams::from_preset("marble", 1.0, profile::Fit::Searchlight);
+        let params = params.unwrap();
+        let mut rng = Rng::from_key(7);
+        let frame = Frame::from_normal(Vec3::new(0.3, -0.5, 0.8).normalize());
+        let xo = Vec3::new(0.25, -1.5, 3.0);
+        let mut n = 0;
+        for axes in ProbeAxes::ALL {
+            let opts = ProbeOptions {
+                axes,
+                ..ProbeOptions::default()
+            };
+            let s = ProbeSampler::new(&params, &opts).unwrap();
+            for i in 0..2000 {
+                let u = ProbeRandoms::from_rng(&mut rng);
+                let kappa = (i % 7) as f32 * 0.4;
+                let twin = ProbeRandoms {
+                    angle: (u.angle + 0.5).fract(),
+                    ..u
+                };
+                let [a, b] = s.sample_probe_pair(xo, &frame, kappa, &u).unwrap();
+                for (got, want) in [
+                    (a, s.sample_probe(xo, &frame, kappa, &u)),
+                    (b, s.sample_probe(xo, &frame, kappa, &twin)),
+                ] {
+                    let want = want.unwrap();
+                    assert_eq!(
+                        (got.ray.o, got.ray.d, got.t_max, got.probs, got.channel),
+                        (want.ray.o, want.ray.d, want.t_max, want.probs, want.channel),
+                        "{axes:?}, probe {i}"
+                    );
+                    assert_eq!((got.xo, got.frame.n), (want.xo, want.frame.n));
+                    n += 1;
+                }
+                // the twin lies across xo: the two disk offsets are opposite
+                let (oa, ob) = (a.ray.o - xo, b.ray.o - xo);
+                let v = -a.ray.d;
+                let (da, db) = (oa - v * oa.dot(v), ob - v * ob.dot(v));
+                assert!(
+                    (da + db).length() <= 1e-5 * (1.0 + da.length()),
+                    "{da} {db}"
+                );
+            }
+        }
+        assert_eq!(n, 2 * 2000 * ProbeAxes::ALL.len());
     }
 }

@@ -58,11 +58,11 @@
 
 use super::aov::{self, Event, Recorder, Source};
 use super::interaction::offset_along;
-use super::probe::{exit_curvature, sample_entry, ProbeTarget};
+use super::probe::{entry_on_segment, exit_curvature, ProbeTarget};
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
-use crate::bssrdf::curvature_correction::mean_curvature;
-use crate::bssrdf::ProbeRandoms;
+use crate::bssrdf::curvature_correction::{mean_curvature, CurvatureCorrection, ExitFactor};
+use crate::bssrdf::{ProbeRandoms, ProbeSegment};
 use crate::film::passes::Pass;
 use crate::fresnel;
 use crate::geometry::{Frame, Ray, Vec3};
@@ -719,9 +719,17 @@ fn entries<'s>(
 ) -> (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>) {
     let frame_o = si.shading_frame_facing(wo);
     let u = ProbeRandoms::from_rng(rng);
-    let kappa = exit_curvature(&ctx.scene.meshes[si.geom as usize], si.prim);
+    let mesh = &ctx.scene.meshes[si.geom as usize];
+    let kappa = exit_curvature(mesh, si.prim);
+    // The curvature correction's exit half, once for both probes of a pair.
+    let exit = ss
+        .curvature_correction()
+        .map(|cc| (cc, cc.at_exit(mean_curvature(mesh, si.prim))));
     if depth >= ctx.pair_depth {
-        let e = probe_entry(ctx, ss, si, &frame_o, kappa, &u, scratch, counters);
+        let e = ss
+            .probe
+            .sample_probe(si.p, &frame_o, kappa, &u)
+            .and_then(|seg| probe_entry(ctx, ss, si, &seg, exit, &u, scratch, counters));
         return match e {
             Some((v, w)) => {
                 *beta *= w;
@@ -730,12 +738,14 @@ fn entries<'s>(
             None => (None, None),
         };
     }
-    let twin = ProbeRandoms {
-        angle: (u.angle + 0.5).fract(),
-        ..u
+    // The twin's randoms are u's with the angle at φ + π
+    // (ProbeSampler::sample_probe_pair), which changes none of what
+    // entry_on_segment reads.
+    let Some([seg_a, seg_b]) = ss.probe.sample_probe_pair(si.p, &frame_o, kappa, &u) else {
+        return (None, None);
     };
-    let a = probe_entry(ctx, ss, si, &frame_o, kappa, &u, scratch, counters);
-    let b = probe_entry(ctx, ss, si, &frame_o, kappa, &twin, scratch, counters);
+    let a = probe_entry(ctx, ss, si, &seg_a, exit, &u, scratch, counters);
+    let b = probe_entry(ctx, ss, si, &seg_b, exit, &u, scratch, counters);
     match (a, b) {
         (Some((va, wa)), Some((vb, wb))) => {
             // Go on from one, chosen with probability ½ (weight 2 × ½);
@@ -772,15 +782,17 @@ fn entry_scatter<'s>(e: (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>)) -> Sca
     }
 }
 
-/// The area integral at xo: one entry point xi from a probe ray with
-/// randoms `u`, and the probe's weight; None when the probe finds nothing.
+/// The area integral at xo: one entry point xi from the probe segment
+/// `seg` sampled with randoms `u`, and the probe's weight; None when the
+/// probe finds nothing. `exit`: the material's curvature correction and
+/// its exit half at xo, if it has one.
 #[allow(clippy::too_many_arguments)]
 fn probe_entry<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
     si: &Interaction,
-    frame_o: &Frame,
-    kappa: f32,
+    seg: &ProbeSegment,
+    exit: Option<(&CurvatureCorrection, ExitFactor)>,
     u: &ProbeRandoms,
     scratch: &mut Scratch,
     counters: &mut Counters,
@@ -791,22 +803,13 @@ fn probe_entry<'s>(
         geom: si.geom,
         mesh: &ctx.scene.meshes[si.geom as usize],
     };
-    let ps = sample_entry(
-        &ss.probe,
-        si.p,
-        frame_o,
-        kappa,
-        u,
-        &target,
-        &mut scratch.probe_hits,
-    )?;
+    let ps = entry_on_segment(&ss.probe, seg, u, &target, &mut scratch.probe_hits)?;
     // The curvature correction (bssrdf::curvature_correction): None, and
     // the weight untouched, on flat and concave surfaces.
     let mut weight = ps.weight;
-    if let Some(cc) = ss.curvature_correction() {
-        let k_o = mean_curvature(target.mesh, si.prim);
+    if let Some((cc, exit)) = &exit {
         let k_i = mean_curvature(target.mesh, ps.hit.prim);
-        if let Some(f) = cc.weight(k_o, k_i) {
+        if let Some(f) = cc.weight_from(exit, k_i) {
             weight *= f;
         }
     }

@@ -10,7 +10,7 @@
 //! with the density the weights divide by (a χ² test).
 
 use crate::accel::{Accel, Hit, ProbeHits};
-use crate::bssrdf::{pick_hit, ProbeRandoms, ProbeSampler};
+use crate::bssrdf::{pick_hit, ProbeRandoms, ProbeSampler, ProbeSegment};
 use crate::geometry::{Frame, Mesh, Vec3};
 
 /// The curvature of `mesh` at triangle `prim`, from its shading normals:
@@ -106,6 +106,20 @@ pub fn sample_entry(
     // docs/bssrdf.md §5: steps 1–2 in the BSSRDF, step 3 here (every hit
     // on the object, one picked uniformly), step 4 in the BSSRDF.
     let seg = sampler.sample_probe(xo, frame, kappa, u)?;
+    entry_on_segment(sampler, &seg, u, target, hits)
+}
+
+/// Steps 3–4 of [`sample_entry`] for a probe segment already sampled (by
+/// [`ProbeSampler::sample_probe`], or one of
+/// [`ProbeSampler::sample_probe_pair`]'s two) with randoms `u`: every hit
+/// of `seg` on the object, one picked, weighed.
+pub fn entry_on_segment(
+    sampler: &ProbeSampler,
+    seg: &ProbeSegment,
+    u: &ProbeRandoms,
+    target: &ProbeTarget,
+    hits: &mut ProbeHits,
+) -> Option<ProbeSample> {
     target
         .accel
         .hits_on_segment(&seg.ray, seg.t_max, target.geom, u.seed, hits);
@@ -115,7 +129,7 @@ pub fn sample_entry(
     }
     let hit = kept[pick_hit(u, kept.len())];
     let normal = target.mesh.face_normal(hit.prim);
-    let entry = sampler.weigh(&seg, hit.t, normal, hits.total())?;
+    let entry = sampler.weigh(seg, hit.t, normal, hits.total())?;
     Some(ProbeSample {
         hit,
         point: entry.point,
