@@ -399,7 +399,13 @@ mod tests {
         for &ko in &ks {
             let exit = cc.at_exit(ko);
             for &ki in &ks {
-                let (got, want) = (cc.weight_from(&exit, ki), cc.weight(ko, ki));
+                // √(f(κo)·f(κi)) per channel, None where neither is convex
+                let want = (ko > 0.0 || ki > 0.0).then(|| {
+                    let (fo, fi) = (cc.factor(ko), cc.factor(ki));
+                    Vec3::from_array(std::array::from_fn(|c| (fo[c] * fi[c]).sqrt()))
+                });
+                let got = cc.weight_from(&exit, ki);
+                assert_eq!(got, cc.weight(ko, ki));
                 assert_eq!(
                     got.map(|v| v.to_array().map(f32::to_bits)),
                     want.map(|v| v.to_array().map(f32::to_bits)),
