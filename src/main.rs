@@ -932,7 +932,7 @@ struct StudyArgs {
     #[arg(long, default_value_t = 10.0)]
     firefly_k: f64,
     /// Only these axes (comma separated: radius, rmax, axes, channel,
-    /// renormalize, exit_sw, specular, backend, integrator, boundary); the baseline
+    /// renormalize, exit_sw, specular, backend, integrator, boundary, lod); the baseline
     /// always runs.
     #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
     only: Vec<lucent::tools::study::Axis>,

@@ -185,7 +185,11 @@ fn forced_lod_keeps_the_coat_energy() {
         }
         let furnace = coat_scene(roughness, 1.0, true);
         let (lod, c) = run(&with_lod(&furnace, LodMode::Force), 256, 3);
-        within_1pct(&format!("lod panel furnace, roughness {roughness}"), &lod, [1.0; 3]);
+        within_1pct(
+            &format!("lod panel furnace, roughness {roughness}"),
+            &lod,
+            [1.0; 3],
+        );
         assert_eq!(c.probes, 0);
     }
 }
@@ -213,9 +217,15 @@ fn auto_lod_switches_at_the_analytic_camera_footprint() {
     let (off, c_off) = run(&with_lod(&base, LodMode::Off), 4, 5);
     let (above, c_above) = run(&at(1.0005 * w_centre / rmax), 4, 5);
     assert_eq!(c_above.probes, c_off.probes);
-    assert!(off.pixels == above.pixels, "LOD that never triggers changed the image");
+    assert!(
+        off.pixels == above.pixels,
+        "LOD that never triggers changed the image"
+    );
     let (_, c_below) = run(&at(0.99 * w_centre / rmax), 4, 5);
-    assert!(c_below.probes < c_off.probes, "no LOD just below the footprint");
+    assert!(
+        c_below.probes < c_off.probes,
+        "no LOD just below the footprint"
+    );
     // At angle θ off the axis the plane is 10/cos θ away and the cone's
     // spread cos²θ times the pixel's: width w_centre·cos θ ≥ 0.99 w_centre
     // where tan θ ≤ 0.1425, within 12.93 pixels of the centre (pitch
@@ -243,7 +253,11 @@ fn cli_lod_flag_overrides_the_scene() {
             .arg(&out)
             .output()
             .unwrap();
-        assert!(res.status.success(), "{}", String::from_utf8_lossy(&res.stderr));
+        assert!(
+            res.status.success(),
+            "{}",
+            String::from_utf8_lossy(&res.stderr)
+        );
         out
     };
     assert!(go("force", "force.exr").exists());

@@ -435,7 +435,16 @@ fn follow<'s, R: Recorder>(
                 if R::ON {
                     rec.surface(ss.albedo(), si.shading_frame_facing(wo).n);
                 }
-                subsurface(ss, &si, wo, &mut beta, rng, counters, depth, cone.width_at(hit.t))
+                subsurface(
+                    ss,
+                    &si,
+                    wo,
+                    &mut beta,
+                    rng,
+                    counters,
+                    depth,
+                    cone.width_at(hit.t),
+                )
             }
         };
         // The footprint after this vertex: specular continuations keep the
@@ -625,7 +634,8 @@ fn subsurface_probe<'s>(
         } else if split {
             *beta *= 1.0 - fr;
             let reflected = Some((mirror(ctx, si, wo, n_out), beta_in * fr, None));
-            let (entry, pair) = entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
+            let (entry, pair) =
+                entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
             return Scatter::Coated(Coated {
                 coat: None,
                 reflected,
