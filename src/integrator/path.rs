@@ -55,6 +55,13 @@
 //! path then goes on by the coat with probability E, else into the medium.
 //! Light sampling already finds the highlight there, and splitting the
 //! rough coat measured worse per unit time (see `COAT_SPLIT_DEPTH`).
+//!
+//! **Level of detail.** Each path carries its footprint, a ray cone
+//! ([`Cone`]: width and spread, from the camera pixel; kept through
+//! specular bounces, widened after lobes). Where a subsurface material's
+//! rule says the footprint is wide against its profile, the entry point is
+//! xo itself, weighted by the profile's plane integral, and no probe is
+//! cast ([`crate::materials::lod`]); the coat is unchanged.
 
 use super::aov::{self, Event, Recorder, Source};
 use super::interaction::offset_along;
