@@ -19,7 +19,7 @@ use lucent::film::passes::PassSet;
 use lucent::film::region::Region;
 use lucent::film::ToneMap;
 use lucent::integrator::IntegratorKind;
-use lucent::materials::{SubsurfaceOverrides, WalkBoundary};
+use lucent::materials::{LodMode, SubsurfaceOverrides, WalkBoundary};
 use lucent::render::{self, RenderOptions};
 use lucent::scene;
 use lucent::Error;
@@ -251,6 +251,11 @@ struct SubsurfaceArgs {
     /// Fresnel transmission with light sampling at the exit; another model).
     #[arg(long, value_enum)]
     boundary: Option<BoundaryArg>,
+    /// Subsurface level of detail: auto (albedo A where the path's
+    /// footprint is wide against the profile, per material threshold) | off
+    /// (always probe) | force (every hit shaded with albedo A; for tests).
+    #[arg(long, value_enum)]
+    lod: Option<LodArg>,
 }
 
 /// How the EXR is stored (docs/output.md); each overrides the scene's
@@ -319,6 +324,13 @@ impl FileArgs {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
+enum LodArg {
+    Auto,
+    Off,
+    Force,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
 enum BoundaryArg {
     Dielectric,
     Diffuse,
@@ -367,6 +379,11 @@ impl SubsurfaceArgs {
                 BoundaryArg::Diffuse => WalkBoundary::Diffuse { exit_nee: true },
             }),
             roughness: self.roughness,
+            lod: self.lod.map(|l| match l {
+                LodArg::Auto => LodMode::Auto,
+                LodArg::Off => LodMode::Off,
+                LodArg::Force => LodMode::Force,
+            }),
         }
     }
 }
@@ -915,7 +932,7 @@ struct StudyArgs {
     #[arg(long, default_value_t = 10.0)]
     firefly_k: f64,
     /// Only these axes (comma separated: radius, rmax, axes, channel,
-    /// renormalize, exit_sw, specular, backend, integrator, boundary); the baseline
+    /// renormalize, exit_sw, specular, backend, integrator, boundary, lod); the baseline
     /// always runs.
     #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
     only: Vec<lucent::tools::study::Axis>,

@@ -480,6 +480,27 @@ fn cases() -> Vec<Case> {
             Some("materials.skin.curvature_correction"),
         ),
         case(
+            "subsurface unknown lod",
+            format!("{CAM}{SSS}preset = \"skin1\"\nlod = \"force\"\n"),
+            "expected \"auto\" or \"off\", found \"force\"",
+            Some("force"),
+            Some("materials.skin.lod"),
+        ),
+        case(
+            "subsurface lod threshold not positive",
+            format!("{CAM}{SSS}preset = \"skin1\"\nlod_threshold = -2.0\n"),
+            "expected a finite number > 0",
+            Some("-2.0"),
+            Some("materials.skin.lod_threshold"),
+        ),
+        case(
+            "subsurface lod threshold zero",
+            format!("{CAM}{SSS}preset = \"skin1\"\nlod_threshold = 0\n"),
+            "found 0",
+            Some("lod_threshold = 0"),
+            Some("materials.skin.lod_threshold"),
+        ),
+        case(
             "subsurface unknown fit",
             format!("{CAM}{SSS}preset = \"skin1\"\nfit = \"dipole\"\n"),
             "unknown fit \"dipole\"",
@@ -725,6 +746,21 @@ fn cli_exits_2_on_scene_errors_without_writing_output() {
             format!("{CAM}{SSS}preset = \"skin1\"\ncurvature_correction = \"sometimes\"\n"),
             None,
             "scene.toml:8: field `materials.skin.curvature_correction`: expected \"auto\" or \"off\"",
+        ),
+        (
+            format!("{CAM}{SSS}preset = \"skin1\"\nlod = \"sometimes\"\n"),
+            None,
+            "scene.toml:8: field `materials.skin.lod`: expected \"auto\" or \"off\"",
+        ),
+        (
+            format!("{CAM}{SSS}preset = \"skin1\"\nlod_threshold = nan\n"),
+            None,
+            "scene.toml:8: field `materials.skin.lod_threshold`: expected a finite number > 0",
+        ),
+        (
+            format!("{CAM}{SSS}preset = \"skin1\"\nlod_threshold = \"big\"\n"),
+            None,
+            "scene.toml:8: field `materials.skin.lod_threshold`",
         ),
         (
             format!("{CAM}{SSS}preset = \"skin1\"\nroughness = 2\n"),

@@ -25,7 +25,7 @@
 //! | `lucent.samples` | `A..B`: the sample indices summed |
 //! | `lucent.requested` | `A..E`: what the job was asked for (`B < E` after an interruption) |
 //! | `lucent.layers` | `L:C,C,…:F;…`: each layer's channels and fixed-point fraction bits |
-//! | `lucent.counters` | `rays,nonfinite,clamped,walks_capped,walks_escaped` |
+//! | `lucent.counters` | `rays,nonfinite,clamped,walks_capped,walks_escaped,probes` |
 //!
 //! A merge needs nothing else: any set of named layers merges the same way
 //! (add the integer sums, divide by spp once), so the AOV layers will ride
@@ -195,8 +195,8 @@ pub fn stage(path: &Path, header: &Header, sums: &Accumulated) -> Result<Staged,
         (
             "lucent.counters",
             format!(
-                "{},{},{},{},{}",
-                c.rays, c.nonfinite, c.clamped, c.walks_capped, c.walks_escaped
+                "{},{},{},{},{},{}",
+                c.rays, c.nonfinite, c.clamped, c.walks_capped, c.walks_escaped, c.probes
             ),
         ),
     ] {
@@ -326,12 +326,13 @@ fn parse_header(
         .split(',')
         .map(|v| v.parse().ok())
         .collect::<Option<_>>()
-        .filter(|v: &Vec<u64>| v.len() == 5)
+        // parts written before the probe count have 5
+        .filter(|v: &Vec<u64>| v.len() == 5 || v.len() == 6)
         .ok_or_else(|| {
             bad(
                 path,
                 Some("lucent.counters"),
-                format!("`{counters_text}` is not 5 counts"),
+                format!("`{counters_text}` is not 6 counts"),
             )
         })?;
     let header = Header {
@@ -354,6 +355,7 @@ fn parse_header(
             clamped: c[2],
             walks_capped: c[3],
             walks_escaped: c[4],
+            probes: c.get(5).copied().unwrap_or(0),
         },
     };
     let (w, h) = header.identity.frame;

@@ -40,6 +40,9 @@ pub struct Context<'a> {
     /// entry points ([`path::PAIR_DEPTH`], the default); 0 turns the pair
     /// off (one probe per hit), for measurements and tests.
     pub pair_depth: u32,
+    /// The camera's pixel angle, for the footprint cone of subsurface
+    /// level of detail ([`crate::materials::lod`]).
+    pub camera_spread: crate::materials::lod::CameraSpread,
 }
 
 impl<'a> Context<'a> {
@@ -64,6 +67,11 @@ impl<'a> Context<'a> {
             ray_epsilon: extent * 1e-6,
             shading,
             pair_depth: path::PAIR_DEPTH,
+            camera_spread: crate::materials::lod::CameraSpread::new(
+                scene.camera.fov_y,
+                scene.camera.height,
+                scene.camera.look_at - scene.camera.look_from,
+            ),
         }
     }
 
@@ -127,6 +135,9 @@ impl IntegratorKind {
 pub struct Counters {
     /// Ray queries issued: nearest, shadow and probe.
     pub rays: u64,
+    /// Probe queries (of `rays`): one per entry point the diffusion
+    /// estimator looked for.
+    pub probes: u64,
     /// Samples whose radiance was not finite and was discarded.
     pub nonfinite: u64,
     /// Sample channels beyond the accumulator's range, clamped to it
@@ -141,6 +152,7 @@ pub struct Counters {
 impl std::ops::AddAssign for Counters {
     fn add_assign(&mut self, o: Self) {
         self.rays += o.rays;
+        self.probes += o.probes;
         self.nonfinite += o.nonfinite;
         self.clamped += o.clamped;
         self.walks_capped += o.walks_capped;

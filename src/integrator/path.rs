@@ -55,6 +55,13 @@
 //! path then goes on by the coat with probability E, else into the medium.
 //! Light sampling already finds the highlight there, and splitting the
 //! rough coat measured worse per unit time (see `COAT_SPLIT_DEPTH`).
+//!
+//! **Level of detail.** Each path carries its footprint, a ray cone
+//! ([`Cone`]: width and spread, from the camera pixel; kept through
+//! specular bounces, widened after lobes). Where a subsurface material's
+//! rule says the footprint is wide against its profile, the entry point is
+//! xo itself, weighted by the profile's plane integral, and no probe is
+//! cast ([`crate::materials::lod`]); the coat is unchanged.
 
 use super::aov::{self, Event, Recorder, Source};
 use super::interaction::offset_along;
@@ -66,6 +73,7 @@ use crate::bssrdf::{ProbeRandoms, ProbeSegment};
 use crate::film::passes::Pass;
 use crate::fresnel;
 use crate::geometry::{Frame, Ray, Vec3};
+use crate::materials::lod::Cone;
 use crate::materials::microfacet::RoughCoat;
 use crate::materials::{dielectric, diffuse, Material, Subsurface};
 use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Draw, SampleRng};
@@ -219,8 +227,9 @@ pub(crate) struct Coated<'a> {
 pub(crate) type Reflected = (Ray, Vec3, Option<(Vec3, f32)>);
 
 /// A path to trace: its ray, throughput, the last non-specular vertex and
-/// its lobe pdf (for the emission MIS weight), its depth, and the class of
-/// its first event (for the light-path passes).
+/// its lobe pdf (for the emission MIS weight), its depth, the class of
+/// its first event (for the light-path passes), and its footprint cone
+/// (for subsurface level of detail, [`crate::materials::lod`]).
 #[derive(Clone, Copy)]
 struct Branch {
     ray: Ray,
@@ -228,6 +237,7 @@ struct Branch {
     prev: Option<(Vec3, f32)>,
     depth: u32,
     event: Event,
+    cone: Cone,
 }
 
 /// A fixed-capacity stack of [`Branch`]es (no allocation per sample).
@@ -273,8 +283,8 @@ pub fn radiance<R: Recorder>(
         rng,
         counters,
         rec,
-        |ss, si, wo, beta, rng, counters, depth| {
-            subsurface_probe(ctx, ss, si, wo, beta, rng, scratch, counters, depth)
+        |ss, si, wo, beta, rng, counters, depth, width| {
+            subsurface_probe(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width)
         },
     )
 }
@@ -302,11 +312,14 @@ pub(crate) fn trace<'s, R: Recorder>(
         rng,
         counters,
         rec,
-        |ss, si, wo, beta, rng, counters, _depth| subsurface(ss, si, wo, beta, rng, counters),
+        |ss, si, wo, beta, rng, counters, _depth, _width| {
+            subsurface(ss, si, wo, beta, rng, counters)
+        },
     )
 }
 
-/// [`trace`] whose `subsurface` also receives the depth of the hit.
+/// [`trace`] whose `subsurface` also receives the depth of the hit and the
+/// width of the path's footprint there ([`Cone`]).
 fn trace_at<'s, R: Recorder>(
     ctx: &'s Context,
     camera_ray: Ray,
@@ -321,6 +334,7 @@ fn trace_at<'s, R: Recorder>(
         &mut SampleRng,
         &mut Counters,
         u32,
+        f32,
     ) -> Scatter<'s>,
 ) -> Vec3 {
     // The paths a coat split off wait here; L sums over all of them.
@@ -332,6 +346,7 @@ fn trace_at<'s, R: Recorder>(
         depth: 0,
         // Set at the first hit.
         event: Event::Diffuse,
+        cone: Cone::camera(&ctx.camera_spread, camera_ray.d),
     });
     let mut l = Vec3::ZERO;
     while let Some(start) = first.take().or_else(|| stack.pop()) {
@@ -357,6 +372,7 @@ fn follow<'s, R: Recorder>(
         &mut SampleRng,
         &mut Counters,
         u32,
+        f32,
     ) -> Scatter<'s>,
     stack: &mut Branches,
 ) -> Vec3 {
@@ -372,6 +388,8 @@ fn follow<'s, R: Recorder>(
     let mut prev: Option<(Vec3, f32)> = start.prev;
     // The class of the path's first event, known after its first hit.
     let mut event = start.event;
+    // The footprint cone of the current ray.
+    let mut cone = start.cone;
 
     let max_depth = scene.settings.max_depth;
     for depth in start.depth..=max_depth {
@@ -424,9 +442,21 @@ fn follow<'s, R: Recorder>(
                 if R::ON {
                     rec.surface(ss.albedo(), si.shading_frame_facing(wo).n);
                 }
-                subsurface(ss, &si, wo, &mut beta, rng, counters, depth)
+                subsurface(
+                    ss,
+                    &si,
+                    wo,
+                    &mut beta,
+                    rng,
+                    counters,
+                    depth,
+                    cone.width_at(hit.t),
+                )
             }
         };
+        // The footprint after this vertex: specular continuations keep the
+        // cone's spread, lobes widen it.
+        let (cone_specular, cone_rough) = (cone.specular(hit.t), cone.rough(hit.t));
         // Light sampled at the vertex counts this much (½ at an entry
         // point of an antithetic pair, whose twin is sampled too).
         let mut nee_scale = 1.0;
@@ -448,6 +478,7 @@ fn follow<'s, R: Recorder>(
                 }
                 prev = None;
                 ray = *next;
+                cone = cone_specular;
                 if !roulette(depth, &mut beta, rng) {
                     break;
                 }
@@ -476,6 +507,7 @@ fn follow<'s, R: Recorder>(
                             prev: p,
                             depth: depth + 1,
                             event: coat_event,
+                            cone: cone_specular,
                         });
                         match branch.map(|br| stack.push(br)) {
                             Some(false) if rng.uniform() < 0.5 => (None, Some((r, 2.0 * b, p))),
@@ -508,6 +540,7 @@ fn follow<'s, R: Recorder>(
                     }
                     (None, Some((r, b, p))) => {
                         (ray, beta, prev, event) = (r, b, p, coat_event);
+                        cone = cone_specular;
                         if !roulette(depth, &mut beta, rng) {
                             break;
                         }
@@ -539,6 +572,7 @@ fn follow<'s, R: Recorder>(
         beta *= weight;
         prev = Some((vertex.p, pdf));
         ray = Ray::new(offset_along(vertex.p, vertex.ng, ctx.ray_epsilon), wi);
+        cone = cone_rough;
         if !roulette(depth, &mut beta, rng) {
             break;
         }
@@ -592,6 +626,7 @@ fn subsurface_probe<'s>(
     scratch: &mut Scratch,
     counters: &mut Counters,
     depth: u32,
+    width: f32,
 ) -> Scatter<'s> {
     // Boundary at xo: the normal facing the camera is "outside"
     // (a mesh wound inside-out is read consistently the other way).
@@ -606,7 +641,8 @@ fn subsurface_probe<'s>(
         } else if split {
             *beta *= 1.0 - fr;
             let reflected = Some((mirror(ctx, si, wo, n_out), beta_in * fr, None));
-            let (entry, pair) = entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth);
+            let (entry, pair) =
+                entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
             return Scatter::Coated(Coated {
                 coat: None,
                 reflected,
@@ -618,7 +654,7 @@ fn subsurface_probe<'s>(
             return Scatter::Continue(mirror(ctx, si, wo, n_out), Event::Specular);
         }
         return entry_scatter(entries(
-            ctx, ss, si, wo, beta, rng, scratch, counters, depth,
+            ctx, ss, si, wo, beta, rng, scratch, counters, depth, width,
         ));
     };
     // The rough coat. Where the shading normal faces away from ωo it
@@ -633,7 +669,7 @@ fn subsurface_probe<'s>(
     if !ss.specular || e <= 0.0 {
         *beta *= 1.0 - e;
         return entry_scatter(entries(
-            ctx, ss, si, wo, beta, rng, scratch, counters, depth,
+            ctx, ss, si, wo, beta, rng, scratch, counters, depth, width,
         ));
     }
     let v = Vertex {
@@ -657,7 +693,7 @@ fn subsurface_probe<'s>(
             pair: None,
         });
     }
-    let (entry, pair) = entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth);
+    let (entry, pair) = entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
     Scatter::Coated(Coated {
         coat: Some((v, beta_in)),
         reflected: None,
@@ -704,7 +740,10 @@ fn coat_reflection(
 /// The entry vertices the path goes on from at a subsurface hit at
 /// `depth`, `beta` scaled by the chosen one's probe weight: one probe, or
 /// below `ctx.pair_depth` an antithetic pair ([`PAIR_DEPTH`]), whose second
-/// vertex comes back with its own throughput for light sampling.
+/// vertex comes back with its own throughput for light sampling. Where the
+/// material's level-of-detail rule applies to the footprint `width`, no
+/// probe: the entry lobe at xo itself, weighted by the profile's plane
+/// integral ([`crate::materials::lod`]).
 #[allow(clippy::too_many_arguments)]
 fn entries<'s>(
     ctx: &Context,
@@ -716,11 +755,15 @@ fn entries<'s>(
     scratch: &mut Scratch,
     counters: &mut Counters,
     depth: u32,
+    width: f32,
 ) -> (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>) {
     let frame_o = si.shading_frame_facing(wo);
-    let u = ProbeRandoms::from_rng(rng);
     let mesh = &ctx.scene.meshes[si.geom as usize];
     let kappa = exit_curvature(mesh, si.prim);
+    if ss.lod().applies(width, kappa) {
+        return (Some(lod_entry(ctx, ss, si, frame_o, beta)), None);
+    }
+    let u = ProbeRandoms::from_rng(rng);
     // The curvature correction's exit half, once for both probes of a pair.
     let exit = ss
         .curvature_correction()
@@ -767,6 +810,35 @@ fn entries<'s>(
     }
 }
 
+/// The level-of-detail entry vertex: xo itself with the entry lobe, `beta`
+/// scaled by the profile's plane integral A_plane and, on a convex surface
+/// with the curvature correction on, f(κo) — the full estimator's mean on
+/// a flat or spherical surface ([`crate::materials::lod`]).
+#[inline(never)]
+fn lod_entry<'s>(
+    ctx: &Context,
+    ss: &'s Subsurface,
+    si: &Interaction,
+    frame_o: Frame,
+    beta: &mut Vec3,
+) -> Vertex<'s> {
+    let mut w = ss.lod().albedo;
+    if let Some(cc) = ss.curvature_correction() {
+        let k_o = mean_curvature(&ctx.scene.meshes[si.geom as usize], si.prim);
+        if let Some(f) = cc.weight(k_o, k_o) {
+            w *= f;
+        }
+    }
+    *beta *= w;
+    Vertex {
+        p: si.p,
+        ng: if si.front { si.ng } else { -si.ng },
+        frame: frame_o,
+        wo_local: Vec3::Z,
+        lobe: Lobe::SubsurfaceEntry(ss),
+    }
+}
+
 /// What [`entries`] found as a [`Scatter`]: the entry vertex (with its
 /// pair's, if any), or the end of the path.
 fn entry_scatter<'s>(e: (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>)) -> Scatter<'s> {
@@ -798,6 +870,7 @@ fn probe_entry<'s>(
     counters: &mut Counters,
 ) -> Option<(Vertex<'s>, Vec3)> {
     counters.rays += 1;
+    counters.probes += 1;
     let target = ProbeTarget {
         accel: ctx.accel,
         geom: si.geom,

@@ -5,12 +5,14 @@
 
 pub mod dielectric;
 pub mod diffuse;
+pub mod lod;
 pub mod microfacet;
 pub mod subsurface;
 
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
+pub use lod::LodMode;
 pub use subsurface::{CurvatureMode, Subsurface, SubsurfaceOverrides, WalkBoundary};
 
 #[derive(Clone, Debug, PartialEq)]

@@ -25,6 +25,7 @@
 //! weighted by the transmitted fraction (1 − Fr or 1 − E) and the reflected
 //! light is lost, for either roughness.
 
+use super::lod::{LodMode, LodRule, DEFAULT_THRESHOLD};
 use super::microfacet::{alpha_from_roughness, RoughCoat, SMOOTH_ALPHA};
 use crate::bssrdf::curvature_correction::CurvatureCorrection;
 use crate::bssrdf::{sw_normalization, ProbeOptions, ProbeSampler, SubsurfaceParams};
@@ -55,6 +56,8 @@ pub struct Subsurface {
     /// The correction, when the mode is on and the parameters record a
     /// medium.
     curvature: Option<CurvatureCorrection>,
+    /// The level-of-detail rule ([`super::lod`]).
+    lod: LodRule,
 }
 
 /// The scene's `curvature_correction` setting.
@@ -87,6 +90,8 @@ impl PartialEq for Subsurface {
             && self.boundary == o.boundary
             && self.roughness == o.roughness
             && self.curvature_mode == o.curvature_mode
+            && self.lod.mode == o.lod.mode
+            && self.lod.threshold == o.lod.threshold
     }
 }
 
@@ -99,6 +104,12 @@ impl Subsurface {
     ) -> Result<Self, ParamError> {
         let probe = ProbeSampler::new(&params, opts)?;
         let curvature = curvature_for(&params, &probe, CurvatureMode::default());
+        let lod = LodRule::new(
+            LodMode::default(),
+            DEFAULT_THRESHOLD,
+            probe.rmax(),
+            probe.planar_reflectance(),
+        );
         Ok(Subsurface {
             sw_c: sw_normalization(params.eta),
             params,
@@ -110,7 +121,25 @@ impl Subsurface {
             coat: None,
             curvature_mode: CurvatureMode::default(),
             curvature,
+            lod,
         })
+    }
+
+    /// The material with level-of-detail `mode` and footprint-to-Rmax
+    /// `threshold` (finite, > 0; the scene loader checks it).
+    pub fn with_lod(mut self, mode: LodMode, threshold: f32) -> Self {
+        self.lod = LodRule::new(
+            mode,
+            threshold,
+            self.probe.rmax(),
+            self.probe.planar_reflectance(),
+        );
+        self
+    }
+
+    /// The level-of-detail rule.
+    pub fn lod(&self) -> &LodRule {
+        &self.lod
     }
 
     /// The material with the curvature correction `mode`.
@@ -240,6 +269,7 @@ pub struct SubsurfaceOverrides {
     pub specular: Option<bool>,
     pub boundary: Option<WalkBoundary>,
     pub roughness: Option<f32>,
+    pub lod: Option<LodMode>,
 }
 
 impl Subsurface {
@@ -250,7 +280,7 @@ impl Subsurface {
         let o = self.probe.options();
         format!(
             "radius={} rmax_quantile={} axes={} channel={} renormalize={} exit_sw={} \
-             specular={} roughness={} boundary={}",
+             specular={} roughness={} boundary={} lod={} lod_threshold={}",
             o.radius.name(),
             o.rmax_quantile,
             o.axes.name(),
@@ -259,7 +289,9 @@ impl Subsurface {
             self.exit_sw,
             self.specular,
             self.roughness,
-            self.boundary.name()
+            self.boundary.name(),
+            self.lod.mode.name(),
+            self.lod.threshold
         )
     }
 }
@@ -284,7 +316,8 @@ impl SubsurfaceOverrides {
             self.specular.unwrap_or(ss.specular),
         )?
         .with_roughness(self.roughness.unwrap_or(ss.roughness))?
-        .with_curvature_mode(ss.curvature_mode);
+        .with_curvature_mode(ss.curvature_mode)
+        .with_lod(self.lod.unwrap_or(ss.lod.mode), ss.lod.threshold);
         out.boundary = self.boundary.unwrap_or(ss.boundary);
         Ok(out)
     }

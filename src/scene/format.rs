@@ -181,6 +181,9 @@ pub struct MaterialDef {
     // subsurface: the diffusion weight's curvature correction
     pub curvature_correction: Option<Spanned<String>>,
     pub roughness: Option<Spanned<f64>>,
+    // subsurface: level of detail
+    pub lod: Option<Spanned<String>>,
+    pub lod_threshold: Option<Spanned<f64>>,
 }
 
 impl MaterialDef {
@@ -223,6 +226,11 @@ impl MaterialDef {
             self.curvature_correction.as_ref().map(|x| x.span()),
         );
         add("roughness", self.roughness.as_ref().map(|x| x.span()));
+        add("lod", self.lod.as_ref().map(|x| x.span()));
+        add(
+            "lod_threshold",
+            self.lod_threshold.as_ref().map(|x| x.span()),
+        );
         v
     }
 }

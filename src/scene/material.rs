@@ -19,7 +19,8 @@ use crate::bssrdf::{
     SubsurfaceParams,
 };
 use crate::error::{Constraint, InputError, Param, ParamError};
-use crate::materials::{CurvatureMode, Material, Subsurface, WalkBoundary};
+use crate::materials::lod::DEFAULT_THRESHOLD;
+use crate::materials::{CurvatureMode, LodMode, Material, Subsurface, WalkBoundary};
 
 /// The keys a `type = "subsurface"` material accepts.
 const SUBSURFACE_KEYS: &[&str] = &[
@@ -42,6 +43,8 @@ const SUBSURFACE_KEYS: &[&str] = &[
     "boundary",
     "roughness",
     "curvature_correction",
+    "lod",
+    "lod_threshold",
 ];
 
 /// The parameter forms, for messages.
@@ -118,6 +121,31 @@ pub(super) fn material(
                 })?;
                 ss = ss.with_curvature_mode(mode);
             }
+            let lod = match text(&d.lod) {
+                Some((s, span)) => LodMode::parse_scene(s).ok_or_else(|| {
+                    cx.err(
+                        span,
+                        &format!("{field}.lod"),
+                        format!("expected \"auto\" or \"off\", found \"{s}\""),
+                    )
+                })?,
+                None => LodMode::default(),
+            };
+            let threshold = match &d.lod_threshold {
+                Some(t) => {
+                    let v = *t.get_ref();
+                    if !(v.is_finite() && v > 0.0 && v <= f32::MAX as f64) {
+                        return Err(cx.err(
+                            t.span(),
+                            &format!("{field}.lod_threshold"),
+                            format!("expected a finite number > 0 (footprint / Rmax), found {v}"),
+                        ));
+                    }
+                    v as f32
+                }
+                None => DEFAULT_THRESHOLD,
+            };
+            ss = ss.with_lod(lod, threshold);
             check_rmax(cx, &field, m, &ss, units_per_mm, units_def)?;
             Ok(Material::Subsurface(Arc::new(ss)))
         }

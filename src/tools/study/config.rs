@@ -12,7 +12,7 @@
 use crate::accel::Backend;
 use crate::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, RadiusSampler, TableSpacing};
 use crate::integrator::IntegratorKind;
-use crate::materials::{Material, WalkBoundary};
+use crate::materials::{LodMode, Material, WalkBoundary};
 use crate::scene::Scene;
 
 /// Which choice a configuration varies from the baseline.
@@ -30,10 +30,13 @@ pub enum Axis {
     Integrator,
     /// The random walk with the diffuse Fresnel boundary (another model).
     Boundary,
+    /// Subsurface level of detail off (the baseline keeps the scene's,
+    /// `auto` by default; `crate::materials::lod`).
+    Lod,
 }
 
 impl Axis {
-    pub const ALL: [Axis; 11] = [
+    pub const ALL: [Axis; 12] = [
         Axis::Baseline,
         Axis::Radius,
         Axis::RmaxQuantile,
@@ -45,6 +48,7 @@ impl Axis {
         Axis::Backend,
         Axis::Integrator,
         Axis::Boundary,
+        Axis::Lod,
     ];
 
     /// The name used in configuration names and the CSV.
@@ -61,6 +65,7 @@ impl Axis {
             Axis::Backend => "backend",
             Axis::Integrator => "integrator",
             Axis::Boundary => "boundary",
+            Axis::Lod => "lod",
         }
     }
 
@@ -137,17 +142,22 @@ fn full_probe(o: ProbeOptions) -> Overrides {
         specular: None,
         boundary: None,
         roughness: None,
+        lod: None,
     }
 }
 
 /// The overrides of the diffusion reference: the exact sampler, MIS axes
-/// and channels, Rmax at [`REFERENCE_RMAX_QUANTILE`]; Fresnel choices are
-/// the scene's (they change the model, not the estimator).
+/// and channels, Rmax at [`REFERENCE_RMAX_QUANTILE`], no level of detail
+/// (the full estimator at every hit); Fresnel choices are the scene's (they
+/// change the model, not the estimator).
 pub fn reference_overrides() -> Overrides {
-    full_probe(ProbeOptions {
-        rmax_quantile: REFERENCE_RMAX_QUANTILE,
-        ..baseline_probe()
-    })
+    Overrides {
+        lod: Some(LodMode::Off),
+        ..full_probe(ProbeOptions {
+            rmax_quantile: REFERENCE_RMAX_QUANTILE,
+            ..baseline_probe()
+        })
+    }
 }
 
 /// The first subsurface material's (exit_sw, specular): the scene's model
@@ -339,6 +349,17 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
             },
         );
     }
+    // Level of detail off: what the probe estimator costs where the
+    // baseline shades with albedo A (the same configuration when LOD never
+    // triggers).
+    m.vary(
+        Axis::Lod,
+        LodMode::Off.name().into(),
+        Overrides {
+            lod: Some(LodMode::Off),
+            ..m.base
+        },
+    );
     for &b in &backends[1..] {
         m.add(
             Axis::Backend,
@@ -412,6 +433,9 @@ pub fn describe(ov: &Overrides) -> String {
     }
     if let Some(b) = ov.boundary {
         parts.push(format!("random-walk boundary {}", b.name()));
+    }
+    if let Some(l) = ov.lod {
+        parts.push(format!("level of detail {}", l.name()));
     }
     parts.join(", ")
 }
