@@ -354,6 +354,9 @@ fn parse_header(
             clamped: c[2],
             walks_capped: c[3],
             walks_escaped: c[4],
+            // parts do not carry the per-effect counts (`--stats` of one
+            // render), so a merged frame's are 0
+            ..Counters::default()
         },
     };
     let (w, h) = header.identity.frame;
