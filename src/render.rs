@@ -489,6 +489,7 @@ fn render_tile<T: Clock>(
                     counters.nonfinite += 1;
                 }
             }
+            counters.camera_rays(samples.len() as u64);
             out[i..i + C].copy_from_slice(&sum);
             i += C;
         }
@@ -714,6 +715,7 @@ fn render_tile_passes<P: PixelPasses, T: Clock>(
                 passes.end_sample(l, finite);
             }
             passes.end_pixel();
+            counters.camera_rays(spp as u64);
             // the mean as Accumulated::film takes it: the same beauty as
             // render's, bit for bit
             let m = |c: usize| Accumulated::FORMAT.mean(sum[c], spp as u64);

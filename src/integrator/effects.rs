@@ -34,7 +34,7 @@ use super::Counters;
 /// The effects ray queries and time are counted by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Effect {
-    /// Nearest-hit queries of camera rays.
+    /// Nearest-hit queries of camera rays (one a sample).
     Camera,
     /// Nearest-hit queries of paths continued after a bounce (lobe,
     /// dielectric, coat reflection, a medium's exit).

@@ -154,6 +154,16 @@ impl Counters {
         self.rays += 1;
         self.effect_rays[effect as usize] += 1;
     }
+
+    /// `samples` samples traced their camera ray. The bounce loop counts
+    /// every nearest-hit query as [`Effect::Indirect`] (so it does not test
+    /// which is the camera's: one add a ray, as before the counts); every
+    /// sample makes exactly one camera query, so the tile loop moves one a
+    /// sample to [`Effect::Camera`].
+    pub fn camera_rays(&mut self, samples: u64) {
+        self.effect_rays[Effect::Camera as usize] += samples;
+        self.effect_rays[Effect::Indirect as usize] -= samples;
+    }
 }
 
 impl std::ops::AddAssign for Counters {

@@ -379,14 +379,15 @@ fn follow<'s, R: Recorder, T: Clock>(
 
     let max_depth = scene.settings.max_depth;
     for depth in start.depth..=max_depth {
+        // camera rays too: the tile loop moves one a sample to Effect::Camera
+        counters.ray(Effect::Indirect);
+        let t0 = T::now();
+        let found = ctx.accel.intersect(&ray, 0.0, f32::INFINITY);
         let effect = if depth == 0 {
             Effect::Camera
         } else {
             Effect::Indirect
         };
-        counters.ray(effect);
-        let t0 = T::now();
-        let found = ctx.accel.intersect(&ray, 0.0, f32::INFINITY);
         T::lap(counters, effect, t0);
         let Some(hit) = found else {
             if ctx.plan.environment {
