@@ -462,6 +462,7 @@ fn render_tile<T: Clock>(
             // a signal stops the render between pixels (see crate::interrupt);
             // the pass is then incomplete and dropped
             if interrupt::requested().is_some() {
+                counters.camera_rays((i / C) as u64 * samples.len() as u64);
                 return counters;
             }
             let pixel = y as u64 * w as u64 + x as u64;
@@ -489,11 +490,11 @@ fn render_tile<T: Clock>(
                     counters.nonfinite += 1;
                 }
             }
-            counters.camera_rays(samples.len() as u64);
             out[i..i + C].copy_from_slice(&sum);
             i += C;
         }
     }
+    counters.camera_rays((i / C) as u64 * samples.len() as u64);
     counters
 }
 
@@ -684,6 +685,7 @@ fn render_tile_passes<P: PixelPasses, T: Clock>(
             // a signal stops the render between pixels (see crate::interrupt);
             // the tile is then incomplete and the render discarded
             if interrupt::requested().is_some() {
+                counters.camera_rays(out.len() as u64 * spp as u64);
                 return (out, counters, passes.finish());
             }
             let pixel = y as u64 * w as u64 + x as u64;
@@ -715,12 +717,12 @@ fn render_tile_passes<P: PixelPasses, T: Clock>(
                 passes.end_sample(l, finite);
             }
             passes.end_pixel();
-            counters.camera_rays(spp as u64);
             // the mean as Accumulated::film takes it: the same beauty as
             // render's, bit for bit
             let m = |c: usize| Accumulated::FORMAT.mean(sum[c], spp as u64);
             out.push(Vec3::new(m(0), m(1), m(2)));
         }
     }
+    counters.camera_rays(out.len() as u64 * spp as u64);
     (out, counters, passes.finish())
 }
