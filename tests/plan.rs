@@ -303,6 +303,21 @@ fn a_plan_without_subsurface_makes_no_probe_query() {
     assert_eq!(c.effect_rays[Effect::Camera as usize], 12 * 8 * 2);
     assert!(c.effect_rays[Effect::Direct as usize] > 0, "{c:?}");
     assert!(c.effect_rays[Effect::Indirect as usize] > 0, "{c:?}");
+    // the tile loop with passes counts the same queries the same way
+    let accel = accel::build(&s.meshes, Backend::Bvh).unwrap();
+    let opts = RenderOptions {
+        threads: Some(1),
+        ..RenderOptions::default()
+    };
+    let out = render::render_passes(
+        &s,
+        accel.as_ref(),
+        &opts,
+        PassSet::parse_list("albedo").unwrap(),
+    )
+    .unwrap();
+    assert_eq!(out.stats.counters.effect_rays, c.effect_rays);
+    assert_eq!(out.stats.counters.rays, c.rays);
 }
 
 #[test]
