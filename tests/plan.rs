@@ -371,10 +371,23 @@ fn explain_prints_the_plan_and_writes_nothing() {
     assert!(text.status.success(), "{text:?}");
     let out = String::from_utf8(text.stdout).unwrap();
     assert!(out.starts_with("render plan (integrator: path)\n"), "{out}");
-    assert!(
-        out.contains("\n  probe queries     on      "),
-        "aligned columns: {out}"
-    );
+    // three aligned columns: effect (18), method (24), reason
+    for (effect, method, reason) in [
+        (
+            "probe queries",
+            "on",
+            "diffusion at subsurface hits on ball",
+        ),
+        (
+            "direct lighting",
+            "next-event estimation",
+            "1 emitting object(s) (light)",
+        ),
+        ("channels", "r g b", "A > 0 in every channel"),
+    ] {
+        let row = format!("\n  {effect:<18}{method:<24}{reason}");
+        assert!(out.contains(&row), "no `{row}` in\n{out}");
+    }
     let json = lucent(
         dir.path(),
         &[
