@@ -376,7 +376,7 @@ fn explain_prints_the_plan_and_writes_nothing() {
         (
             "probe queries",
             "on",
-            "diffusion at subsurface hits on ball",
+            "diffusion at hits on material(s) sauce",
         ),
         (
             "direct lighting",

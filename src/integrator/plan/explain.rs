@@ -330,7 +330,7 @@ impl Explanation {
             choice(
                 "on",
                 format!(
-                    "diffusion at subsurface hits on {}",
+                    "diffusion at hits on material(s) {}",
                     probes_needed.join(", ")
                 ),
             )
