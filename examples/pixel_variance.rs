@@ -33,7 +33,7 @@ use lucent::film::Film;
 use lucent::geometry::{Ray, Vec3};
 use lucent::integrator::aov::NoAov;
 use lucent::integrator::path::Scratch;
-use lucent::integrator::{Context, Counters, IntegratorKind};
+use lucent::integrator::{Context, Counters, IntegratorKind, NoClock};
 use lucent::materials::SubsurfaceOverrides;
 use lucent::sampling::{Draw, Rng, SampleRng};
 use lucent::scene::{self, Camera};
@@ -133,7 +133,7 @@ fn main() {
                             let mut rng = SampleRng::for_sample(key, s as u64);
                             let [jx, jy] = rng.uniform2_packed();
                             let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                            let l = IntegratorKind::Path.radiance(
+                            let l = IntegratorKind::Path.radiance::<_, NoClock>(
                                 &ctx,
                                 ray,
                                 &mut rng,

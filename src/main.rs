@@ -18,7 +18,7 @@ use lucent::film::exr_layers::{
 use lucent::film::passes::PassSet;
 use lucent::film::region::Region;
 use lucent::film::ToneMap;
-use lucent::integrator::IntegratorKind;
+use lucent::integrator::{effects, plan, IntegratorKind};
 use lucent::materials::{LodMode, SubsurfaceOverrides, WalkBoundary};
 use lucent::render::{self, RenderOptions};
 use lucent::scene;
@@ -106,6 +106,21 @@ enum Command {
         /// all, lightpaths, data, ids, cryptomatte, noise (docs/output.md).
         #[arg(long, value_parser = parse_aov)]
         aov: Option<PassSet>,
+        /// Print the render plan (each effect, the method chosen and why)
+        /// and exit without rendering: as text, or `--explain=json`
+        /// (docs/output.md, "The render plan").
+        #[arg(
+            long,
+            value_enum,
+            num_args = 0..=1,
+            require_equals = true,
+            default_missing_value = "text"
+        )]
+        explain: Option<ExplainArg>,
+        /// After the render, ray queries and share of time per effect
+        /// (docs/performance.md, "Per-effect statistics").
+        #[arg(long)]
+        stats: bool,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
         #[command(flatten)]
@@ -323,6 +338,12 @@ impl FileArgs {
     }
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ExplainArg {
+    Text,
+    Json,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum LodArg {
     Auto,
@@ -406,6 +427,8 @@ fn main() -> ExitCode {
             quiet,
             integrator,
             aov,
+            explain,
+            stats,
             subsurface,
             file,
             split,
@@ -423,7 +446,17 @@ fn main() -> ExitCode {
                 threads,
                 progress: !quiet,
                 integrator,
+                stats,
             };
+            if let Some(format) = explain {
+                return finish(run_explain(
+                    &scene,
+                    integrator,
+                    aov,
+                    &subsurface.overrides(),
+                    format,
+                ));
+            }
             file.settings().and_then(|file| {
                 run_render(
                     &scene,
@@ -453,6 +486,11 @@ fn main() -> ExitCode {
             Ok(())
         }
     };
+    finish(result)
+}
+
+/// The exit code of a command's result, its error (if any) printed.
+fn finish(result: Result<(), Error>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -654,6 +692,7 @@ fn run_render(
             accel.name(),
             backend,
             opts,
+            passes,
             stats.seconds,
         )?;
         exr_layers::write_frame(output, &film, &layers, &coverage, &header, &out)?;
@@ -665,6 +704,9 @@ fn run_render(
                 scene.triangle_count(),
                 stats.summary(accel.name())
             );
+        }
+        if opts.stats {
+            eprint!("{}", effects::summary(&stats.counters));
         }
         report_rejected_rays(accel.as_ref());
         return Ok(());
@@ -704,6 +746,7 @@ fn run_render(
             accel.name(),
             backend,
             opts,
+            PassSet::EMPTY,
             r.stats.seconds,
         )?;
         exr_layers::write_frame(output, &r.sums.film()?, &[], &[], &header, &out)?;
@@ -723,8 +766,48 @@ fn run_render(
             r.stats.summary(accel.name())
         );
     }
+    if opts.stats {
+        eprint!("{}", effects::summary(&r.stats.counters));
+    }
     report_rejected_rays(accel.as_ref());
     Ok(())
+}
+
+/// Prints the plan of rendering `scene_path` with these options (no
+/// render, no file written): the scene's errors are those of a render.
+fn run_explain(
+    scene_path: &Path,
+    integrator: IntegratorKind,
+    aov: Option<PassSet>,
+    overrides: &SubsurfaceOverrides,
+    format: ExplainArg,
+) -> Result<(), Error> {
+    let mut scene = scene::load(scene_path)?;
+    overrides
+        .apply_all(&mut scene.materials)
+        .map_err(option_error)?;
+    let plan = render_plan(&scene, integrator, aov.unwrap_or(scene.output.aovs));
+    match format {
+        ExplainArg::Text => print!("{}", plan::text::render(&plan)),
+        ExplainArg::Json => println!("{}", plan.to_json_pretty()),
+    }
+    Ok(())
+}
+
+/// The plan a render of `scene` with `integrator` and `passes` follows.
+fn render_plan(
+    scene: &scene::Scene,
+    integrator: IntegratorKind,
+    passes: PassSet,
+) -> plan::Explanation {
+    plan::Explanation::new(
+        scene,
+        &plan::PlanOptions {
+            integrator,
+            passes,
+            ..plan::PlanOptions::default()
+        },
+    )
 }
 
 /// What the EXR header records about this render (docs/output.md): the
@@ -737,6 +820,7 @@ fn frame_header(
     accel_name: &str,
     backend: Backend,
     opts: &RenderOptions,
+    passes: PassSet,
     seconds: f64,
 ) -> Result<FrameHeader, Error> {
     use sha2::{Digest, Sha256};
@@ -782,6 +866,7 @@ fn frame_header(
             .into(),
         ),
         sampling,
+        plan: Some(render_plan(scene, opts.integrator, passes).to_json()),
         render_seconds: Some(seconds),
     })
 }

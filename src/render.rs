@@ -45,7 +45,7 @@ use crate::geometry::Vec3;
 use crate::integrator::aov::pixels::{assemble, Layout};
 use crate::integrator::aov::{NoAov, PixelPasses, Setup, TilePasses};
 use crate::integrator::path::Scratch;
-use crate::integrator::{Context, Counters, IntegratorKind};
+use crate::integrator::{Clock, Context, Counters, IntegratorKind, NoClock, Stopwatch};
 use crate::interrupt;
 use crate::sampling::{Draw, Rng, SampleRng};
 use crate::scene::Scene;
@@ -70,6 +70,9 @@ pub struct RenderOptions {
     /// The estimator: the diffusion BSSRDF (default) or the random-walk
     /// reference at subsurface objects.
     pub integrator: IntegratorKind,
+    /// Measure the share of time per effect (`--stats`,
+    /// [`crate::integrator::effects`]): the tile loop's timed instance.
+    pub stats: bool,
 }
 
 impl Default for RenderOptions {
@@ -80,6 +83,7 @@ impl Default for RenderOptions {
             threads: None,
             progress: false,
             integrator: IntegratorKind::Path,
+            stats: false,
         }
     }
 }
@@ -393,7 +397,12 @@ pub fn render_job(
             chunks
                 .into_par_iter()
                 .map(|(t, prev, out)| {
-                    let c = render_tile(&ctx, opts.integrator, t, s.clone(), prev, out);
+                    // the timed instance only with --stats (integrator::effects)
+                    let c = if opts.stats {
+                        render_tile::<Stopwatch>(&ctx, opts.integrator, t, s.clone(), prev, out)
+                    } else {
+                        render_tile::<NoClock>(&ctx, opts.integrator, t, s.clone(), prev, out)
+                    };
                     bar.inc(t.area() * s.len() as u64);
                     c
                 })
@@ -433,7 +442,7 @@ pub fn render_job(
 /// (the tile's pixels row by row), writing the result to `out`. Stops at
 /// the next pixel once a signal came (the pass is then dropped).
 #[inline(never)]
-fn render_tile(
+fn render_tile<T: Clock>(
     ctx: &Context,
     integrator: IntegratorKind,
     tile: &Region,
@@ -453,6 +462,7 @@ fn render_tile(
             // a signal stops the render between pixels (see crate::interrupt);
             // the pass is then incomplete and dropped
             if interrupt::requested().is_some() {
+                counters.camera_rays((i / C) as u64 * samples.len() as u64);
                 return counters;
             }
             let pixel = y as u64 * w as u64 + x as u64;
@@ -464,7 +474,8 @@ fn render_tile(
                 let mut rng = SampleRng::for_sample(pixel_key, s as u64);
                 let [jx, jy] = rng.uniform2_packed();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                let l = integrator.radiance(
+                let t0 = T::now();
+                let l = integrator.radiance::<_, T>(
                     ctx,
                     ray,
                     &mut rng,
@@ -472,6 +483,7 @@ fn render_tile(
                     &mut counters,
                     &mut NoAov,
                 );
+                T::lap_sample(&mut counters, t0);
                 if l.is_finite() {
                     counters.clamped += Accumulated::FORMAT.add(&mut sum, &[l.x, l.y, l.z]) as u64;
                 } else {
@@ -482,6 +494,7 @@ fn render_tile(
             i += C;
         }
     }
+    counters.camera_rays((i / C) as u64 * samples.len() as u64);
     counters
 }
 
@@ -552,6 +565,7 @@ pub fn render_passes(
         tiles: &tiles,
         pool: &pool,
         bar: &bar,
+        stats: opts.stats,
     };
     let setup = Setup::new(scene, &ctx.lights, passes);
     let layout = Layout::new(&setup);
@@ -592,6 +606,8 @@ struct Run<'a> {
     tiles: &'a [(u32, u32)],
     pool: &'a rayon::ThreadPool,
     bar: &'a ProgressBar,
+    /// Time the effects (`--stats`).
+    stats: bool,
 }
 
 impl Run<'_> {
@@ -608,7 +624,12 @@ impl Run<'_> {
                 .par_iter()
                 .map(|&(x0, y0)| {
                     let pixels = (TILE.min(w - x0) * TILE.min(h - y0)) as usize;
-                    let r = render_tile_passes(ctx, self.integrator, x0, y0, passes(pixels));
+                    let (i, p) = (self.integrator, passes(pixels));
+                    let r = if self.stats {
+                        render_tile_passes::<_, Stopwatch>(ctx, i, x0, y0, p)
+                    } else {
+                        render_tile_passes::<_, NoClock>(ctx, i, x0, y0, p)
+                    };
                     self.bar.inc(1);
                     r
                 })
@@ -644,7 +665,7 @@ impl Run<'_> {
 /// The tile loop of [`render_passes`]: every sample of every pixel of the
 /// tile at (x0, y0), recorded by `passes`.
 #[inline(never)]
-fn render_tile_passes<P: PixelPasses>(
+fn render_tile_passes<P: PixelPasses, T: Clock>(
     ctx: &Context,
     integrator: IntegratorKind,
     x0: u32,
@@ -664,6 +685,7 @@ fn render_tile_passes<P: PixelPasses>(
             // a signal stops the render between pixels (see crate::interrupt);
             // the tile is then incomplete and the render discarded
             if interrupt::requested().is_some() {
+                counters.camera_rays(out.len() as u64 * spp as u64);
                 return (out, counters, passes.finish());
             }
             let pixel = y as u64 * w as u64 + x as u64;
@@ -676,7 +698,16 @@ fn render_tile_passes<P: PixelPasses>(
                 let [jx, jy] = rng.uniform2_packed();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 let rec = passes.begin_sample();
-                let l = integrator.radiance(ctx, ray, &mut rng, &mut scratch, &mut counters, rec);
+                let t0 = T::now();
+                let l = integrator.radiance::<_, T>(
+                    ctx,
+                    ray,
+                    &mut rng,
+                    &mut scratch,
+                    &mut counters,
+                    rec,
+                );
+                T::lap_sample(&mut counters, t0);
                 let finite = l.is_finite();
                 if finite {
                     counters.clamped += Accumulated::FORMAT.add(&mut sum, &[l.x, l.y, l.z]) as u64;
@@ -692,5 +723,6 @@ fn render_tile_passes<P: PixelPasses>(
             out.push(Vec3::new(m(0), m(1), m(2)));
         }
     }
+    counters.camera_rays(out.len() as u64 * spp as u64);
     (out, counters, passes.finish())
 }

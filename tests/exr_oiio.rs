@@ -169,6 +169,7 @@ fn header() -> FrameHeader {
         backend_version: Some("lucent 0.1.0".into()),
         integrator: Some("path".into()),
         sampling: vec![("bunny".into(), "axes=curvature roughness=0.3".into())],
+        plan: Some(r#"{"schema":1,"integrator":"path"}"#.into()),
         render_seconds: Some(12.5),
     }
 }
@@ -192,6 +193,10 @@ fn assert_header(info: &Info) {
         (
             "lucent/sampling",
             "\"bunny: axes=curvature roughness=0.3\"".into(),
+        ),
+        (
+            "lucent/plan",
+            r#""{"schema":1,"integrator":"path"}""#.into(),
         ),
         ("lucent/renderTime", "12.5".into()),
     ];
@@ -332,6 +337,18 @@ fn oiiotool_reads_the_header_of_a_real_render() {
         .trim_matches('"');
     assert_eq!(sha.len(), 64);
     assert!(info.attribute("lucent/renderTime").is_some());
+    // the render plan, as the JSON `--explain=json` prints (on one line)
+    let plan = info.attribute("lucent/plan").unwrap();
+    let plan: lucent::integrator::plan::Explanation =
+        serde_json::from_str(&plan[1..plan.len() - 1]).unwrap();
+    assert_eq!(plan.integrator, "path");
+    assert_eq!(plan.probe_queries.method, "on");
+    assert_eq!(plan.environment.method, "escaping rays");
+    let axes = match &plan.materials[0].subsurface[0] {
+        lucent::integrator::plan::explain::SubsurfaceMethod::Diffusion { axes, .. } => axes,
+        m => panic!("{m:?}"),
+    };
+    assert_eq!(axes, "mis3");
     // the command line overrides the scene's [output]
     let out = Command::new(env!("CARGO_BIN_EXE_lucent"))
         .args(["render", "--quiet", "--exr-compression", "piz", "-o"])

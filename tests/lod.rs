@@ -90,10 +90,10 @@ fn forced_lod_on_the_uniform_slab_reflects_a_without_probes() {
     let expected = [a.x as f64, a.y as f64, a.z as f64];
     let (full, cf) = run(&with_lod(&base, LodMode::Off), 256, 1);
     let m_full = within_1pct("full", &full, expected);
-    assert!(cf.probes > 0);
+    assert!(cf.probes() > 0);
     let (lod, cl) = run(&with_lod(&base, LodMode::Force), 256, 1);
     let m_lod = within_1pct("lod forced", &lod, expected);
-    assert_eq!(cl.probes, 0, "a probe was cast under forced LOD");
+    assert_eq!(cl.probes(), 0, "a probe was cast under forced LOD");
     // the two estimate the same value: within their noise of each other
     let (_, se_full) = mean_se(&full);
     for c in 0..3 {
@@ -179,7 +179,7 @@ fn forced_lod_keeps_the_coat_energy() {
         let m_full = within_1pct(&format!("full, roughness {roughness}"), &full, expected);
         let (lod, c) = run(&with_lod(&s, LodMode::Force), 256, 2);
         let m_lod = within_1pct(&format!("lod, roughness {roughness}"), &lod, expected);
-        assert_eq!(c.probes, 0);
+        assert_eq!(c.probes(), 0);
         for ch in 0..3 {
             assert!((m_full[ch] - m_lod[ch]).abs() < 0.01 * expected[ch]);
         }
@@ -190,7 +190,7 @@ fn forced_lod_keeps_the_coat_energy() {
             &lod,
             [1.0; 3],
         );
-        assert_eq!(c.probes, 0);
+        assert_eq!(c.probes(), 0);
     }
 }
 
@@ -216,14 +216,14 @@ fn auto_lod_switches_at_the_analytic_camera_footprint() {
     };
     let (off, c_off) = run(&with_lod(&base, LodMode::Off), 4, 5);
     let (above, c_above) = run(&at(1.0005 * w_centre / rmax), 4, 5);
-    assert_eq!(c_above.probes, c_off.probes);
+    assert_eq!(c_above.probes(), c_off.probes());
     assert!(
         off.pixels == above.pixels,
         "LOD that never triggers changed the image"
     );
     let (_, c_below) = run(&at(0.99 * w_centre / rmax), 4, 5);
     assert!(
-        c_below.probes < c_off.probes,
+        c_below.probes() < c_off.probes(),
         "no LOD just below the footprint"
     );
     // At angle θ off the axis the plane is 10/cos θ away and the cone's
@@ -232,12 +232,12 @@ fn auto_lod_switches_at_the_analytic_camera_footprint() {
     // 2 tan 10°/32): π·12.93² ≈ 525 of the 1024 pixels lose their probes
     // (each pixel casts the same number: two per sample, the antithetic
     // pair, and the bounced rays leave for the sky)
-    let per_pixel = c_off.probes as f64 / 1024.0;
-    let lost = (c_off.probes - c_below.probes) as f64 / per_pixel;
+    let per_pixel = c_off.probes() as f64 / 1024.0;
+    let lost = (c_off.probes() - c_below.probes()) as f64 / per_pixel;
     assert!(lost > 500.0 && lost < 550.0, "{lost} pixels under LOD");
     // everywhere under LOD with a threshold far below the footprint
     let (_, c_all) = run(&at(0.01 * w_centre / rmax), 4, 5);
-    assert_eq!(c_all.probes, 0);
+    assert_eq!(c_all.probes(), 0);
 }
 
 /// `lucent render --lod force` renders; a value other than auto, off or

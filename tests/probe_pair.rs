@@ -14,7 +14,7 @@ use std::path::Path;
 use lucent::accel::{self, Backend};
 use lucent::integrator::aov::NoAov;
 use lucent::integrator::path::{radiance, Scratch};
-use lucent::integrator::{Context, Counters};
+use lucent::integrator::{Context, Counters, NoClock};
 use lucent::sampling::{Draw, SampleRng};
 
 const SCENE: &str = r#"
@@ -65,7 +65,7 @@ fn pixel_stats(ctx: &Context, x: u32, y: u32, n: u64) -> ([f64; 3], [f64; 3]) {
         let mut rng = SampleRng::new(7, (y * 32 + x) as u64, s);
         let [jx, jy] = rng.uniform2_packed();
         let ray = ctx.scene.camera.ray(x as f32 + jx, y as f32 + jy);
-        let l = radiance(ctx, ray, &mut rng, &mut scratch, &mut counters, &mut NoAov);
+        let l = radiance::<_, NoClock>(ctx, ray, &mut rng, &mut scratch, &mut counters, &mut NoAov);
         for c in 0..3 {
             s1[c] += l[c] as f64;
             s2[c] += (l[c] as f64).powi(2);

@@ -25,7 +25,7 @@
 //! | `lucent.samples` | `A..B`: the sample indices summed |
 //! | `lucent.requested` | `A..E`: what the job was asked for (`B < E` after an interruption) |
 //! | `lucent.layers` | `L:C,C,…:F;…`: each layer's channels and fixed-point fraction bits |
-//! | `lucent.counters` | `rays,nonfinite,clamped,walks_capped,walks_escaped,probes` |
+//! | `lucent.counters` | `rays,nonfinite,clamped,walks_capped,walks_escaped` |
 //!
 //! A merge needs nothing else: any set of named layers merges the same way
 //! (add the integer sums, divide by spp once), so the AOV layers will ride
@@ -195,8 +195,8 @@ pub fn stage(path: &Path, header: &Header, sums: &Accumulated) -> Result<Staged,
         (
             "lucent.counters",
             format!(
-                "{},{},{},{},{},{}",
-                c.rays, c.nonfinite, c.clamped, c.walks_capped, c.walks_escaped, c.probes
+                "{},{},{},{},{}",
+                c.rays, c.nonfinite, c.clamped, c.walks_capped, c.walks_escaped
             ),
         ),
     ] {
@@ -326,13 +326,12 @@ fn parse_header(
         .split(',')
         .map(|v| v.parse().ok())
         .collect::<Option<_>>()
-        // parts written before the probe count have 5
-        .filter(|v: &Vec<u64>| v.len() == 5 || v.len() == 6)
+        .filter(|v: &Vec<u64>| v.len() == 5)
         .ok_or_else(|| {
             bad(
                 path,
                 Some("lucent.counters"),
-                format!("`{counters_text}` is not 6 counts"),
+                format!("`{counters_text}` is not 5 counts"),
             )
         })?;
     let header = Header {
@@ -355,7 +354,9 @@ fn parse_header(
             clamped: c[2],
             walks_capped: c[3],
             walks_escaped: c[4],
-            probes: c.get(5).copied().unwrap_or(0),
+            // parts do not carry the per-effect counts (`--stats` of one
+            // render), so a merged frame's are 0
+            ..Counters::default()
         },
     };
     let (w, h) = header.identity.frame;

@@ -1,7 +1,8 @@
 //! What a frame's EXR header says about the render that made it: the
 //! renderer and its version, the scene file and its content hash, the
 //! resolution, samples, seed, backend, integrator, every sampling option
-//! and the render time, as standard OpenEXR attribute types (`string`,
+//! the render plan (JSON, `crate::integrator::plan`) and the render time,
+//! as standard OpenEXR attribute types (`string`,
 //! `int`, `float`, `v2i`) so `exrheader`, OpenImageIO (`iinfo -v`,
 //! `oiiotool --info -v`) and compositors show them. The names are listed
 //! in `docs/output.md` ("Header attributes").
@@ -36,6 +37,9 @@ pub struct FrameHeader {
     pub integrator: Option<String>,
     /// Sampling options by material: (material name, `key=value …`).
     pub sampling: Vec<(String, String)>,
+    /// The render plan as one line of JSON
+    /// (`crate::integrator::plan::Explanation::to_json`).
+    pub plan: Option<String>,
     /// Wall time of the render, seconds.
     pub render_seconds: Option<f64>,
 }
@@ -88,6 +92,7 @@ impl FrameHeader {
             ("lucent/backend", s(&self.backend)),
             ("lucent/backendVersion", s(&self.backend_version)),
             ("lucent/integrator", s(&self.integrator)),
+            ("lucent/plan", s(&self.plan)),
             (
                 "lucent/renderTime",
                 self.render_seconds.map(|t| AttributeValue::F32(t as f32)),

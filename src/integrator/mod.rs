@@ -10,9 +10,11 @@
 //! materials, selected with [`IntegratorKind`]; [`diffuse_boundary`] is
 //! its optional diffuse Fresnel boundary model. [`aov`] records what the
 //! passes (light paths, light groups, data, ID coverage) measure.
+//! [`effects`] counts ray queries and time per effect for `--stats`.
 
 pub mod aov;
 pub mod diffuse_boundary;
+pub mod effects;
 pub mod interaction;
 pub mod path;
 pub mod plan;
@@ -23,6 +25,7 @@ use crate::accel::Accel;
 use crate::lights::LightSet;
 use crate::scene::Scene;
 
+pub use effects::{Clock, Effect, NoClock, Stopwatch, EFFECTS};
 pub use interaction::Interaction;
 pub use plan::Plan;
 
@@ -110,8 +113,8 @@ pub enum IntegratorKind {
 
 impl IntegratorKind {
     /// One sample of the radiance along `ray` with this estimator; its
-    /// parts go to `rec` ([`aov`]).
-    pub fn radiance<R: aov::Recorder>(
+    /// parts go to `rec` ([`aov`]), its effects' time to `T` ([`effects`]).
+    pub fn radiance<R: aov::Recorder, T: Clock>(
         self,
         ctx: &Context,
         ray: crate::geometry::Ray,
@@ -121,9 +124,9 @@ impl IntegratorKind {
         rec: &mut R,
     ) -> crate::geometry::Vec3 {
         match self {
-            IntegratorKind::Path => path::radiance(ctx, ray, rng, scratch, counters, rec),
+            IntegratorKind::Path => path::radiance::<R, T>(ctx, ray, rng, scratch, counters, rec),
             IntegratorKind::RandomWalk => {
-                randomwalk::radiance(ctx, ray, rng, scratch, counters, rec)
+                randomwalk::radiance::<R, T>(ctx, ray, rng, scratch, counters, rec)
             }
         }
     }
@@ -135,9 +138,6 @@ impl IntegratorKind {
 pub struct Counters {
     /// Ray queries issued: nearest, shadow and probe.
     pub rays: u64,
-    /// Probe queries (of `rays`): one per entry point the diffusion
-    /// estimator looked for.
-    pub probes: u64,
     /// Samples whose radiance was not finite and was discarded.
     pub nonfinite: u64,
     /// Sample channels beyond the accumulator's range, clamped to it
@@ -147,15 +147,49 @@ pub struct Counters {
     pub walks_capped: u64,
     /// Random walks that left an open mesh through a hole (no boundary hit).
     pub walks_escaped: u64,
+    /// Ray queries by [`Effect`]: they sum to `rays`.
+    pub effect_rays: [u64; EFFECTS],
+    /// Clock ticks by [`Effect`] (0 unless timed, [`effects`]).
+    pub effect_ticks: [u64; EFFECTS],
+    /// Clock ticks of whole samples (0 unless timed).
+    pub sample_ticks: u64,
+}
+
+impl Counters {
+    /// Probe queries made (subsurface probes; none under level of detail).
+    pub fn probes(&self) -> u64 {
+        self.effect_rays[Effect::Probe as usize]
+    }
+
+    /// One ray query made for `effect`.
+    #[inline(always)]
+    pub fn ray(&mut self, effect: Effect) {
+        self.rays += 1;
+        self.effect_rays[effect as usize] += 1;
+    }
+
+    /// `samples` samples traced their camera ray. The bounce loop counts
+    /// every nearest-hit query as [`Effect::Indirect`] (so it does not test
+    /// which is the camera's: one add a ray, as before the counts); every
+    /// sample makes exactly one camera query, so the tile loop moves one a
+    /// sample to [`Effect::Camera`].
+    pub fn camera_rays(&mut self, samples: u64) {
+        self.effect_rays[Effect::Camera as usize] += samples;
+        self.effect_rays[Effect::Indirect as usize] -= samples;
+    }
 }
 
 impl std::ops::AddAssign for Counters {
     fn add_assign(&mut self, o: Self) {
         self.rays += o.rays;
-        self.probes += o.probes;
         self.nonfinite += o.nonfinite;
         self.clamped += o.clamped;
         self.walks_capped += o.walks_capped;
         self.walks_escaped += o.walks_escaped;
+        for e in 0..EFFECTS {
+            self.effect_rays[e] += o.effect_rays[e];
+            self.effect_ticks[e] += o.effect_ticks[e];
+        }
+        self.sample_ticks += o.sample_ticks;
     }
 }

@@ -66,7 +66,7 @@
 use super::aov::{self, Event, Recorder, Source};
 use super::interaction::offset_along;
 use super::probe::{entry_on_segment, exit_curvature, ProbeTarget};
-use super::{Context, Counters, Interaction};
+use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::ProbeHits;
 use crate::bssrdf::curvature_correction::{mean_curvature, CurvatureCorrection, ExitFactor};
 use crate::bssrdf::{ProbeRandoms, ProbeSegment};
@@ -79,7 +79,7 @@ use crate::materials::{dielectric, diffuse, Material, Subsurface};
 use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Draw, SampleRng};
 
 /// Bounces after which Russian roulette may end a path.
-const RR_START: u32 = 3;
+pub(crate) const RR_START: u32 = 3;
 
 /// Smooth-coated subsurface hits at depths below this split into the
 /// mirror reflection and the medium (both followed); deeper ones choose
@@ -268,8 +268,9 @@ impl Branches {
 
 /// The radiance arriving along `camera_ray`: one sample of L, with the
 /// BSSRDF estimated by one probe ray per subsurface hit (an antithetic pair
-/// at the camera vertex); its parts go to `rec` ([`aov`]).
-pub fn radiance<R: Recorder>(
+/// at the camera vertex); its parts go to `rec` ([`aov`]), its effects'
+/// time to `T` ([`super::effects`]).
+pub fn radiance<R: Recorder, T: Clock>(
     ctx: &Context,
     camera_ray: Ray,
     rng: &mut SampleRng,
@@ -277,21 +278,25 @@ pub fn radiance<R: Recorder>(
     counters: &mut Counters,
     rec: &mut R,
 ) -> Vec3 {
-    trace_at(
+    trace_at::<R, T>(
         ctx,
         camera_ray,
         rng,
         counters,
         rec,
         |ss, si, wo, beta, rng, counters, depth, width| {
-            subsurface_probe(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width)
+            let t0 = T::now();
+            let s =
+                subsurface_probe(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
+            T::lap(counters, Effect::Probe, t0);
+            s
         },
     )
 }
 
 /// The bounce loop both integrators share; `subsurface` handles hits on
 /// subsurface objects (and may scale the throughput `beta`).
-pub(crate) fn trace<'s, R: Recorder>(
+pub(crate) fn trace<'s, R: Recorder, T: Clock>(
     ctx: &'s Context,
     camera_ray: Ray,
     rng: &mut SampleRng,
@@ -306,7 +311,7 @@ pub(crate) fn trace<'s, R: Recorder>(
         &mut Counters,
     ) -> Scatter<'s>,
 ) -> Vec3 {
-    trace_at(
+    trace_at::<R, T>(
         ctx,
         camera_ray,
         rng,
@@ -320,7 +325,7 @@ pub(crate) fn trace<'s, R: Recorder>(
 
 /// [`trace`] whose `subsurface` also receives the depth of the hit and the
 /// width of the path's footprint there ([`Cone`]).
-fn trace_at<'s, R: Recorder>(
+fn trace_at<'s, R: Recorder, T: Clock>(
     ctx: &'s Context,
     camera_ray: Ray,
     rng: &mut SampleRng,
@@ -350,7 +355,7 @@ fn trace_at<'s, R: Recorder>(
     });
     let mut l = Vec3::ZERO;
     while let Some(start) = first.take().or_else(|| stack.pop()) {
-        l += follow(ctx, start, rng, counters, rec, &mut subsurface, &mut stack);
+        l += follow::<R, T>(ctx, start, rng, counters, rec, &mut subsurface, &mut stack);
     }
     l
 }
@@ -358,7 +363,7 @@ fn trace_at<'s, R: Recorder>(
 /// One path from `start` until it ends; paths split off on the way are
 /// pushed on `stack`.
 #[inline(always)]
-fn follow<'s, R: Recorder>(
+fn follow<'s, R: Recorder, T: Clock>(
     ctx: &'s Context,
     start: Branch,
     rng: &mut SampleRng,
@@ -393,8 +398,17 @@ fn follow<'s, R: Recorder>(
 
     let max_depth = scene.settings.max_depth;
     for depth in start.depth..=max_depth {
-        counters.rays += 1;
-        let Some(hit) = ctx.accel.intersect(&ray, 0.0, f32::INFINITY) else {
+        // camera rays too: the tile loop moves one a sample to Effect::Camera
+        counters.ray(Effect::Indirect);
+        let t0 = T::now();
+        let found = ctx.accel.intersect(&ray, 0.0, f32::INFINITY);
+        let effect = if depth == 0 {
+            Effect::Camera
+        } else {
+            Effect::Indirect
+        };
+        T::lap(counters, effect, t0);
+        let Some(hit) = found else {
             if ctx.plan.environment {
                 let c = beta * scene.environment.unwrap_or(Vec3::ZERO);
                 l += c;
@@ -487,7 +501,9 @@ fn follow<'s, R: Recorder>(
             Scatter::Absorbed => break,
             Scatter::Coated(c) => {
                 if let (Some((v, b)), true) = (&c.coat, ctx.plan.area_lights) {
+                    let t0 = T::now();
                     let (d, light) = direct_lighting(ctx, v, rng, counters);
+                    T::lap(counters, Effect::Direct, t0);
                     let c = *b * d;
                     l += c;
                     rec.light(c, aov::sampled(coat_event, depth), Source::Light(light));
@@ -529,7 +545,9 @@ fn follow<'s, R: Recorder>(
                         }
                         if let Some((pv, b)) = &c.pair {
                             if ctx.plan.area_lights {
+                                let t0 = T::now();
                                 let (d, light) = direct_lighting(ctx, pv, rng, counters);
+                                T::lap(counters, Effect::Direct, t0);
                                 let c = (entry_mul * *b) * d;
                                 l += c;
                                 rec.light(c, aov::sampled(event, depth), Source::Light(light));
@@ -553,7 +571,9 @@ fn follow<'s, R: Recorder>(
 
         // Next-event estimation, then continue by sampling the lobe.
         if ctx.plan.area_lights {
+            let t0 = T::now();
             let (d, light) = direct_lighting(ctx, vertex, rng, counters);
+            T::lap(counters, Effect::Direct, t0);
             let c = (nee_scale * beta) * d;
             l += c;
             rec.light(c, aov::sampled(event, depth), Source::Light(light));
@@ -869,8 +889,7 @@ fn probe_entry<'s>(
     scratch: &mut Scratch,
     counters: &mut Counters,
 ) -> Option<(Vertex<'s>, Vec3)> {
-    counters.rays += 1;
-    counters.probes += 1;
+    counters.ray(Effect::Probe);
     let target = ProbeTarget {
         accel: ctx.accel,
         geom: si.geom,
@@ -958,7 +977,7 @@ fn direct_lighting(
         return (Vec3::ZERO, source);
     }
     let pdf_light = ls.pdf_area * dist2 / cos_l;
-    counters.rays += 1;
+    counters.ray(Effect::Direct);
     let origin = offset_along(v.p, v.ng, ctx.ray_epsilon);
     // t is in units of |d| = the distance to the light point; stop just short
     // of it so the light's own triangle does not shadow itself.

@@ -59,7 +59,7 @@ use super::aov::{Event, Recorder};
 use super::diffuse_boundary::DiffuseBoundary;
 use super::interaction::offset_along;
 use super::path::{trace, Lobe, Scatter, Scratch, Vertex};
-use super::{Context, Counters, Interaction};
+use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
 use crate::geometry::{Frame, Ray, Vec3};
@@ -79,7 +79,7 @@ const WALK_RR_START: u32 = 16;
 /// subsurface objects simulated as media. Same contract as
 /// [`super::path::radiance`], and the same bounce loop (`trace`); only
 /// subsurface hits differ.
-pub fn radiance<R: Recorder>(
+pub fn radiance<R: Recorder, T: Clock>(
     ctx: &Context,
     camera_ray: Ray,
     rng: &mut SampleRng,
@@ -87,55 +87,73 @@ pub fn radiance<R: Recorder>(
     counters: &mut Counters,
     rec: &mut R,
 ) -> Vec3 {
-    trace(
+    trace::<R, T>(
         ctx,
         camera_ray,
         rng,
         counters,
         rec,
         |ss, si, wo, beta, rng, counters| {
-            // Parameters built by hand without a medium leave nothing to
-            // simulate; the path ends as at a black surface.
-            let Some(medium) = ss.params.medium else {
-                return Scatter::Absorbed;
-            };
-            // As in the path tracer, the side the ray arrives from is
-            // "outside", so a mesh wound inside-out still works.
-            let n_out = if si.front { si.ng } else { -si.ng };
-            match ss.boundary {
-                WalkBoundary::Dielectric => {
-                    let frame = Frame::from_normal(n_out);
-                    let s = dielectric::sample(ss.eta(), frame.to_local(wo), rng.uniform());
-                    *beta *= s.weight;
-                    let wi = frame.to_world(s.wi).normalize();
-                    if !s.transmitted {
-                        return Scatter::Continue(si.spawn(wi, ctx.ray_epsilon), Event::Specular);
-                    }
-                    let inside = si.spawn(wi, ctx.ray_epsilon);
-                    let law = Boundary::Dielectric(ss.eta());
-                    match walk(ctx, &medium, law, inside, rng, counters) {
-                        Some((WalkEnd::Refracted(exit), w)) => {
-                            *beta *= w;
-                            Scatter::Continue(exit, Event::Subsurface)
-                        }
-                        _ => Scatter::Absorbed,
-                    }
-                }
-                WalkBoundary::Diffuse { exit_nee } => diffuse_hit(
-                    ctx,
-                    &medium,
-                    ss.eta(),
-                    exit_nee,
-                    si,
-                    n_out,
-                    wo,
-                    beta,
-                    rng,
-                    counters,
-                ),
-            }
+            let t0 = T::now();
+            let s = walk_hit(ctx, ss, si, wo, beta, rng, counters);
+            T::lap(counters, Effect::Walk, t0);
+            s
         },
     )
+}
+
+/// A subsurface hit under the random walk: the boundary at the hit, the
+/// walk inside, and what leaves.
+#[inline(always)]
+fn walk_hit<'s>(
+    ctx: &'s Context,
+    ss: &'s crate::materials::Subsurface,
+    si: &Interaction,
+    wo: Vec3,
+    beta: &mut Vec3,
+    rng: &mut SampleRng,
+    counters: &mut Counters,
+) -> Scatter<'s> {
+    // Parameters built by hand without a medium leave nothing to
+    // simulate; the path ends as at a black surface.
+    let Some(medium) = ss.params.medium else {
+        return Scatter::Absorbed;
+    };
+    // As in the path tracer, the side the ray arrives from is
+    // "outside", so a mesh wound inside-out still works.
+    let n_out = if si.front { si.ng } else { -si.ng };
+    match ss.boundary {
+        WalkBoundary::Dielectric => {
+            let frame = Frame::from_normal(n_out);
+            let s = dielectric::sample(ss.eta(), frame.to_local(wo), rng.uniform());
+            *beta *= s.weight;
+            let wi = frame.to_world(s.wi).normalize();
+            if !s.transmitted {
+                return Scatter::Continue(si.spawn(wi, ctx.ray_epsilon), Event::Specular);
+            }
+            let inside = si.spawn(wi, ctx.ray_epsilon);
+            let law = Boundary::Dielectric(ss.eta());
+            match walk(ctx, &medium, law, inside, rng, counters) {
+                Some((WalkEnd::Refracted(exit), w)) => {
+                    *beta *= w;
+                    Scatter::Continue(exit, Event::Subsurface)
+                }
+                _ => Scatter::Absorbed,
+            }
+        }
+        WalkBoundary::Diffuse { exit_nee } => diffuse_hit(
+            ctx,
+            &medium,
+            ss.eta(),
+            exit_nee,
+            si,
+            n_out,
+            wo,
+            beta,
+            rng,
+            counters,
+        ),
+    }
 }
 
 /// A subsurface hit under the diffuse Fresnel boundary
@@ -237,7 +255,7 @@ pub fn walk(
     let sigma_t = m.sigma_t();
     let mut beta = [1.0f64; 3];
     for event in 0..MAX_WALK_EVENTS {
-        counters.rays += 1;
+        counters.ray(Effect::Walk);
         // Inside a closed mesh every direction meets the boundary. No hit
         // means the walk is in the open (through a hole of an open mesh, or
         // on the wrong side of a single sheet): there is no bounded medium,

@@ -96,6 +96,7 @@ fn render_opts(
         threads: s.threads,
         progress,
         integrator,
+        stats: false,
     }
 }
 

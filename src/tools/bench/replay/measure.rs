@@ -53,6 +53,7 @@ pub(super) fn measure(
         threads: Some(threads),
         progress: false,
         integrator: IntegratorKind::Path,
+        stats: false,
     };
     let rec = record(s, scene, accel, &opts, &label, notes)?;
 

@@ -1,0 +1,52 @@
+//! The render plan: what a scene needs simulated, decided once before
+//! rendering, so a scene without lights, environment or subsurface
+//! materials pays nothing for them.
+//!
+//! The plan has two faces. [`Plan`] is what the bounce loop reads: a few
+//! booleans, tested once per vertex where the effect would be estimated
+//! (a branch the predictor learns at once, since it never changes within
+//! a render). [`Explanation`] ([`explain`]) is the same decision written
+//! out for people and pipelines: every effect, the method chosen and the
+//! reason, per material where materials differ. `lucent render --explain`
+//! prints it ([`text`] for people, JSON for pipelines) and the EXR header
+//! stores it (`lucent/plan`, `docs/output.md`). Both are derived from the
+//! same scene and options by the functions of this module, and the tests
+//! (`tests/plan.rs`) check that the explanation says what the flags do
+//! and that a render honours it (no probe ray where it says none).
+
+pub mod explain;
+pub mod text;
+
+use crate::materials::Material;
+use crate::scene::Scene;
+
+pub use explain::{Explanation, PlanOptions};
+
+/// The flags the hot path reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Some object emits: do next-event estimation.
+    pub area_lights: bool,
+    /// Escaping rays see a non-zero environment.
+    pub environment: bool,
+    /// Some object has a subsurface material: probe rays will be cast.
+    pub subsurface: bool,
+}
+
+impl Plan {
+    pub fn new(scene: &Scene) -> Self {
+        Plan {
+            area_lights: scene.objects.iter().any(|o| emits(o.emission)),
+            environment: scene.environment.is_some_and(|e| e.max_element() > 0.0),
+            subsurface: scene
+                .objects
+                .iter()
+                .any(|o| matches!(scene.materials[o.material], Material::Subsurface(_))),
+        }
+    }
+}
+
+/// Whether an object's emission makes it a light.
+pub(crate) fn emits(e: Option<crate::geometry::Vec3>) -> bool {
+    e.is_some_and(|e| e.max_element() > 0.0)
+}
