@@ -391,7 +391,7 @@ fn passes_split_and_merge_to_the_uncut_file() {
                 // beauty, the passes, Cryptomatte's ranks)
                 let lively = uncut
                     .iter()
-                    .filter(|c| c.1.iter().collect::<std::collections::BTreeSet<_>>().len() > 5)
+                    .filter(|c| c.1.iter().collect::<std::collections::BTreeSet<_>>().len() > 2)
                     .count();
                 let one_file = f.is_empty() && opts.is_empty();
                 assert!(lively >= if one_file { 30 } else { 1 }, "{out}{f}: {lively}");
