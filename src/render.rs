@@ -220,7 +220,7 @@ impl Accumulated {
     }
 
     /// Pixel (x, y)'s index in the sums (tile-major layout: the tiles of
-    /// [`tiles`] in order, each row-major); its beauty sums start at
+    /// `tiles` in order, each row-major); its beauty sums start at
     /// index · [`CHANNELS`](Self::CHANNELS).
     pub fn index(&self, x: u32, y: u32) -> usize {
         let r = &self.region;

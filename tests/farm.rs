@@ -113,8 +113,11 @@ fn layer_bits(layers: &[Layer]) -> Vec<(String, Vec<String>, Vec<u32>)> {
         .collect()
 }
 
+/// A coverage's kind, names, and per pixel (ID, fraction bits).
+type CoverageBits = (String, Vec<String>, Vec<Vec<(u32, u32)>>);
+
 /// Every coverage list, fractions as bits.
-fn coverage_bits(cov: &[Coverage]) -> Vec<(String, Vec<String>, Vec<Vec<(u32, u32)>>)> {
+fn coverage_bits(cov: &[Coverage]) -> Vec<CoverageBits> {
     cov.iter()
         .map(|c| {
             let px = c
@@ -142,66 +145,69 @@ fn merged_parts_are_bitwise_the_uncut_render_for_random_splits() {
         };
         let (plain, _) = render::render(&scene, accel.as_ref(), &opts).unwrap();
         for passes in [PassSet::EMPTY, PassSet::all()] {
-        let uncut = render::render_passes(&scene, accel.as_ref(), &opts, passes).unwrap();
-        // passes leave the beauty as it is without them
-        assert!(bits(&uncut.film) == bits(&plain));
-        // the merge would be vacuous over a black image, or passes
-        // without contents
-        assert!(uncut.film.pixels.iter().filter(|p| p.x > 0.0).count() > (w * h / 2) as usize);
-        if !passes.is_empty() {
-            let l = |n: &str| uncut.layers.iter().find(|l| l.name == n).unwrap();
-            assert!(l("sss_direct").values.iter().any(|v| *v > 0.0));
-            for name in ["diffuse_direct", "albedo", "N", "Z", "variance"] {
-                let distinct: std::collections::BTreeSet<u32> =
-                    l(name).values.iter().map(|v| v.to_bits()).collect();
-                assert!(distinct.len() > 10, "{name}");
+            let uncut = render::render_passes(&scene, accel.as_ref(), &opts, passes).unwrap();
+            // passes leave the beauty as it is without them
+            assert!(bits(&uncut.film) == bits(&plain));
+            // the merge would be vacuous over a black image, or passes
+            // without contents
+            assert!(uncut.film.pixels.iter().filter(|p| p.x > 0.0).count() > (w * h / 2) as usize);
+            if !passes.is_empty() {
+                let l = |n: &str| uncut.layers.iter().find(|l| l.name == n).unwrap();
+                assert!(l("sss_direct").values.iter().any(|v| *v > 0.0));
+                for name in ["diffuse_direct", "albedo", "N", "Z", "variance"] {
+                    let distinct: std::collections::BTreeSet<u32> =
+                        l(name).values.iter().map(|v| v.to_bits()).collect();
+                    assert!(distinct.len() > 10, "{name}");
+                }
+                // pixels seen by two objects (edges): coverage fractions to rank
+                assert!(uncut.coverage[0].pixels.iter().any(|p| p.len() >= 2));
             }
-            // pixels seen by two objects (edges): coverage fractions to rank
-            assert!(uncut.coverage[0].pixels.iter().any(|p| p.len() >= 2));
-        }
-        for kind in ["tiles", "samples", "both"] {
-            let (xs, ys, ss) = match kind {
-                "tiles" => (rand.cuts(w, 3), rand.cuts(h, 2), vec![0, spp]),
-                "samples" => (vec![0, w], vec![0, h], rand.cuts(spp, 3)),
-                _ => (rand.cuts(w, 2), rand.cuts(h, 1), rand.cuts(spp, 2)),
-            };
-            let mut parts = Vec::new();
-            for y in ys.windows(2) {
-                for x in xs.windows(2) {
-                    for s in ss.windows(2) {
-                        let region = Region {
-                            x0: x[0],
-                            y0: y[0],
-                            x1: x[1],
-                            y1: y[1],
-                        };
-                        let p = dir.path().join(format!("{kind}-{}.exr", parts.len()));
-                        render_part(
-                            &scene,
-                            accel.as_ref(),
-                            spp,
-                            region,
-                            s[0]..s[1],
-                            passes,
-                            &p,
-                        );
-                        parts.push(p);
+            for kind in ["tiles", "samples", "both"] {
+                let (xs, ys, ss) = match kind {
+                    "tiles" => (rand.cuts(w, 3), rand.cuts(h, 2), vec![0, spp]),
+                    "samples" => (vec![0, w], vec![0, h], rand.cuts(spp, 3)),
+                    _ => (rand.cuts(w, 2), rand.cuts(h, 1), rand.cuts(spp, 2)),
+                };
+                let mut parts = Vec::new();
+                for y in ys.windows(2) {
+                    for x in xs.windows(2) {
+                        for s in ss.windows(2) {
+                            let region = Region {
+                                x0: x[0],
+                                y0: y[0],
+                                x1: x[1],
+                                y1: y[1],
+                            };
+                            let p = dir.path().join(format!("{kind}-{}.exr", parts.len()));
+                            render_part(
+                                &scene,
+                                accel.as_ref(),
+                                spp,
+                                region,
+                                s[0]..s[1],
+                                passes,
+                                &p,
+                            );
+                            parts.push(p);
+                        }
                     }
                 }
+                // in any order
+                parts.reverse();
+                let merged = lucent::farm::merge::merge(&parts).unwrap();
+                let what = format!("{backend:?} {kind}: x {xs:?} y {ys:?} samples {ss:?}");
+                assert!(bits(&merged.film) == bits(&uncut.film), "{what}");
+                assert_eq!(merged.film.width, w);
+                assert_eq!(merged.layers.len(), uncut.layers.len(), "{what}");
+                assert!(
+                    layer_bits(&merged.layers) == layer_bits(&uncut.layers),
+                    "{what}"
+                );
+                assert!(
+                    coverage_bits(&merged.coverage) == coverage_bits(&uncut.coverage),
+                    "{what}"
+                );
             }
-            // in any order
-            parts.reverse();
-            let merged = lucent::farm::merge::merge(&parts).unwrap();
-            let what = format!("{backend:?} {kind}: x {xs:?} y {ys:?} samples {ss:?}");
-            assert!(bits(&merged.film) == bits(&uncut.film), "{what}");
-            assert_eq!(merged.film.width, w);
-            assert_eq!(merged.layers.len(), uncut.layers.len(), "{what}");
-            assert!(layer_bits(&merged.layers) == layer_bits(&uncut.layers), "{what}");
-            assert!(
-                coverage_bits(&merged.coverage) == coverage_bits(&uncut.coverage),
-                "{what}"
-            );
-        }
         }
     }
 }
@@ -394,7 +400,10 @@ fn passes_split_and_merge_to_the_uncut_file() {
                     .filter(|c| c.1.iter().collect::<std::collections::BTreeSet<_>>().len() > 2)
                     .count();
                 let one_file = f.is_empty() && opts.is_empty();
-                assert!(lively >= if one_file { 30 } else { 1 }, "{out}{f}: {lively}");
+                assert!(
+                    lively >= if one_file { 30 } else { 1 },
+                    "{out}{f}: {lively}"
+                );
                 assert_eq!(
                     merged.iter().map(|c| &c.0).collect::<Vec<_>>(),
                     uncut.iter().map(|c| &c.0).collect::<Vec<_>>(),
@@ -419,7 +428,13 @@ fn parts_with_other_passes_are_refused() {
     let d = dir.path();
     let part = |extra: &[&str], out: &str| {
         let mut a = vec![
-            "render", "scene.toml", "--quiet", "--spp", "2", "--threads", "1",
+            "render",
+            "scene.toml",
+            "--quiet",
+            "--spp",
+            "2",
+            "--threads",
+            "1",
         ];
         a.extend_from_slice(extra);
         a.extend_from_slice(&["-o", out]);
@@ -430,7 +445,10 @@ fn parts_with_other_passes_are_refused() {
     part(&["--tile", "1/2", "--aov", "all"], "b.exr");
     part(&["--tile", "1/2", "--aov", "Z"], "z.exr");
     part(&["--tile", "1/2"], "none.exr");
-    part(&["--tile", "1/2", "--aov", "all", "--exr-compression", "piz"], "piz.exr");
+    part(
+        &["--tile", "1/2", "--aov", "all", "--exr-compression", "piz"],
+        "piz.exr",
+    );
     let o = lucent(d, &["merge", "-o", "good.exr", "a.exr", "b.exr", "--quiet"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for (other, field, problem) in [
@@ -453,7 +471,10 @@ fn parts_with_other_passes_are_refused() {
     forged[at] = b'N';
     fs::write(d.join("forged.exr"), &forged).unwrap();
     let e = refused(d, &["merge", "-o", "out.exr", "forged.exr"]);
-    assert!(e.contains("forged.exr") && e.contains("lucent.layers"), "{e}");
+    assert!(
+        e.contains("forged.exr") && e.contains("lucent.layers"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -180,7 +180,10 @@ fn killed_and_resumed(options: &[&str]) {
         .iter()
         .filter(|c| c.1.iter().collect::<std::collections::BTreeSet<_>>().len() > 2)
         .count();
-    assert!(lively >= if options.is_empty() { 3 } else { 12 }, "{lively}");
+    assert!(
+        lively >= if options.is_empty() { 3 } else { 12 },
+        "{lively}"
+    );
     // a seeded "random" moment: reproducible, yet not a round number
     let nanos = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)

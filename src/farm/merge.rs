@@ -64,7 +64,13 @@ pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
                 "lucent.output" => "the parts ask for different frame file options",
                 _ => "the parts are of different frames",
             };
-            let show = |v: &str| if v.is_empty() { "none".to_string() } else { format!("`{v}`") };
+            let show = |v: &str| {
+                if v.is_empty() {
+                    "none".to_string()
+                } else {
+                    format!("`{v}`")
+                }
+            };
             return Err(located(
                 p,
                 Some(field),
@@ -154,8 +160,7 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
     let identity = check(&headers)?;
     let frame = Region::full(identity.frame.0, identity.frame.1);
     let (first, _) = &headers[0];
-    let layout =
-        part::layout_of(&identity).map_err(|(f, e)| located(first, Some(f), e))?;
+    let layout = part::layout_of(&identity).map_err(|(f, e)| located(first, Some(f), e))?;
     let output = part::parse_output(&identity.output).ok_or_else(|| {
         located(
             first,

@@ -13,9 +13,9 @@
 //! With P, Z or an ID pass, the nearest camera hit is stored as the u32
 //! channels `nearest.depth`, `nearest.sample`, `nearest.px`/`py`/`pz` (f32
 //! bits), `nearest.object`, `nearest.material` (index + 1, 0: none); with
-//! Cryptomatte, the sample counts per ID as `coverage.object.id{k}` (index
-//! + 1, 0: empty) and `coverage.object.n{k}` for k below the most IDs any
-//! pixel of the part saw (the same for `material`).
+//! Cryptomatte, the sample counts per ID as `coverage.object.id{k}` (the
+//! index plus 1, 0: empty) and `coverage.object.n{k}` for k below the most
+//! IDs any pixel of the part saw (the same for `material`).
 //! Header attributes (text):
 //!
 //! | attribute | value |
@@ -281,9 +281,9 @@ pub fn stage(path: &Path, header: &Header, sums: &Accumulated) -> Result<Staged,
                     let c = layer.channels.iter().position(|x| x == ch).unwrap_or(0);
                     sums.pixel_at(i)[c]
                 } else {
-                    sums.passes.as_ref().map_or(0, |p| {
-                        p.sums.sums[i * stride + aov_channel]
-                    })
+                    sums.passes
+                        .as_ref()
+                        .map_or(0, |p| p.sums.sums[i * stride + aov_channel])
                 }
             };
             let mut words = [
@@ -311,7 +311,8 @@ pub fn stage(path: &Path, header: &Header, sums: &Accumulated) -> Result<Staged,
     if let Some(p) = &sums.passes {
         let aov = &p.sums;
         if !aov.nearest.is_empty() {
-            let fields: [(&str, fn(&Nearest) -> u32); 7] = [
+            type Field = fn(&Nearest) -> u32;
+            let fields: [(&str, Field); 7] = [
                 ("depth", |n| n.z.to_bits()),
                 ("sample", |n| n.sample),
                 ("px", |n| n.p[0].to_bits()),
@@ -335,7 +336,10 @@ pub fn stage(path: &Path, header: &Header, sums: &Accumulated) -> Result<Staged,
             let most = order.iter().map(|&i| counts[i].len()).max().unwrap_or(0);
             for k in 0..most {
                 let at = |i: usize| counts[i].get(k).copied();
-                let ids = order.iter().map(|&i| at(i).map_or(0, |e| e.0 + 1)).collect();
+                let ids = order
+                    .iter()
+                    .map(|&i| at(i).map_or(0, |e| e.0 + 1))
+                    .collect();
                 let ns = order.iter().map(|&i| at(i).map_or(0, |e| e.1)).collect();
                 channels.push(AnyChannel::new(
                     format!("coverage.{kind}.id{k}").as_str(),
@@ -551,7 +555,10 @@ fn parse_header(
         return Err(bad(
             path,
             Some("lucent.output"),
-            format!("`{}` is not the frame's file options", header.identity.output),
+            format!(
+                "`{}` is not the frame's file options",
+                header.identity.output
+            ),
         ));
     }
     let expected = layers_of(layout.as_ref());
@@ -716,7 +723,11 @@ pub fn read(path: &Path) -> Result<(Header, Accumulated), Error> {
         }
         for (kind, names, counts) in [
             ("object", p.layout.object_names.len(), &mut aov.objects),
-            ("material", p.layout.material_names.len(), &mut aov.materials),
+            (
+                "material",
+                p.layout.material_names.len(),
+                &mut aov.materials,
+            ),
         ] {
             if counts.is_empty() {
                 continue;

@@ -225,9 +225,14 @@ impl Layout {
 
     /// Whether the nearest camera hit is kept (P, Z, IDs).
     pub fn nearest(&self) -> bool {
-        [Pass::Position, Pass::Depth, Pass::ObjectId, Pass::MaterialId]
-            .iter()
-            .any(|p| self.passes.contains(*p))
+        [
+            Pass::Position,
+            Pass::Depth,
+            Pass::ObjectId,
+            Pass::MaterialId,
+        ]
+        .iter()
+        .any(|p| self.passes.contains(*p))
     }
 
     /// The summed layers, in stride order (a part's `lucent.layers` after
@@ -454,7 +459,11 @@ pub struct AovViewMut<'a> {
 #[inline]
 pub fn square_words(q: i128) -> [i128; SQUARE_WORDS] {
     let w = mul_u128(q.unsigned_abs(), q.unsigned_abs());
-    [w[0] as i128, w[1] as i128, (w[2] as i128) | (w[3] as i128) << 64]
+    [
+        w[0] as i128,
+        w[1] as i128,
+        (w[2] as i128) | (w[3] as i128) << 64,
+    ]
 }
 
 /// The 256-bit product of two u128, as four u64 limbs, least significant
