@@ -115,9 +115,9 @@ enum Command {
     },
     /// Merge parts (`render --crop/--tile/--samples`) into the frame they
     /// split: bitwise the frame one uncut render gives. Checks that they
-    /// are of one scene, seed, spp, options and lucent version and cover
-    /// the frame's pixels and samples exactly once; writes the EXR and its
-    /// PNG preview, or nothing.
+    /// are of one scene, seed, spp, options, passes and lucent version and
+    /// cover the frame's pixels and samples exactly once; writes the EXR
+    /// (with every pass the parts carry) and its PNG preview, or nothing.
     Merge {
         /// The part files.
         #[arg(required = true)]

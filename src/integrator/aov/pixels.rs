@@ -612,6 +612,11 @@ impl<'a> PixelPasses for TilePasses<'a> {
                 },
                 _ => continue,
             };
+            // most of a sample's light is in one or two passes: adding a
+            // zero (to_fixed(±0) = 0) is skipped, exactly
+            if v == Vec3::ZERO {
+                continue;
+            }
             F.add(
                 &mut self.sums[slot.offset..slot.offset + 3],
                 &[v.x, v.y, v.z],
