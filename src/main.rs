@@ -130,9 +130,9 @@ enum Command {
     },
     /// Merge parts (`render --crop/--tile/--samples`) into the frame they
     /// split: bitwise the frame one uncut render gives. Checks that they
-    /// are of one scene, seed, spp, options and lucent version and cover
-    /// the frame's pixels and samples exactly once; writes the EXR and its
-    /// PNG preview, or nothing.
+    /// are of one scene, seed, spp, options, passes and lucent version and
+    /// cover the frame's pixels and samples exactly once; writes the EXR
+    /// (with every pass the parts carry) and its PNG preview, or nothing.
     Merge {
         /// The part files.
         #[arg(required = true)]
@@ -190,19 +190,6 @@ struct SplitArgs {
 }
 
 impl SplitArgs {
-    /// The first splitting, checkpoint or resume option given, by name.
-    fn option_given(&self) -> Option<&'static str> {
-        [
-            (self.crop.is_some(), "--crop"),
-            (self.tile.is_some(), "--tile"),
-            (self.samples.is_some(), "--samples"),
-            (self.checkpoint.is_some(), "--checkpoint"),
-            (self.resume.is_some(), "--resume"),
-        ]
-        .into_iter()
-        .find_map(|(given, name)| given.then_some(name))
-    }
-
     /// Whether the output is a part rather than a frame.
     fn is_part(&self) -> bool {
         self.crop.is_some() || self.tile.is_some() || self.samples.is_some()
@@ -629,7 +616,13 @@ fn run_render(
             ),
         });
     }
+    let passes = aov.unwrap_or(scene.output.aovs);
+    let layout = (!passes.is_empty()).then(|| lucent::integrator::aov::layout(&scene, passes));
+    let mut out = file.over(scene.output.file.over(OutputOptions::default()));
     let identity = Identity {
+        passes: part::passes_text(layout.as_ref()),
+        names: part::names_text(layout.as_ref()),
+        output: part::output_text(&out),
         version: env!("CARGO_PKG_VERSION").into(),
         scene_hash: lucent::farm::scene_hash(scene_bytes.as_bytes(), &scene),
         seed: opts.seed.unwrap_or(scene.settings.seed),
@@ -651,13 +644,14 @@ fn run_render(
         region,
         samples: sums.start..sums.done,
         requested: samples.clone(),
-        layers: vec![part::beauty_layer()],
+        layers: part::layers_of(layout.as_ref()),
         counters: sums.counters,
     };
     let job = render::Job {
         region,
         samples: samples.clone(),
         pass_seconds: split.checkpoint.map_or(2.0, |c| (c / 2.0).min(2.0)),
+        passes,
     };
     let resume = match &split.resume {
         Some(p) => Some(resumable(p, &identity, &job)?),
@@ -666,51 +660,7 @@ fn run_render(
     stop_if_interrupted()?;
     let accel = accel::build(&scene.meshes, backend)?;
     stop_if_interrupted()?;
-    let passes = aov.unwrap_or(scene.output.aovs);
-    let mut out = file.over(scene.output.file.over(OutputOptions::default()));
     out.preview = Some(preview);
-    if !passes.is_empty() {
-        // passes are not yet carried by parts (docs/farm.md): a render with
-        // passes is one uncut run
-        if let Some(arg) = split.option_given() {
-            return Err(Error::Argument {
-                argument: arg.into(),
-                problem: "passes (--aov or the scene's [output] aovs) are not yet \
-                          carried by parts; render them in one run"
-                    .into(),
-            });
-        }
-        let render::RenderOutput {
-            film,
-            layers,
-            coverage,
-            stats,
-        } = render::render_passes(&scene, accel.as_ref(), opts, passes)?;
-        let header = frame_header(
-            scene_path,
-            &scene,
-            accel.name(),
-            backend,
-            opts,
-            passes,
-            stats.seconds,
-        )?;
-        exr_layers::write_frame(output, &film, &layers, &coverage, &header, &out)?;
-        if !quiet {
-            eprintln!(
-                "{}: {w}×{h} at {spp} spp, {} passes, {} triangles: {}",
-                output.display(),
-                layers.len() + coverage.len(),
-                scene.triangle_count(),
-                stats.summary(accel.name())
-            );
-        }
-        if opts.stats {
-            eprint!("{}", effects::summary(&stats.counters));
-        }
-        report_rejected_rays(accel.as_ref());
-        return Ok(());
-    }
     let keep = checkpoint_path(output);
     let mut last = std::time::Instant::now();
     let mut checkpoint = |sums: &render::Accumulated| -> Result<(), Error> {
@@ -749,7 +699,8 @@ fn run_render(
             PassSet::EMPTY,
             r.stats.seconds,
         )?;
-        exr_layers::write_frame(output, &r.sums.film()?, &[], &[], &header, &out)?;
+        let (layers, coverage) = r.sums.layers()?;
+        exr_layers::write_frame(output, &r.sums.film()?, &layers, &coverage, &header, &out)?;
     }
     // the finished output replaces what was kept to resume from
     if keep.is_file() {
@@ -928,7 +879,16 @@ fn run_merge(
     check_exr_output(output)?;
     let start = std::time::Instant::now();
     let m = lucent::farm::merge::merge(parts)?;
-    m.film.write_exr_and_preview(output, tonemap, exposure)?;
+    let header = lucent::film::exr_attributes::FrameHeader {
+        spp: Some(m.identity.spp),
+        seed: Some(m.identity.seed),
+        ..Default::default()
+    };
+    let out = OutputOptions {
+        preview: Some(Preview { tonemap, exposure }),
+        ..m.output
+    };
+    exr_layers::write_frame(output, &m.film, &m.layers, &m.coverage, &header, &out)?;
     if !quiet {
         eprintln!(
             "{}: {} parts merged, {}×{} at {} spp, {:.2} s{}",

@@ -20,13 +20,13 @@
 //! [`Job::pass_seconds`] each (the first is one sample); they change when
 //! a render can stop, never what it computes.
 //!
-//! [`render_passes`] also computes passes (AOVs, `crate::integrator::aov`)
-//! in one uncut run over the whole frame (parts do not carry passes yet:
-//! docs/farm.md). Its beauty is summed in the same fixed point, in the
-//! same sample order, so it is bitwise the beauty of [`render`]. Whether
-//! passes are computed is decided once per render, by which instance of
-//! the tile loop runs: without passes the recorder does nothing, so a
-//! render without passes costs what it did before passes.
+//! Passes (AOVs, `crate::integrator::aov`) are summed in the same loop,
+//! exactly and order-free like the beauty (`crate::integrator::aov::pixels`),
+//! into sums that persist across passes, are kept at a signal, saved in
+//! parts and merged: everything said above of the beauty holds for them.
+//! Whether passes are computed is decided once per render, by which
+//! instance of the tile loop runs: without passes the recorder does
+//! nothing, so a render without passes costs what it did before passes.
 
 use std::ops::Range;
 use std::time::Instant;
@@ -42,7 +42,7 @@ use crate::film::passes::PassSet;
 use crate::film::region::Region;
 use crate::film::Film;
 use crate::geometry::Vec3;
-use crate::integrator::aov::pixels::{assemble, Layout};
+use crate::integrator::aov::pixels::{self, AovSums, Layout, Passes};
 use crate::integrator::aov::{NoAov, PixelPasses, Setup, TilePasses};
 use crate::integrator::path::Scratch;
 use crate::integrator::{Clock, Context, Counters, IntegratorKind, NoClock, Stopwatch};
@@ -137,6 +137,8 @@ pub struct Job {
     /// how much work a signal may drop, and how often a checkpoint can be
     /// written.
     pub pass_seconds: f64,
+    /// The passes (AOVs) summed besides the beauty.
+    pub passes: PassSet,
 }
 
 impl Job {
@@ -146,13 +148,15 @@ impl Job {
             region: Region::full(scene.camera.width, scene.camera.height),
             samples: 0..spp,
             pass_seconds: 2.0,
+            passes: PassSet::EMPTY,
         }
     }
 }
 
 /// The exact per-pixel sums of a region's samples `start..done`: beauty
 /// RGB, [`Accumulated::CHANNELS`] values a pixel in the format
-/// [`Accumulated::FORMAT`], stored tile by tile.
+/// [`Accumulated::FORMAT`], stored tile by tile, and the passes' sums in
+/// the same pixel order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Accumulated {
     pub region: Region,
@@ -163,6 +167,8 @@ pub struct Accumulated {
     /// Tallies of the summed samples.
     pub counters: Counters,
     sums: Vec<i128>,
+    /// The passes, when any is summed.
+    pub passes: Option<Passes>,
 }
 
 impl Accumulated {
@@ -174,6 +180,15 @@ impl Accumulated {
     /// Zero sums over `region`, no sample yet (from `start`); fails with a
     /// runtime error, not an abort, when the memory is not there.
     pub fn new(region: Region, start: u32) -> Result<Accumulated, Error> {
+        Self::with_passes(region, start, None)
+    }
+
+    /// [`new`](Self::new), with zero sums for the passes of `layout` too.
+    pub fn with_passes(
+        region: Region,
+        start: u32,
+        layout: Option<&Layout>,
+    ) -> Result<Accumulated, Error> {
         let n = region.area() as usize * Self::CHANNELS;
         let mut sums = Vec::new();
         sums.try_reserve_exact(n).map_err(|_| {
@@ -193,6 +208,13 @@ impl Accumulated {
             done: start,
             counters: Counters::default(),
             sums,
+            passes: match layout {
+                Some(l) => Some(Passes {
+                    layout: l.clone(),
+                    sums: AovSums::new(l, region.area() as usize)?,
+                }),
+                None => None,
+            },
         })
     }
 
@@ -201,9 +223,10 @@ impl Accumulated {
         self.done - self.start
     }
 
-    /// Where pixel (x, y)'s sums start in `sums` (tile-major layout: the
-    /// tiles of [`tiles`] in order, each row-major).
-    fn offset(&self, x: u32, y: u32) -> usize {
+    /// Pixel (x, y)'s index in the sums (tile-major layout: the tiles of
+    /// `tiles` in order, each row-major); its beauty sums start at
+    /// index · [`CHANNELS`](Self::CHANNELS).
+    pub fn index(&self, x: u32, y: u32) -> usize {
         let r = &self.region;
         let (lx, ly) = (x - r.x0, y - r.y0);
         let (tx, ty) = (lx / TILE * TILE, ly / TILE * TILE);
@@ -212,18 +235,28 @@ impl Accumulated {
         let th = TILE.min(r.height() - ty) as usize;
         let left = tx as usize * th;
         let tw = TILE.min(r.width() - tx) as usize;
-        (above + left + (ly - ty) as usize * tw + (lx - tx) as usize) * Self::CHANNELS
+        above + left + (ly - ty) as usize * tw + (lx - tx) as usize
     }
 
     /// Pixel (x, y)'s sums (frame coordinates, inside the region).
     pub fn pixel(&self, x: u32, y: u32) -> &[i128] {
-        let o = self.offset(x, y);
+        let o = self.index(x, y) * Self::CHANNELS;
         &self.sums[o..o + Self::CHANNELS]
+    }
+
+    /// The beauty sums of the pixel of index `i` ([`index`](Self::index)).
+    pub fn pixel_at(&self, i: usize) -> &[i128] {
+        &self.sums[i * Self::CHANNELS..(i + 1) * Self::CHANNELS]
+    }
+
+    /// [`pixel_at`](Self::pixel_at), to set.
+    pub fn pixel_at_mut(&mut self, i: usize) -> &mut [i128] {
+        &mut self.sums[i * Self::CHANNELS..(i + 1) * Self::CHANNELS]
     }
 
     /// Pixel (x, y)'s sums, to set (merging, reading a part back).
     pub fn pixel_mut(&mut self, x: u32, y: u32) -> &mut [i128] {
-        let o = self.offset(x, y);
+        let o = self.index(x, y) * Self::CHANNELS;
         &mut self.sums[o..o + Self::CHANNELS]
     }
 
@@ -241,6 +274,26 @@ impl Accumulated {
             }
         }
         Ok(film)
+    }
+
+    /// The region's passes (layers in output order, and ID coverage) from
+    /// their sums and the [`count`](Self::count): none without passes.
+    pub fn layers(&self) -> Result<(Vec<Layer>, Vec<Coverage>), Error> {
+        let Some(p) = &self.passes else {
+            return Ok((Vec::new(), Vec::new()));
+        };
+        let r = self.region;
+        pixels::layers(
+            &p.layout,
+            &p.sums,
+            r.width(),
+            r.height(),
+            self.count() as u64,
+            |x, y| {
+                let (x, y) = (x + r.x0, y + r.y0);
+                (self.index(x, y), self.pixel(x, y))
+            },
+        )
     }
 }
 
@@ -341,8 +394,16 @@ pub fn render_job(
             job.region, frame.x1, frame.y1, job.samples.start, job.samples.end
         )));
     }
+    let ctx = Context::new(scene, accel);
+    let setup = (!job.passes.is_empty()).then(|| Setup::new(scene, &ctx.lights, job.passes));
+    let layout = setup.as_ref().map(Layout::of);
     let mut sums = match resume {
         Some(a) => {
+            if a.passes.as_ref().map(|p| &p.layout) != layout.as_ref() {
+                return Err(Error::Input(
+                    "cannot resume: the saved sums hold other passes than the job's".into(),
+                ));
+            }
             if a.region != job.region || a.start != job.samples.start || a.done > job.samples.end {
                 return Err(Error::Input(format!(
                     "cannot resume: the saved sums cover region {} samples {}..{}, the job \
@@ -352,16 +413,16 @@ pub fn render_job(
             }
             a
         }
-        None => Accumulated::new(job.region, job.samples.start)?,
+        None => Accumulated::with_passes(job.region, job.samples.start, layout.as_ref())?,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads.unwrap_or(0))
         .build()
         .map_err(|e| Error::Runtime(format!("cannot start worker threads: {e}")))?;
     let threads = pool.current_num_threads();
-    let ctx = Context::new(scene, accel);
     let tiles = tiles(&job.region);
-    let mut next = Accumulated::new(job.region, job.samples.start)?;
+    let areas: Vec<usize> = tiles.iter().map(|t| t.area() as usize).collect();
+    let mut next = Accumulated::with_passes(job.region, job.samples.start, layout.as_ref())?;
     let first = sums.done;
 
     let total = job.region.area() * (job.samples.end - first) as u64;
@@ -379,9 +440,9 @@ pub fn render_job(
 
     let start = Instant::now();
     let mut interrupted = None;
-    let mut pass = 1u32;
+    let mut size = 1u32;
     while sums.done < job.samples.end {
-        let s = sums.done..sums.done + pass.min(job.samples.end - sums.done);
+        let s = sums.done..sums.done + size.min(job.samples.end - sums.done);
         let pass_start = Instant::now();
         // each tile reads its previous sums and writes previous + pass
         let mut chunks = Vec::with_capacity(tiles.len());
@@ -393,34 +454,40 @@ pub fn render_job(
             chunks.push((t, a, c));
             (prev, rest) = (b, d);
         }
-        let counters: Vec<Counters> = pool.install(|| {
-            chunks
-                .into_par_iter()
-                .map(|(t, prev, out)| {
-                    // the timed instance only with --stats (integrator::effects)
-                    let c = if opts.stats {
-                        render_tile::<Stopwatch>(&ctx, opts.integrator, t, s.clone(), prev, out)
-                    } else {
-                        render_tile::<NoClock>(&ctx, opts.integrator, t, s.clone(), prev, out)
-                    };
-                    bar.inc(t.area() * s.len() as u64);
-                    c
-                })
-                .collect()
-        });
+        let pass = Pass {
+            ctx: &ctx,
+            integrator: opts.integrator,
+            samples: s.clone(),
+            pool: &pool,
+            bar: &bar,
+            stats: opts.stats,
+        };
+        let counters = match (&setup, &layout, &sums.passes, &mut next.passes) {
+            (Some(setup), Some(layout), Some(p), Some(q)) => {
+                let views = p.sums.views(layout, &areas);
+                let outs = q.sums.views_mut(layout, &areas);
+                let with = views
+                    .into_iter()
+                    .zip(outs)
+                    .map(|(v, o)| TilePasses::new(setup, layout, v, o));
+                pass.run(chunks.into_iter().zip(with).collect())
+            }
+            _ => pass.run(chunks.into_iter().map(|c| (c, NoAov)).collect()),
+        };
         // stopped by a signal: this pass is incomplete, drop it
         if let Some(sig) = interrupt::requested() {
             interrupted = Some(sig);
             break;
         }
         std::mem::swap(&mut sums.sums, &mut next.sums);
+        std::mem::swap(&mut sums.passes, &mut next.passes);
         sums.done = s.end;
         for c in counters {
             sums.counters += c;
         }
         after_pass(&sums)?;
         let per_sample = pass_start.elapsed().as_secs_f64() / s.len() as f64;
-        pass = (job.pass_seconds / per_sample.max(1e-9)).clamp(1.0, u32::MAX as f64) as u32;
+        size = (job.pass_seconds / per_sample.max(1e-9)).clamp(1.0, u32::MAX as f64) as u32;
     }
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
@@ -437,18 +504,57 @@ pub fn render_job(
     })
 }
 
+/// One pass over the tiles: what every tile of it needs.
+struct Pass<'a> {
+    ctx: &'a Context<'a>,
+    integrator: IntegratorKind,
+    samples: Range<u32>,
+    pool: &'a rayon::ThreadPool,
+    bar: &'a ProgressBar,
+    /// Time the effects (`--stats`): the timed instance of the tile loop.
+    stats: bool,
+}
+
+/// A tile, its previous sums and where its new ones go.
+type Chunk<'a> = (&'a Region, &'a [i128], &'a mut [i128]);
+
+impl Pass<'_> {
+    /// Renders every tile with its passes' recorder; the tiles' counters.
+    fn run<P: PixelPasses>(&self, tiles: Vec<(Chunk, P)>) -> Vec<Counters> {
+        self.pool.install(|| {
+            tiles
+                .into_par_iter()
+                .map(|((t, prev, out), passes)| {
+                    let (ctx, i, s) = (self.ctx, self.integrator, self.samples.clone());
+                    // the timed instance only with --stats (integrator::effects)
+                    let c = if self.stats {
+                        render_tile::<_, Stopwatch>(ctx, i, t, s, prev, out, passes)
+                    } else {
+                        render_tile::<_, NoClock>(ctx, i, t, s, prev, out, passes)
+                    };
+                    self.bar.inc(t.area() * self.samples.len() as u64);
+                    c
+                })
+                .collect()
+        })
+    }
+}
+
 // Kept out of line so profiles (scripts/profile.sh) can name the tile loop.
 /// Adds the samples `samples` of every pixel of `tile` to its sums `prev`
-/// (the tile's pixels row by row), writing the result to `out`. Stops at
-/// the next pixel once a signal came (the pass is then dropped).
+/// (the tile's pixels row by row), writing the result to `out`, and to the
+/// sums of its `passes` (with [`NoAov`]: none, and this instance is the
+/// loop without passes). Stops at the next pixel once a signal came (the
+/// pass is then dropped).
 #[inline(never)]
-fn render_tile<T: Clock>(
+fn render_tile<P: PixelPasses, T: Clock>(
     ctx: &Context,
     integrator: IntegratorKind,
     tile: &Region,
     samples: Range<u32>,
     prev: &[i128],
     out: &mut [i128],
+    mut passes: P,
 ) -> Counters {
     const C: usize = Accumulated::CHANNELS;
     let scene = ctx.scene;
@@ -467,13 +573,15 @@ fn render_tile<T: Clock>(
             }
             let pixel = y as u64 * w as u64 + x as u64;
             let pixel_key = Rng::pixel_key(seed_key, pixel);
-            let mut sum: [i128; C] = prev[i..i + C].try_into().unwrap();
+            let mut sum: [i128; C] = prev[i * C..(i + 1) * C].try_into().unwrap();
+            passes.begin_pixel(i);
             for s in samples.clone() {
                 // = SampleRng::new(seed, pixel, s), hashing the seed and
                 // pixel once
                 let mut rng = SampleRng::for_sample(pixel_key, s as u64);
                 let [jx, jy] = rng.uniform2_packed();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
+                let rec = passes.begin_sample();
                 let t0 = T::now();
                 let l = integrator.radiance::<_, T>(
                     ctx,
@@ -481,17 +589,20 @@ fn render_tile<T: Clock>(
                     &mut rng,
                     &mut scratch,
                     &mut counters,
-                    &mut NoAov,
+                    rec,
                 );
                 T::lap_sample(&mut counters, t0);
-                if l.is_finite() {
+                let finite = l.is_finite();
+                if finite {
                     counters.clamped += Accumulated::FORMAT.add(&mut sum, &[l.x, l.y, l.z]) as u64;
                 } else {
                     counters.nonfinite += 1;
                 }
+                passes.end_sample(s, l, finite);
             }
-            out[i..i + C].copy_from_slice(&sum);
-            i += C;
+            out[i * C..(i + 1) * C].copy_from_slice(&sum);
+            passes.end_pixel(i);
+            i += 1;
         }
     }
     counters.camera_rays((i / C) as u64 * samples.len() as u64);
@@ -516,213 +627,20 @@ pub fn render_passes(
     opts: &RenderOptions,
     passes: PassSet,
 ) -> Result<RenderOutput, Error> {
-    if passes.is_empty() {
-        let (film, stats) = render(scene, accel, opts)?;
-        return Ok(RenderOutput {
-            film,
-            layers: Vec::new(),
-            coverage: Vec::new(),
-            stats,
-        });
+    let spp = opts.spp.unwrap_or(scene.settings.spp);
+    let job = Job {
+        passes,
+        ..Job::full(scene, spp)
+    };
+    let r = render_job(scene, accel, opts, &job, None, &mut |_| Ok(()))?;
+    if let Some(sig) = r.interrupted {
+        return Err(Error::Interrupted(sig));
     }
-    let scene = with_overrides(scene, opts);
-    let scene = scene.as_ref();
-    if let Some(n) = opts.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
-        return Err(Error::Argument {
-            argument: "--threads".into(),
-            problem: format!("{n} is not a thread count (1 to {MAX_THREADS})"),
-        });
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| Error::Runtime(format!("cannot start worker threads: {e}")))?;
-    let threads = pool.current_num_threads();
-    let ctx = Context::new(scene, accel);
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
-        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
-        .collect();
-
-    let bar = if opts.progress {
-        let b =
-            ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::stderr());
-        b.set_style(
-            ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:40}] {pos}/{len} tiles, eta {eta}",
-            )
-            .unwrap()
-            .progress_chars("=> "),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
-    };
-
-    let run = Run {
-        ctx: &ctx,
-        integrator: opts.integrator,
-        tiles: &tiles,
-        pool: &pool,
-        bar: &bar,
-        stats: opts.stats,
-    };
-    let setup = Setup::new(scene, &ctx.lights, passes);
-    let layout = Layout::new(&setup);
-    let done = run.tiles(|pixels| TilePasses::new(&setup, &layout, pixels))?;
-    let tile_width = |x0: u32| TILE.min(w - x0);
-    let parts = tiles
-        .iter()
-        .zip(&done.passes)
-        .map(|(&(x0, y0), t)| ((x0, y0), tile_width(x0), t));
-    let (layers, coverage) = assemble(&setup, &layout, w, h, parts)?;
-    let stats = RenderStats {
-        seconds: done.seconds,
-        samples: w as u64 * h as u64 * scene.settings.spp as u64,
-        threads,
-        counters: done.counters,
-    };
+    let (layers, coverage) = r.sums.layers()?;
     Ok(RenderOutput {
-        film: done.film,
+        film: r.sums.film()?,
         layers,
         coverage,
-        stats,
+        stats: r.stats,
     })
-}
-
-/// The rendered tiles: the film, the summed counters, the seconds the tiles
-/// took, and each tile's passes in tile order.
-struct Tiles<T> {
-    film: Film,
-    counters: Counters,
-    seconds: f64,
-    passes: Vec<T>,
-}
-
-/// What rendering the tiles needs.
-struct Run<'a> {
-    ctx: &'a Context<'a>,
-    integrator: IntegratorKind,
-    tiles: &'a [(u32, u32)],
-    pool: &'a rayon::ThreadPool,
-    bar: &'a ProgressBar,
-    /// Time the effects (`--stats`).
-    stats: bool,
-}
-
-impl Run<'_> {
-    /// Renders every tile with the passes `passes(pixels)` makes for it.
-    fn tiles<P: PixelPasses>(
-        &self,
-        passes: impl Fn(usize) -> P + Sync,
-    ) -> Result<Tiles<P::Tile>, Error> {
-        let ctx = self.ctx;
-        let start = Instant::now();
-        let (w, h) = (ctx.scene.camera.width, ctx.scene.camera.height);
-        let results: Vec<(Vec<Vec3>, Counters, P::Tile)> = self.pool.install(|| {
-            self.tiles
-                .par_iter()
-                .map(|&(x0, y0)| {
-                    let pixels = (TILE.min(w - x0) * TILE.min(h - y0)) as usize;
-                    let (i, p) = (self.integrator, passes(pixels));
-                    let r = if self.stats {
-                        render_tile_passes::<_, Stopwatch>(ctx, i, x0, y0, p)
-                    } else {
-                        render_tile_passes::<_, NoClock>(ctx, i, x0, y0, p)
-                    };
-                    self.bar.inc(1);
-                    r
-                })
-                .collect()
-        });
-        let seconds = start.elapsed().as_secs_f64();
-        self.bar.finish_and_clear();
-        // stopped by a signal: the tiles after it are incomplete
-        if let Some(sig) = interrupt::requested() {
-            return Err(Error::Interrupted(sig));
-        }
-
-        let mut film = Film::try_new(w, h)?;
-        let mut counters = Counters::default();
-        let mut out = Vec::with_capacity(results.len());
-        for (&(x0, y0), (pixels, c, t)) in self.tiles.iter().zip(results) {
-            counters += c;
-            let tw = TILE.min(w - x0);
-            for (i, p) in pixels.into_iter().enumerate() {
-                film.set(x0 + i as u32 % tw, y0 + i as u32 / tw, p);
-            }
-            out.push(t);
-        }
-        Ok(Tiles {
-            film,
-            counters,
-            seconds,
-            passes: out,
-        })
-    }
-}
-
-/// The tile loop of [`render_passes`]: every sample of every pixel of the
-/// tile at (x0, y0), recorded by `passes`.
-#[inline(never)]
-fn render_tile_passes<P: PixelPasses, T: Clock>(
-    ctx: &Context,
-    integrator: IntegratorKind,
-    x0: u32,
-    y0: u32,
-    mut passes: P,
-) -> (Vec<Vec3>, Counters, P::Tile) {
-    let scene = ctx.scene;
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
-    let spp = scene.settings.spp;
-    let mut counters = Counters::default();
-    let mut scratch = Scratch::default();
-    let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-    let seed_key = Rng::seed_key(scene.settings.seed);
-    for y in y0..y1 {
-        for x in x0..x1 {
-            // a signal stops the render between pixels (see crate::interrupt);
-            // the tile is then incomplete and the render discarded
-            if interrupt::requested().is_some() {
-                counters.camera_rays(out.len() as u64 * spp as u64);
-                return (out, counters, passes.finish());
-            }
-            let pixel = y as u64 * w as u64 + x as u64;
-            let pixel_key = Rng::pixel_key(seed_key, pixel);
-            let mut sum = [0i128; Accumulated::CHANNELS];
-            for s in 0..spp {
-                // = SampleRng::new(seed, pixel, s), hashing the seed and
-                // pixel once
-                let mut rng = SampleRng::for_sample(pixel_key, s as u64);
-                let [jx, jy] = rng.uniform2_packed();
-                let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                let rec = passes.begin_sample();
-                let t0 = T::now();
-                let l = integrator.radiance::<_, T>(
-                    ctx,
-                    ray,
-                    &mut rng,
-                    &mut scratch,
-                    &mut counters,
-                    rec,
-                );
-                T::lap_sample(&mut counters, t0);
-                let finite = l.is_finite();
-                if finite {
-                    counters.clamped += Accumulated::FORMAT.add(&mut sum, &[l.x, l.y, l.z]) as u64;
-                } else {
-                    counters.nonfinite += 1;
-                }
-                passes.end_sample(l, finite);
-            }
-            passes.end_pixel();
-            // the mean as Accumulated::film takes it: the same beauty as
-            // render's, bit for bit
-            let m = |c: usize| Accumulated::FORMAT.mean(sum[c], spp as u64);
-            out.push(Vec3::new(m(0), m(1), m(2)));
-        }
-    }
-    counters.camera_rays(out.len() as u64 * spp as u64);
-    (out, counters, passes.finish())
 }

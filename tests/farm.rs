@@ -14,7 +14,10 @@ use std::process::{Command, Output};
 
 use lucent::accel;
 use lucent::farm::part::{self, Header, Identity};
+use lucent::film::layers::{Coverage, Layer};
+use lucent::film::passes::PassSet;
 use lucent::film::region::Region;
+use lucent::integrator::aov::{self, Layout};
 use lucent::render::{self, Job, RenderOptions};
 use lucent::scene::Scene;
 
@@ -41,8 +44,11 @@ impl Rand {
     }
 }
 
-fn identity(scene: &Scene, spp: u32) -> Identity {
+fn identity(scene: &Scene, spp: u32, layout: Option<&Layout>) -> Identity {
     Identity {
+        passes: part::passes_text(layout),
+        names: part::names_text(layout),
+        output: part::output_text(&Default::default()),
         version: "test".into(),
         scene_hash: "0".into(),
         seed: scene.settings.seed,
@@ -59,6 +65,7 @@ fn render_part(
     spp: u32,
     region: Region,
     samples: Range<u32>,
+    passes: PassSet,
     path: &Path,
 ) {
     let opts = RenderOptions {
@@ -71,16 +78,18 @@ fn render_part(
         samples: samples.clone(),
         // passes of one sample: the pass boundaries fall everywhere
         pass_seconds: 0.0,
+        passes,
     };
+    let layout = (!passes.is_empty()).then(|| aov::layout(scene, passes));
     let r = render::render_job(scene, accel, &opts, &job, None, &mut |_| Ok(())).unwrap();
     assert_eq!((r.sums.start, r.sums.done), (samples.start, samples.end));
     let header = Header {
-        identity: identity(scene, spp),
+        identity: identity(scene, spp, layout.as_ref()),
         scene: "marble-ball.toml".into(),
         region,
         samples: samples.clone(),
         requested: samples,
-        layers: vec![part::beauty_layer()],
+        layers: part::layers_of(layout.as_ref()),
         counters: r.sums.counters,
     };
     lucent::film::commit_all(vec![part::stage(path, &header, &r.sums).unwrap()]).unwrap();
@@ -90,6 +99,34 @@ fn bits(f: &lucent::film::Film) -> Vec<u32> {
     f.pixels
         .iter()
         .flat_map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+        .collect()
+}
+
+/// Every layer's name, channels and value bits.
+fn layer_bits(layers: &[Layer]) -> Vec<(String, Vec<String>, Vec<u32>)> {
+    layers
+        .iter()
+        .map(|l| {
+            let v = l.values.iter().map(|x| x.to_bits()).collect();
+            (l.name.clone(), l.channels.clone(), v)
+        })
+        .collect()
+}
+
+/// A coverage's kind, names, and per pixel (ID, fraction bits).
+type CoverageBits = (String, Vec<String>, Vec<Vec<(u32, u32)>>);
+
+/// Every coverage list, fractions as bits.
+fn coverage_bits(cov: &[Coverage]) -> Vec<CoverageBits> {
+    cov.iter()
+        .map(|c| {
+            let px = c
+                .pixels
+                .iter()
+                .map(|p| p.iter().map(|&(i, f)| (i, f.to_bits())).collect())
+                .collect();
+            (c.kind.clone(), c.names.clone(), px)
+        })
         .collect()
 }
 
@@ -106,39 +143,71 @@ fn merged_parts_are_bitwise_the_uncut_render_for_random_splits() {
             spp: Some(spp),
             ..RenderOptions::default()
         };
-        let (uncut, _) = render::render(&scene, accel.as_ref(), &opts).unwrap();
-        // the merge would be vacuous over a black image
-        assert!(uncut.pixels.iter().filter(|p| p.x > 0.0).count() > (w * h / 2) as usize);
-        for kind in ["tiles", "samples", "both"] {
-            let (xs, ys, ss) = match kind {
-                "tiles" => (rand.cuts(w, 3), rand.cuts(h, 2), vec![0, spp]),
-                "samples" => (vec![0, w], vec![0, h], rand.cuts(spp, 3)),
-                _ => (rand.cuts(w, 2), rand.cuts(h, 1), rand.cuts(spp, 2)),
-            };
-            let mut parts = Vec::new();
-            for y in ys.windows(2) {
-                for x in xs.windows(2) {
-                    for s in ss.windows(2) {
-                        let region = Region {
-                            x0: x[0],
-                            y0: y[0],
-                            x1: x[1],
-                            y1: y[1],
-                        };
-                        let p = dir.path().join(format!("{kind}-{}.exr", parts.len()));
-                        render_part(&scene, accel.as_ref(), spp, region, s[0]..s[1], &p);
-                        parts.push(p);
+        let (plain, _) = render::render(&scene, accel.as_ref(), &opts).unwrap();
+        for passes in [PassSet::EMPTY, PassSet::all()] {
+            let uncut = render::render_passes(&scene, accel.as_ref(), &opts, passes).unwrap();
+            // passes leave the beauty as it is without them
+            assert!(bits(&uncut.film) == bits(&plain));
+            // the merge would be vacuous over a black image, or passes
+            // without contents
+            assert!(uncut.film.pixels.iter().filter(|p| p.x > 0.0).count() > (w * h / 2) as usize);
+            if !passes.is_empty() {
+                let l = |n: &str| uncut.layers.iter().find(|l| l.name == n).unwrap();
+                assert!(l("sss_direct").values.iter().any(|v| *v > 0.0));
+                for name in ["diffuse_direct", "albedo", "N", "Z", "variance"] {
+                    let distinct: std::collections::BTreeSet<u32> =
+                        l(name).values.iter().map(|v| v.to_bits()).collect();
+                    assert!(distinct.len() > 10, "{name}");
+                }
+                // pixels seen by two objects (edges): coverage fractions to rank
+                assert!(uncut.coverage[0].pixels.iter().any(|p| p.len() >= 2));
+            }
+            for kind in ["tiles", "samples", "both"] {
+                let (xs, ys, ss) = match kind {
+                    "tiles" => (rand.cuts(w, 3), rand.cuts(h, 2), vec![0, spp]),
+                    "samples" => (vec![0, w], vec![0, h], rand.cuts(spp, 3)),
+                    _ => (rand.cuts(w, 2), rand.cuts(h, 1), rand.cuts(spp, 2)),
+                };
+                let mut parts = Vec::new();
+                for y in ys.windows(2) {
+                    for x in xs.windows(2) {
+                        for s in ss.windows(2) {
+                            let region = Region {
+                                x0: x[0],
+                                y0: y[0],
+                                x1: x[1],
+                                y1: y[1],
+                            };
+                            let p = dir.path().join(format!("{kind}-{}.exr", parts.len()));
+                            render_part(
+                                &scene,
+                                accel.as_ref(),
+                                spp,
+                                region,
+                                s[0]..s[1],
+                                passes,
+                                &p,
+                            );
+                            parts.push(p);
+                        }
                     }
                 }
+                // in any order
+                parts.reverse();
+                let merged = lucent::farm::merge::merge(&parts).unwrap();
+                let what = format!("{backend:?} {kind}: x {xs:?} y {ys:?} samples {ss:?}");
+                assert!(bits(&merged.film) == bits(&uncut.film), "{what}");
+                assert_eq!(merged.film.width, w);
+                assert_eq!(merged.layers.len(), uncut.layers.len(), "{what}");
+                assert!(
+                    layer_bits(&merged.layers) == layer_bits(&uncut.layers),
+                    "{what}"
+                );
+                assert!(
+                    coverage_bits(&merged.coverage) == coverage_bits(&uncut.coverage),
+                    "{what}"
+                );
             }
-            // in any order
-            parts.reverse();
-            let merged = lucent::farm::merge::merge(&parts).unwrap();
-            assert!(
-                bits(&merged.film) == bits(&uncut),
-                "{backend:?} {kind}: x {xs:?} y {ys:?} samples {ss:?}"
-            );
-            assert_eq!(merged.film.width, w);
         }
     }
 }
@@ -242,30 +311,170 @@ fn refused(d: &Path, args: &[&str]) -> String {
     e
 }
 
-/// Passes are not carried by parts yet: asking for both is refused, naming
-/// the splitting option, rather than writing a part without the passes.
+/// Every channel of every layer (of every file, for split passes) of the
+/// EXR at `path`: name and value bits.
+fn exr_channels(path: &Path) -> Vec<(String, Vec<u32>)> {
+    use exr::prelude::*;
+    let image = read_all_flat_layers_from_file(path).unwrap();
+    let mut v = Vec::new();
+    for layer in &image.layer_data {
+        let prefix = layer
+            .attributes
+            .layer_name
+            .as_ref()
+            .map(|n| format!("{n}."))
+            .unwrap_or_default();
+        for ch in &layer.channel_data.list {
+            let bits = match &ch.sample_data {
+                FlatSamples::F32(x) => x.iter().map(|f| f.to_bits()).collect(),
+                FlatSamples::F16(x) => x.iter().map(|f| f.to_bits() as u32).collect(),
+                FlatSamples::U32(x) => x.clone(),
+            };
+            v.push((format!("{prefix}{}", ch.name), bits));
+        }
+    }
+    v.sort();
+    v
+}
+
+/// Passes ride in parts: `--aov all` rendered as bands and as
+/// crops × sample ranges in separate processes merges to every channel of
+/// every layer of the uncut render (light paths, groups, data, IDs,
+/// Cryptomatte, variance), and the same PNG; with file options from the
+/// parts (half precision, split files).
 #[test]
-fn passes_with_a_split_are_refused() {
+fn passes_split_and_merge_to_the_uncut_file() {
     let dir = scene_dir();
     let d = dir.path();
-    for (split, name) in [
-        (&["--tile", "0/2"][..], "--tile"),
-        (&["--samples", "0..1"][..], "--samples"),
-        (&["--checkpoint", "5"][..], "--checkpoint"),
+    for (opts, files) in [
+        (&[][..], &[""][..]),
+        (
+            &["--aov-precision", "half", "--aov-split"][..],
+            &["", ".sss_direct", ".Z", ".CryptoObject", ".variance"][..],
+        ),
     ] {
+        let mut base = vec![
+            "render",
+            "scene.toml",
+            "--quiet",
+            "--spp",
+            "5",
+            "--threads",
+            "2",
+            "--aov",
+            "all",
+        ];
+        base.extend_from_slice(opts);
+        let run = |extra: &[&str]| {
+            let mut a = base.clone();
+            a.extend_from_slice(extra);
+            let o = lucent(d, &a);
+            assert!(
+                o.status.success(),
+                "{a:?}: {}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+        };
+        run(&["-o", "uncut.exr"]);
+        run(&["--tile", "0/2", "-o", "band0.exr"]);
+        run(&["--tile", "1/2", "-o", "band1.exr"]);
+        run(&["--crop", "0,0,10,16", "--samples", "0..2", "-o", "c0.exr"]);
+        run(&["--crop", "0,0,10,16", "--samples", "2..5", "-o", "c1.exr"]);
+        run(&["--crop", "10,0,24,16", "--samples", "0..3", "-o", "c2.exr"]);
+        run(&["--crop", "10,0,24,16", "--samples", "3..5", "-o", "c3.exr"]);
+        for (parts, out) in [
+            (vec!["band1.exr", "band0.exr"], "bands.exr"),
+            (vec!["c3.exr", "c1.exr", "c2.exr", "c0.exr"], "crops.exr"),
+        ] {
+            let mut a = vec!["merge", "--quiet", "-o", out];
+            a.extend_from_slice(&parts);
+            let o = lucent(d, &a);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            for f in files {
+                let path = |p: &str| d.join(p.replace(".exr", &format!("{f}.exr")));
+                let (merged, uncut) = (exr_channels(&path(out)), exr_channels(&path("uncut.exr")));
+                // not vacuous: channels that vary over the image (the
+                // beauty, the passes, Cryptomatte's ranks)
+                let lively = uncut
+                    .iter()
+                    .filter(|c| c.1.iter().collect::<std::collections::BTreeSet<_>>().len() > 2)
+                    .count();
+                let one_file = f.is_empty() && opts.is_empty();
+                assert!(
+                    lively >= if one_file { 30 } else { 1 },
+                    "{out}{f}: {lively}"
+                );
+                assert_eq!(
+                    merged.iter().map(|c| &c.0).collect::<Vec<_>>(),
+                    uncut.iter().map(|c| &c.0).collect::<Vec<_>>(),
+                    "{out}{f}"
+                );
+                for (m, u) in merged.iter().zip(&uncut) {
+                    assert!(m == u, "{out}{f}: channel {} differs", m.0);
+                }
+            }
+            let png = |p: &str| fs::read(d.join(p).with_extension("png")).unwrap();
+            assert!(png(out) == png("uncut.exr"));
+        }
+    }
+}
+
+/// Parts whose passes differ, or one without passes, or with other file
+/// options, do not merge: exit 2, naming the file, the field and the
+/// problem, nothing written.
+#[test]
+fn parts_with_other_passes_are_refused() {
+    let dir = scene_dir();
+    let d = dir.path();
+    let part = |extra: &[&str], out: &str| {
         let mut a = vec![
             "render",
             "scene.toml",
             "--quiet",
-            "--aov",
-            "Z",
-            "-o",
-            "p.exr",
+            "--spp",
+            "2",
+            "--threads",
+            "1",
         ];
-        a.extend_from_slice(split);
-        let e = refused(d, &a);
-        assert!(e.contains(name) && e.contains("passes"), "{e}");
+        a.extend_from_slice(extra);
+        a.extend_from_slice(&["-o", out]);
+        let o = lucent(d, &a);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    part(&["--tile", "0/2", "--aov", "all"], "a.exr");
+    part(&["--tile", "1/2", "--aov", "all"], "b.exr");
+    part(&["--tile", "1/2", "--aov", "Z"], "z.exr");
+    part(&["--tile", "1/2"], "none.exr");
+    part(
+        &["--tile", "1/2", "--aov", "all", "--exr-compression", "piz"],
+        "piz.exr",
+    );
+    let o = lucent(d, &["merge", "-o", "good.exr", "a.exr", "b.exr", "--quiet"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for (other, field, problem) in [
+        ("z.exr", "lucent.passes", "different passes"),
+        ("none.exr", "lucent.passes", "different passes"),
+        ("piz.exr", "lucent.output", "file options"),
+    ] {
+        let e = refused(d, &["merge", "-o", "out.exr", "a.exr", other]);
+        assert!(
+            e.contains(other) && e.contains(field) && e.contains(problem),
+            "{other}: {e}"
+        );
     }
+    // a part whose layer list does not match its passes (edited)
+    let bytes = fs::read(d.join("z.exr")).unwrap();
+    let key = b"lucent.passes\0string\0";
+    let at = key.len() + 4 + bytes.windows(key.len()).position(|w| w == key).unwrap();
+    assert_eq!(bytes[at], b'Z');
+    let mut forged = bytes.clone();
+    forged[at] = b'N';
+    fs::write(d.join("forged.exr"), &forged).unwrap();
+    let e = refused(d, &["merge", "-o", "out.exr", "forged.exr"]);
+    assert!(
+        e.contains("forged.exr") && e.contains("lucent.layers"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -8,13 +8,18 @@
 //! frame's (exactly: integer addition, in any order), and the frame is the
 //! sums divided by spp, the same [`crate::render::Accumulated::film`] a
 //! single-machine render ends with — so the merged frame is bitwise the
-//! uncut render.
+//! uncut render. The passes' sums merge the same way (integer sums added,
+//! nearest hits by their unique (Z, sample) minimum, ID coverage by adding
+//! sample counts), and their layers and Cryptomatte come from the merged
+//! sums by [`crate::render::Accumulated::layers`], as in the uncut render.
 
 use std::path::{Path, PathBuf};
 
 use super::cover::{self, CoverError, Piece};
 use super::part::{self, Header, Identity};
 use crate::error::{Error, InputError};
+use crate::film::exr_layers::OutputOptions;
+use crate::film::layers::{Coverage, Layer};
 use crate::film::region::Region;
 use crate::film::Film;
 use crate::render::Accumulated;
@@ -23,6 +28,12 @@ use crate::render::Accumulated;
 #[derive(Debug)]
 pub struct Merged {
     pub film: Film,
+    /// The passes, as the uncut render gives them.
+    pub layers: Vec<Layer>,
+    pub coverage: Vec<Coverage>,
+    /// How the frame is to be written (the parts' `lucent.output`; no
+    /// preview).
+    pub output: OutputOptions,
     pub identity: Identity,
     /// Summed over the parts.
     pub counters: crate::integrator::Counters,
@@ -47,12 +58,27 @@ pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
     };
     for (p, h) in &headers[1..] {
         if let Some((field, a, b)) = h.identity.difference(&first.identity) {
+            let what = match field {
+                "lucent.passes" => "the parts carry different passes",
+                "lucent.names" => "the parts' passes name different groups or IDs",
+                "lucent.output" => "the parts ask for different frame file options",
+                _ => "the parts are of different frames",
+            };
+            let show = |v: &str| {
+                if v.is_empty() {
+                    "none".to_string()
+                } else {
+                    format!("`{v}`")
+                }
+            };
             return Err(located(
                 p,
                 Some(field),
                 format!(
-                    "`{a}`, but {} has `{b}`: the parts are of different frames",
-                    first_path.display()
+                    "{}, but {} has {}: {what}",
+                    show(&a),
+                    first_path.display(),
+                    show(&b)
                 ),
             ));
         }
@@ -133,7 +159,16 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
         .collect::<Result<Vec<_>, Error>>()?;
     let identity = check(&headers)?;
     let frame = Region::full(identity.frame.0, identity.frame.1);
-    let mut sums = Accumulated::new(frame, 0)?;
+    let (first, _) = &headers[0];
+    let layout = part::layout_of(&identity).map_err(|(f, e)| located(first, Some(f), e))?;
+    let output = part::parse_output(&identity.output).ok_or_else(|| {
+        located(
+            first,
+            Some("lucent.output"),
+            format!("`{}` is not the frame's file options", identity.output),
+        )
+    })?;
+    let mut sums = Accumulated::with_passes(frame, 0, layout.as_ref())?;
     sums.done = identity.spp;
     for (path, header) in &headers {
         crate::interrupt::stop_if_requested()?;
@@ -146,21 +181,32 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
         for y in r.y0..r.y1 {
             for x in r.x0..r.x1 {
                 let from = part.pixel(x, y);
+                // a forged part could hold sums no render makes
+                let beyond = || {
+                    located(
+                        path,
+                        None,
+                        format!("pixel ({x}, {y}): sums beyond any render's range"),
+                    )
+                };
                 for (s, v) in sums.pixel_mut(x, y).iter_mut().zip(from) {
-                    // a forged part could hold sums no render makes
-                    *s = s.checked_add(*v).ok_or_else(|| {
-                        located(
-                            path,
-                            None,
-                            format!("pixel ({x}, {y}): sums beyond any render's range"),
-                        )
-                    })?;
+                    *s = s.checked_add(*v).ok_or_else(beyond)?;
+                }
+                let (i, j) = (sums.index(x, y), part.index(x, y));
+                if let (Some(to), Some(from)) = (&mut sums.passes, &part.passes) {
+                    to.sums
+                        .add_pixel(&to.layout, i, &from.sums, j)
+                        .ok_or_else(beyond)?;
                 }
             }
         }
     }
+    let (layers, coverage) = sums.layers()?;
     Ok(Merged {
         film: sums.film()?,
+        layers,
+        coverage,
+        output,
         identity,
         counters: sums.counters,
     })

@@ -4,11 +4,18 @@
 //! # Format (version [`FORMAT_VERSION`])
 //!
 //! One scan-line EXR (ZIP), its data window the part's region, its display
-//! window the whole frame. Each summed channel `C` of a layer `L` (beauty
-//! today: `beauty.R`, `beauty.G`, `beauty.B`) is stored as four `u32`
+//! window the whole frame. Each summed channel `C` of a layer `L` (the
+//! beauty's `beauty.R`, `beauty.G`, `beauty.B`, then the passes' summed
+//! layers, `crate::integrator::aov::pixels`) is stored as four `u32`
 //! channels `L.C.w0` … `L.C.w3`, the words of the pixel's `i128` sum, least
 //! significant first ([`crate::film::accumulate::to_words`]) — EXR's only
 //! integer sample type is u32, and floats could not hold the sums exactly.
+//! With P, Z or an ID pass, the nearest camera hit is stored as the u32
+//! channels `nearest.depth`, `nearest.sample`, `nearest.px`/`py`/`pz` (f32
+//! bits), `nearest.object`, `nearest.material` (index + 1, 0: none); with
+//! Cryptomatte, the sample counts per ID as `coverage.object.id{k}` (the
+//! index plus 1, 0: empty) and `coverage.object.n{k}` for k below the most
+//! IDs any pixel of the part saw (the same for `material`).
 //! Header attributes (text):
 //!
 //! | attribute | value |
@@ -26,10 +33,15 @@
 //! | `lucent.requested` | `A..E`: what the job was asked for (`B < E` after an interruption) |
 //! | `lucent.layers` | `L:C,C,…:F;…`: each layer's channels and fixed-point fraction bits |
 //! | `lucent.counters` | `rays,nonfinite,clamped,walks_capped,walks_escaped` |
+//! | `lucent.passes` | the passes, comma-separated (empty: none) |
+//! | `lucent.names` | JSON: the light groups, matted objects and materials the passes name |
+//! | `lucent.output` | how the frame is written: `precision=… compression=… split=… ranks=…` |
 //!
-//! A merge needs nothing else: any set of named layers merges the same way
-//! (add the integer sums, divide by spp once), so the AOV layers will ride
-//! along as more `lucent.layers` entries.
+//! A merge needs nothing else. The passes, names and output options are
+//! part of the [`Identity`]: the EXR options change no sum, but a merged
+//! frame is written as its parts say, so they must agree (and then equal
+//! the uncut render's file options); the PNG preview's tone map is the
+//! merge command's own.
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -37,13 +49,121 @@ use std::path::Path;
 
 use crate::error::{Error, InputError};
 use crate::film::accumulate::{from_words, to_words, FixedPoint};
+use crate::film::exr_layers::{ExrCompression, OutputOptions, Precision};
+use crate::film::passes::PassSet;
 use crate::film::region::Region;
 use crate::film::Staged;
+use crate::integrator::aov::pixels::{AovSums, Layout, Nearest};
 use crate::integrator::Counters;
 use crate::render::Accumulated;
 
+/// The passes of `layout` as `lucent.passes` says them (empty: none).
+pub fn passes_text(layout: Option<&Layout>) -> String {
+    layout.map_or(String::new(), |l| {
+        l.passes
+            .iter()
+            .map(|p| p.name())
+            .collect::<Vec<_>>()
+            .join(",")
+    })
+}
+
+/// The names `layout` uses, as `lucent.names` says them: JSON, non-ASCII
+/// characters escaped (EXR text is bytes).
+pub fn names_text(layout: Option<&Layout>) -> String {
+    let Some(l) = layout else {
+        return String::new();
+    };
+    let json = serde_json::json!({
+        "groups": l.groups,
+        "objects": l.object_names,
+        "materials": l.material_names,
+    })
+    .to_string();
+    let mut out = String::with_capacity(json.len());
+    for c in json.chars() {
+        if c.is_ascii() {
+            out.push(c);
+        } else {
+            for u in c.encode_utf16(&mut [0; 2]) {
+                out.push_str(&format!("\\u{u:04x}"));
+            }
+        }
+    }
+    out
+}
+
+/// The file options of a frame, as `lucent.output` says them.
+pub fn output_text(o: &OutputOptions) -> String {
+    format!(
+        "precision={} compression={} split={} ranks={}",
+        o.precision.name(),
+        o.compression.name(),
+        o.split,
+        o.cryptomatte_ranks
+    )
+}
+
+/// The inverse of [`output_text`] (no preview).
+pub fn parse_output(s: &str) -> Option<OutputOptions> {
+    let mut o = OutputOptions::default();
+    let mut seen = 0;
+    for kv in s.split(' ') {
+        let (k, v) = kv.split_once('=')?;
+        match k {
+            "precision" => o.precision = Precision::parse(v)?,
+            "compression" => o.compression = ExrCompression::parse(v)?,
+            "split" => o.split = v.parse().ok()?,
+            "ranks" => o.cryptomatte_ranks = v.parse().ok()?,
+            _ => return None,
+        }
+        seen += 1;
+    }
+    (seen == 4).then_some(o)
+}
+
+/// The layout a part's identity describes (None: no passes), or what is
+/// wrong with it (the attribute and the problem).
+pub fn layout_of(id: &Identity) -> Result<Option<Layout>, (&'static str, String)> {
+    if id.passes.is_empty() {
+        return Ok(None);
+    }
+    let passes = PassSet::parse_list(&id.passes).map_err(|e| ("lucent.passes", e.problem()))?;
+    let names: serde_json::Value = serde_json::from_str(&id.names)
+        .map_err(|e| ("lucent.names", format!("not the JSON of names: {e}")))?;
+    let list = |k: &str| -> Result<Vec<String>, (&'static str, String)> {
+        names
+            .get(k)
+            .and_then(|v| v.as_array())
+            .and_then(|a| a.iter().map(|s| s.as_str().map(String::from)).collect())
+            .ok_or(("lucent.names", format!("no list of names `{k}`")))
+    };
+    Ok(Some(Layout::new(
+        passes,
+        &list("groups")?,
+        &list("objects")?,
+        &list("materials")?,
+    )))
+}
+
+/// The layers a part of `layout`'s passes sums: the beauty, then the
+/// passes' summed layers.
+pub fn layers_of(layout: Option<&Layout>) -> Vec<LayerFormat> {
+    let mut v = vec![beauty_layer()];
+    if let Some(l) = layout {
+        v.extend(l.sum_layers().into_iter().map(|s| LayerFormat {
+            name: s.name,
+            channels: s.channels,
+            fixed: FixedPoint {
+                frac_bits: s.frac_bits,
+            },
+        }));
+    }
+    v
+}
+
 /// The part format this build writes and reads.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 /// What identifies the frame a part belongs to: parts merge only if all of
 /// it is equal.
@@ -59,6 +179,12 @@ pub struct Identity {
     pub options: String,
     /// The frame's width and height.
     pub frame: (u32, u32),
+    /// The passes ([`passes_text`]).
+    pub passes: String,
+    /// The names the passes use ([`names_text`]).
+    pub names: String,
+    /// The frame's file options ([`output_text`]).
+    pub output: String,
 }
 
 impl Identity {
@@ -77,6 +203,9 @@ impl Identity {
             ("lucent.spp", self.spp.to_string(), o.spp.to_string()),
             ("lucent.options", self.options.clone(), o.options.clone()),
             ("lucent.frame", f(&self.frame), f(&o.frame)),
+            ("lucent.passes", self.passes.clone(), o.passes.clone()),
+            ("lucent.names", self.names.clone(), o.names.clone()),
+            ("lucent.output", self.output.clone(), o.output.clone()),
         ]
         .into_iter()
         .find(|(_, a, b)| a != b)
@@ -136,27 +265,91 @@ pub fn stage(path: &Path, header: &Header, sums: &Accumulated) -> Result<Staged,
     use exr::prelude::*;
     let r = sums.region;
     let n = r.area() as usize;
-    let beauty = beauty_layer();
+    let layout = sums.passes.as_ref().map(|p| &p.layout);
     let mut channels = SmallVec::<[AnyChannel<FlatSamples>; 4]>::new();
-    for (c, ch) in beauty.channels.iter().enumerate() {
-        let mut words = [
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-        ];
-        for y in r.y0..r.y1 {
-            for x in r.x0..r.x1 {
-                for (k, w) in to_words(sums.pixel(x, y)[c]).into_iter().enumerate() {
+    // the region's pixels, row by row: their index in the sums
+    let order: Vec<usize> = (r.y0..r.y1)
+        .flat_map(|y| (r.x0..r.x1).map(move |x| (x, y)))
+        .map(|(x, y)| sums.index(x, y))
+        .collect();
+    let stride = layout.map_or(0, |l| l.stride());
+    let mut aov_channel = 0;
+    for layer in layers_of(layout) {
+        for ch in &layer.channels {
+            let value = |i: usize| -> i128 {
+                if layer.name == "beauty" {
+                    let c = layer.channels.iter().position(|x| x == ch).unwrap_or(0);
+                    sums.pixel_at(i)[c]
+                } else {
+                    sums.passes
+                        .as_ref()
+                        .map_or(0, |p| p.sums.sums[i * stride + aov_channel])
+                }
+            };
+            let mut words = [
+                Vec::with_capacity(n),
+                Vec::with_capacity(n),
+                Vec::with_capacity(n),
+                Vec::with_capacity(n),
+            ];
+            for &i in &order {
+                for (k, w) in to_words(value(i)).into_iter().enumerate() {
                     words[k].push(w);
                 }
             }
+            for (k, w) in words.into_iter().enumerate() {
+                channels.push(AnyChannel::new(
+                    format!("{}.{ch}.w{k}", layer.name).as_str(),
+                    FlatSamples::U32(w),
+                ));
+            }
+            if layer.name != "beauty" {
+                aov_channel += 1;
+            }
         }
-        for (k, w) in words.into_iter().enumerate() {
-            channels.push(AnyChannel::new(
-                format!("{}.{ch}.w{k}", beauty.name).as_str(),
-                FlatSamples::U32(w),
-            ));
+    }
+    if let Some(p) = &sums.passes {
+        let aov = &p.sums;
+        if !aov.nearest.is_empty() {
+            type Field = fn(&Nearest) -> u32;
+            let fields: [(&str, Field); 7] = [
+                ("depth", |n| n.z.to_bits()),
+                ("sample", |n| n.sample),
+                ("px", |n| n.p[0].to_bits()),
+                ("py", |n| n.p[1].to_bits()),
+                ("pz", |n| n.p[2].to_bits()),
+                ("object", |n| n.object),
+                ("material", |n| n.material),
+            ];
+            for (name, f) in fields {
+                let v = order.iter().map(|&i| f(&aov.nearest[i])).collect();
+                channels.push(AnyChannel::new(
+                    format!("nearest.{name}").as_str(),
+                    FlatSamples::U32(v),
+                ));
+            }
+        }
+        for (kind, counts) in [("object", &aov.objects), ("material", &aov.materials)] {
+            if counts.is_empty() {
+                continue;
+            }
+            let most = order.iter().map(|&i| counts[i].len()).max().unwrap_or(0);
+            for k in 0..most {
+                let at = |i: usize| counts[i].get(k).copied();
+                let ids = order
+                    .iter()
+                    .map(|&i| at(i).map_or(0, |e| e.0 + 1))
+                    .collect();
+                let ns = order.iter().map(|&i| at(i).map_or(0, |e| e.1)).collect();
+                channels.push(AnyChannel::new(
+                    format!("coverage.{kind}.id{k}").as_str(),
+                    FlatSamples::U32(ids),
+                ));
+                channels.push(AnyChannel::new(
+                    format!("coverage.{kind}.n{k}").as_str(),
+                    FlatSamples::U32(ns),
+                ));
+            }
         }
     }
     let text = |s: &str| {
@@ -185,13 +378,16 @@ pub fn stage(path: &Path, header: &Header, sums: &Accumulated) -> Result<Staged,
         ("lucent.requested", range_text(&header.requested)),
         (
             "lucent.layers",
-            format!(
-                "{}:{}:{}",
-                beauty.name,
-                beauty.channels.join(","),
-                beauty.fixed.frac_bits
-            ),
+            header
+                .layers
+                .iter()
+                .map(|l| format!("{}:{}:{}", l.name, l.channels.join(","), l.fixed.frac_bits))
+                .collect::<Vec<_>>()
+                .join(";"),
         ),
+        ("lucent.passes", id.passes.clone()),
+        ("lucent.names", id.names.clone()),
+        ("lucent.output", id.output.clone()),
         (
             "lucent.counters",
             format!(
@@ -303,7 +499,9 @@ fn parse_header(
             Some(LayerFormat {
                 name: name.into(),
                 channels: ch.split(',').map(String::from).collect(),
-                fixed: FixedPoint::new(f.parse().ok()?)?,
+                fixed: FixedPoint {
+                    frac_bits: f.parse().ok()?,
+                },
             })
         })
         .collect::<Option<Vec<_>>>()
@@ -314,13 +512,6 @@ fn parse_header(
                 format!("`{layers_text}` is not NAME:CHANNELS:BITS"),
             )
         })?;
-    if layers != [beauty_layer()] {
-        return Err(bad(
-            path,
-            Some("lucent.layers"),
-            format!("`{layers_text}`: this lucent merges the layer beauty:R,G,B:64 only"),
-        ));
-    }
     let counters_text = get("lucent.counters")?;
     let c: Vec<u64> = counters_text
         .split(',')
@@ -342,6 +533,9 @@ fn parse_header(
             spp,
             options: get("lucent.options")?,
             frame,
+            passes: get("lucent.passes")?,
+            names: get("lucent.names")?,
+            output: get("lucent.output")?,
         },
         scene: get("lucent.scene")?,
         region,
@@ -359,6 +553,35 @@ fn parse_header(
             ..Counters::default()
         },
     };
+    let layout = layout_of(&header.identity).map_err(|(f, e)| bad(path, Some(f), e))?;
+    if parse_output(&header.identity.output).is_none() {
+        return Err(bad(
+            path,
+            Some("lucent.output"),
+            format!(
+                "`{}` is not the frame's file options",
+                header.identity.output
+            ),
+        ));
+    }
+    let expected = layers_of(layout.as_ref());
+    if header.layers != expected {
+        let show = |ls: &[LayerFormat]| {
+            ls.iter()
+                .map(|l| format!("{}:{}:{}", l.name, l.channels.join(","), l.fixed.frac_bits))
+                .collect::<Vec<_>>()
+                .join(";")
+        };
+        return Err(bad(
+            path,
+            Some("lucent.layers"),
+            format!(
+                "`{layers_text}`, but the passes `{}` sum the layers `{}`",
+                header.identity.passes,
+                show(&expected)
+            ),
+        ));
+    }
     let (w, h) = header.identity.frame;
     if !region.within(&Region::full(w, h)) {
         return Err(bad(
@@ -434,46 +657,128 @@ pub fn read(path: &Path) -> Result<(Header, Accumulated), Error> {
             ),
         ));
     }
-    let mut sums = Accumulated::new(r, header.samples.start)?;
+    let layout = layout_of(&header.identity).map_err(|(f, e)| bad(path, Some(f), e))?;
+    let mut sums = Accumulated::with_passes(r, header.samples.start, layout.as_ref())?;
     sums.done = header.samples.end;
     sums.counters = header.counters;
-    let beauty = beauty_layer();
-    let expected = beauty.channels.len() * 4;
-    if layer.channel_data.list.len() != expected {
+    let list = &layer.channel_data.list;
+    let n = r.area() as usize;
+    let channel = |name: &str| -> std::result::Result<&[u32], crate::error::Error> {
+        let found = list.iter().find(|a| a.name == Text::new_or_panic(name));
+        match found.map(|a| &a.sample_data) {
+            Some(FlatSamples::U32(v)) if v.len() == n => Ok(v),
+            Some(_) => Err(bad(path, None, format!("channel {name} is not u32 pixels"))),
+            None => Err(bad(path, None, format!("channel {name} is missing"))),
+        }
+    };
+    // the region's pixels, row by row: their index in the sums
+    let order: Vec<usize> = (r.y0..r.y1)
+        .flat_map(|y| (r.x0..r.x1).map(move |x| (x, y)))
+        .map(|(x, y)| sums.index(x, y))
+        .collect();
+    let stride = layout.as_ref().map_or(0, |l| l.stride());
+    let mut expected = 0;
+    let mut aov_channel = 0;
+    for l in &header.layers {
+        for ch in &l.channels {
+            let mut words: Vec<&[u32]> = Vec::with_capacity(4);
+            for k in 0..4 {
+                words.push(channel(&format!("{}.{ch}.w{k}", l.name))?);
+            }
+            expected += 4;
+            let c = l.channels.iter().position(|x| x == ch).unwrap_or(0);
+            for (j, &i) in order.iter().enumerate() {
+                let v = from_words([words[0][j], words[1][j], words[2][j], words[3][j]]);
+                if l.name == "beauty" {
+                    sums.pixel_at_mut(i)[c] = v;
+                } else if let Some(p) = &mut sums.passes {
+                    p.sums.sums[i * stride + aov_channel] = v;
+                }
+            }
+            if l.name != "beauty" {
+                aov_channel += 1;
+            }
+        }
+    }
+    if let Some(p) = &mut sums.passes {
+        let aov: &mut AovSums = &mut p.sums;
+        if !aov.nearest.is_empty() {
+            let f = |k: &str| channel(&format!("nearest.{k}"));
+            let (z, s, px, py, pz, o, m) = (
+                f("depth")?,
+                f("sample")?,
+                f("px")?,
+                f("py")?,
+                f("pz")?,
+                f("object")?,
+                f("material")?,
+            );
+            expected += 7;
+            for (j, &i) in order.iter().enumerate() {
+                aov.nearest[i] = Nearest {
+                    z: f32::from_bits(z[j]),
+                    sample: s[j],
+                    p: [px[j], py[j], pz[j]].map(f32::from_bits),
+                    object: o[j],
+                    material: m[j],
+                };
+            }
+        }
+        for (kind, names, counts) in [
+            ("object", p.layout.object_names.len(), &mut aov.objects),
+            (
+                "material",
+                p.layout.material_names.len(),
+                &mut aov.materials,
+            ),
+        ] {
+            if counts.is_empty() {
+                continue;
+            }
+            let mut k = 0;
+            while list
+                .iter()
+                .any(|a| a.name == Text::new_or_panic(format!("coverage.{kind}.id{k}").as_str()))
+            {
+                let ids = channel(&format!("coverage.{kind}.id{k}"))?;
+                let ns = channel(&format!("coverage.{kind}.n{k}"))?;
+                expected += 2;
+                for (j, &i) in order.iter().enumerate() {
+                    match (ids[j], ns[j]) {
+                        (0, 0) => {}
+                        (id, c) if id as usize <= names && c > 0 => {
+                            let before = counts[i].last().map(|e| e.0 + 1);
+                            if before.is_some_and(|b| b > id - 1) {
+                                return Err(bad(
+                                    path,
+                                    None,
+                                    format!("coverage.{kind}: IDs out of order"),
+                                ));
+                            }
+                            counts[i].push((id - 1, c));
+                        }
+                        _ => {
+                            return Err(bad(
+                                path,
+                                None,
+                                format!("coverage.{kind}.id{k}: no such {kind}"),
+                            ))
+                        }
+                    }
+                }
+                k += 1;
+            }
+        }
+    }
+    if list.len() != expected {
         return Err(bad(
             path,
             None,
             format!(
-                "{} channels, a part of layer beauty has {expected}",
-                layer.channel_data.list.len()
+                "{} channels, a part of these layers and passes has {expected}",
+                list.len()
             ),
         ));
-    }
-    for (c, ch) in beauty.channels.iter().enumerate() {
-        let mut words: Vec<&[u32]> = Vec::with_capacity(4);
-        for k in 0..4 {
-            let name = format!("{}.{ch}.w{k}", beauty.name);
-            let found = layer
-                .channel_data
-                .list
-                .iter()
-                .find(|a| a.name == Text::new_or_panic(&name));
-            match found.map(|a| &a.sample_data) {
-                Some(FlatSamples::U32(v)) if v.len() == r.area() as usize => words.push(v),
-                Some(_) => {
-                    return Err(bad(path, None, format!("channel {name} is not u32 pixels")))
-                }
-                None => return Err(bad(path, None, format!("channel {name} is missing"))),
-            }
-        }
-        let mut i = 0;
-        for y in r.y0..r.y1 {
-            for x in r.x0..r.x1 {
-                sums.pixel_mut(x, y)[c] =
-                    from_words([words[0][i], words[1][i], words[2][i], words[3][i]]);
-                i += 1;
-            }
-        }
     }
     Ok((header, sums))
 }

@@ -45,7 +45,7 @@
 pub mod pixels;
 mod sample;
 
-pub use pixels::{PixelPasses, TilePasses};
+pub use pixels::{AovSums, Layout, Passes, PixelPasses, TilePasses};
 pub use sample::SampleAovs;
 
 use std::collections::HashMap;
@@ -176,17 +176,30 @@ pub struct Setup {
     pub material_names: Vec<String>,
 }
 
+/// The layout of `passes` over `scene`'s names (what a part of its render
+/// holds), without building the scene's lights.
+pub fn layout(scene: &Scene, passes: PassSet) -> Layout {
+    Layout::of(&Setup::build(scene, None, passes))
+}
+
 impl Setup {
     pub fn new(scene: &Scene, lights: &LightSet, passes: PassSet) -> Setup {
+        Setup::build(scene, Some(lights), passes)
+    }
+
+    /// [`Setup::new`]; without `lights`, no light has a group.
+    fn build(scene: &Scene, lights: Option<&LightSet>, passes: PassSet) -> Setup {
         let out = &scene.output;
         let groups = out.group_names();
         let group = |g: u32| g.min(groups.len() as u32 - 1);
         let object_group: Vec<u32> = (0..scene.objects.len())
             .map(|i| group(out.object_group.get(i).copied().unwrap_or(0)))
             .collect();
-        let light_group = (0..lights.len() as u32)
-            .map(|t| object_group[lights.geom_of(t) as usize])
-            .collect();
+        let light_group = lights.map_or(Vec::new(), |lights| {
+            (0..lights.len() as u32)
+                .map(|t| object_group[lights.geom_of(t) as usize])
+                .collect()
+        });
         let mut object_names: Vec<String> = Vec::new();
         let mut by_name: HashMap<&str, u32> = HashMap::new();
         let object_name = scene
