@@ -286,8 +286,7 @@ pub fn radiance<R: Recorder, T: Clock>(
         rec,
         |ss, si, wo, beta, rng, counters, depth, width| {
             let t0 = T::now();
-            let s =
-                subsurface_probe(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
+            let s = subsurface_probe(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
             T::lap(counters, Effect::Probe, t0);
             s
         },

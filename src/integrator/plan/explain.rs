@@ -102,9 +102,14 @@ pub struct Aovs {
 
 /// One way a subsurface hit is estimated, with its reason; a material's
 /// list is tried in order (module docs).
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "method", rename_all = "kebab-case")]
 pub enum SubsurfaceMethod {
+    /// Level of detail ([`crate::materials::lod`]): hits whose footprint is
+    /// at least `min_width` wide (0: every hit, `--lod force`) are shaded
+    /// as the entry lobe at xo weighted by the profile's plane integral,
+    /// with no probe; the others go on to the next method.
+    LevelOfDetail { min_width: f32, reason: String },
     /// The Christensen–Burley diffusion BSSRDF sampled with probe rays.
     Diffusion {
         /// Probe axes: `normal`, `mis3` or `curvature`.
@@ -324,7 +329,8 @@ impl Explanation {
         } else if probes_needed.is_empty() {
             choice(
                 "off",
-                "no object has a subsurface material with an active channel",
+                "no object has a subsurface material that casts probes (none with an \
+                 active channel, or every hit under level of detail)",
             )
         } else {
             choice(
@@ -345,7 +351,7 @@ impl Explanation {
             reason: if passes.is_empty() {
                 "no pass asked for: the tile loop without a recorder".into()
             } else {
-                "asked for (--aov or [output] aovs): one uncut run with a recorder".into()
+                "asked for (--aov or [output] aovs): summed exactly in the render loop, carried by parts".into()
             },
             passes,
         };
@@ -398,27 +404,39 @@ fn diffusion_material(ss: &Subsurface, pair_depth: u32, mp: &mut MaterialPlan) -
     let o = ss.probe.options();
     let active: [bool; 3] = std::array::from_fn(|c| ss.params.active(c));
     let any = active.iter().any(|&a| a);
-    mp.subsurface = vec![if any {
-        SubsurfaceMethod::Diffusion {
-            axes: o.axes.name().into(),
-            channel: o.channel.name().into(),
-            radius: o.radius.name(),
-            pair_depth,
-            curvature_correction: ss.curvature_correction().is_some(),
-            reason: if pair_depth > 0 {
-                format!(
-                    "the integrator's default: probe rays sample the profile, an \
+    let lod = ss.lod().decision();
+    let every_hit_lod = any && lod.can_trigger && lod.min_width == Some(0.0);
+    mp.subsurface = Vec::new();
+    if let (true, Some(min_width)) = (any && lod.can_trigger, lod.min_width) {
+        mp.subsurface.push(SubsurfaceMethod::LevelOfDetail {
+            min_width,
+            reason: lod.reason,
+        });
+    }
+    if !every_hit_lod {
+        mp.subsurface.push(if any {
+            SubsurfaceMethod::Diffusion {
+                axes: o.axes.name().into(),
+                channel: o.channel.name().into(),
+                radius: o.radius.name(),
+                pair_depth,
+                curvature_correction: ss.curvature_correction().is_some(),
+                reason: if pair_depth > 0 {
+                    format!(
+                        "the integrator's default: probe rays sample the profile, an \
                      antithetic pair at depth < {pair_depth}, one probe deeper"
-                )
-            } else {
-                "the integrator's default: probe rays sample the profile, one probe a hit".into()
-            },
-        }
-    } else {
-        SubsurfaceMethod::None {
-            reason: "A = 0 in every channel: the medium reflects nothing".into(),
-        }
-    }];
+                    )
+                } else {
+                    "the integrator's default: probe rays sample the profile, one probe a hit"
+                        .into()
+                },
+            }
+        } else {
+            SubsurfaceMethod::None {
+                reason: "A = 0 in every channel: the medium reflects nothing".into(),
+            }
+        });
+    }
     let split = if COAT_SPLIT_DEPTH > 0 {
         format!("both followed at depth < {COAT_SPLIT_DEPTH}, one chosen by Fr deeper")
     } else {
@@ -464,7 +482,7 @@ fn diffusion_material(ss: &Subsurface, pair_depth: u32, mp: &mut MaterialPlan) -
             )
         },
     ));
-    any
+    any && !every_hit_lod
 }
 
 /// A used subsurface material under the random walk.

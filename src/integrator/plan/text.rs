@@ -81,6 +81,12 @@ pub fn render(p: &Explanation) -> String {
                     &format!("boundary={boundary}; {reason}"),
                 ),
                 SubsurfaceMethod::None { reason } => row(r, "subsurface", "none", reason),
+                SubsurfaceMethod::LevelOfDetail { min_width, reason } => row(
+                    r,
+                    "subsurface",
+                    "level of detail",
+                    &format!("footprint ≥ {min_width:e}; {reason}"),
+                ),
             }
         }
         if let Some(c) = &m.coat {
