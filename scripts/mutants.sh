@@ -182,13 +182,17 @@ if [ -n "$sample" ]; then
     # Seeded permutation: sort by sha256 of seed and name.
     cargo mutants --list "${args[@]}" | while IFS= read -r m; do
         printf '%s\t%s\n' "$(printf '%s:%s' "$seed" "$m" | sha256sum | cut -c1-16)" "$m"
-    done | sort | cut -f2- | head -n "$sample" >mutants.out.sample
+    done | sort | cut -f2- >mutants.out.order
+    # (not `| head`: with pipefail, the writer's SIGPIPE would end the script)
+    sed -n "1,${sample}p" mutants.out.order >mutants.out.sample
     while IFS= read -r m; do
         if [ -n "$stop_at" ] && [ "$(date -u +%H:%M)" \> "$stop_at" ]; then
             echo "mutants.sh: past $stop_at, stopping"
             break
         fi
-        if cut -f3- "$rec" | grep -qxF -- "$m"; then continue; fi
+        if M="$m" awk -F '\t' '$3 == ENVIRON["M"] { f = 1 } END { exit !f }' "$rec"; then
+            continue
+        fi
         file="${m%%:*}"
         case "$file" in
             src/accel/bvh/*) t=("${TESTS_BVH[@]}") ;;
