@@ -82,6 +82,19 @@ while [ $# -gt 0 ]; do
     esac
 done
 
+# The test selection as options of every cargo command cargo-mutants runs:
+# given after `--` it reaches only `cargo test`, and the build before it
+# (`cargo test --no-run`) would build every test target and example.
+cargo_args() {
+    while [ $# -gt 0 ]; do
+        if [ "$1" = --test ]; then
+            printf -- '--cargo-arg=--test=%s\n' "$2"; shift 2
+        else
+            printf -- '--cargo-arg=%s\n' "$1"; shift
+        fi
+    done
+}
+
 # Per file: caught / missed / timeout / unviable, from the outcome lists
 # cargo-mutants writes (one mutant per line, "FILE:LINE:COL: description").
 report() {
@@ -207,7 +220,7 @@ if [ -n "$sample" ]; then
         start=$(date +%s)
         rm -rf mutants.out
         cargo mutants --in-place --baseline skip --timeout "${MUTANTS_TIMEOUT:-300}" \
-            --no-shuffle --file "$file" --re "$re" "${extra[@]}" -- "${t[@]}" \
+            --no-shuffle --file "$file" --re "$re" $(cargo_args "${t[@]}") "${extra[@]}" \
             >mutants.out.log 2>&1 || true
         secs=$(( $(date +%s) - start ))
         outcome=error
@@ -236,7 +249,7 @@ fi
 # cargo-mutants exits non-zero when a mutant is missed; the report is what
 # matters, so it is printed either way and that status is passed on.
 status=0
-cargo mutants "${args[@]}" "${extra[@]}" -- "${TESTS[@]}" || status=$?
+cargo mutants "${args[@]}" $(cargo_args "${TESTS[@]}") "${extra[@]}" || status=$?
 echo
 report "$out"
 exit "$status"
