@@ -164,7 +164,7 @@ fi
 
 if ! cargo mutants --version >/dev/null 2>&1; then
     echo "--- installing cargo-mutants ---"
-    cargo install --locked cargo-mutants
+    cargo install --locked cargo-mutants --version '^27'
 fi
 
 if [ ${#files[@]} -eq 0 ]; then
