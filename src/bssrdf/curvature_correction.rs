@@ -335,6 +335,24 @@ mod tests {
         assert!((w.x - (fo[0] * fi[0]).sqrt()).abs() < 1e-6);
     }
 
+    /// A hit between a flat or concave point (f = 1) and a convex one (f >
+    /// 1), e.g. from the flat base of a dome onto the dome, carries √f of
+    /// the convex point, whichever end is xo.
+    #[test]
+    fn a_hit_between_a_flat_and_a_convex_point_carries_the_root_of_one_factor() {
+        let (_, cc) = marble(1.0);
+        let k = 0.3;
+        let f = cc.factor(k);
+        assert!(f.iter().all(|&v| v > 1.0), "{f:?}");
+        let want = Vec3::new(f[0].sqrt(), f[1].sqrt(), f[2].sqrt());
+        for flat in [0.0, -0.5] {
+            for w in [cc.weight(flat, k), cc.weight(k, flat)] {
+                let w = w.expect("a convex end must change the weight");
+                assert!((w - want).abs().max_element() < 1e-6, "{w} vs {want}");
+            }
+        }
+    }
+
     /// The lookup the renderer uses against the equations, over curvatures
     /// from a sphere of 10⁵ diffusion lengths to one of 1/100, for two
     /// materials (marble, skin1) at two scales.
