@@ -344,8 +344,15 @@ fn oiiotool_reads_the_header_of_a_real_render() {
     assert_eq!(plan.integrator, "path");
     assert_eq!(plan.probe_queries.method, "on");
     assert_eq!(plan.environment.method, "escaping rays");
-    let axes = match &plan.materials[0].subsurface[0] {
-        lucent::integrator::plan::explain::SubsurfaceMethod::Diffusion { axes, .. } => axes,
+    // level of detail (the default, auto) first, then the diffusion
+    use lucent::integrator::plan::explain::SubsurfaceMethod;
+    let methods = &plan.materials[0].subsurface;
+    assert!(
+        matches!(methods[0], SubsurfaceMethod::LevelOfDetail { .. }),
+        "{methods:?}"
+    );
+    let axes = match &methods[1] {
+        SubsurfaceMethod::Diffusion { axes, .. } => axes,
         m => panic!("{m:?}"),
     };
     assert_eq!(axes, "mis3");
