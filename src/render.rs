@@ -568,7 +568,7 @@ fn render_tile<P: PixelPasses, T: Clock>(
             // a signal stops the render between pixels (see crate::interrupt);
             // the pass is then incomplete and dropped
             if interrupt::requested().is_some() {
-                counters.camera_rays((i / C) as u64 * samples.len() as u64);
+                counters.camera_rays(i as u64 * samples.len() as u64);
                 return counters;
             }
             let pixel = y as u64 * w as u64 + x as u64;
@@ -605,7 +605,7 @@ fn render_tile<P: PixelPasses, T: Clock>(
             i += 1;
         }
     }
-    counters.camera_rays((i / C) as u64 * samples.len() as u64);
+    counters.camera_rays(i as u64 * samples.len() as u64);
     counters
 }
 

@@ -44,6 +44,7 @@ fn without_reasons(p: &Explanation) -> Value {
         match v {
             Value::Object(m) => {
                 m.remove("reason");
+                m.remove("min_width");
                 m.values_mut().for_each(strip);
             }
             Value::Array(a) => a.iter_mut().for_each(strip),
@@ -84,9 +85,12 @@ fn with_materials(mut v: Value, materials: Value) -> Value {
     v
 }
 
+/// The default subsurface plan: level of detail (auto) where the footprint
+/// is wide, else the diffusion (`min_width` is checked in
+/// `level_of_detail_at_distance_forced_or_off`).
 fn diffusion(coat: &str, exit: &str, active: &[&str], inactive: &[&str]) -> Value {
     json!({
-        "subsurface": [{
+        "subsurface": [{"method": "level-of-detail"}, {
             "method": "diffusion", "axes": "curvature", "channel": "mis",
             "radius": "analytic", "pair_depth": 1, "curvature_correction": true
         }],
@@ -464,4 +468,60 @@ fn stats_prints_rays_and_time_per_effect() {
         assert!(line.contains("% of time"), "{line}");
     }
     assert!(!err.contains("random walk"), "{err}");
+}
+
+#[test]
+fn level_of_detail_at_distance_forced_or_off() {
+    use lucent::integrator::plan::explain::SubsurfaceMethod;
+    use lucent::materials::{LodMode, Material, SubsurfaceOverrides};
+    // auto (the default): LOD from 0.25 × Rmax of the widest active
+    // channel, then the diffusion
+    let s = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
+    let Material::Subsurface(ss) = &s.materials[1] else {
+        panic!("sauce is the second material")
+    };
+    let rmax = ss.probe.rmax() as f32;
+    let p = plan_of(&s, IntegratorKind::Path, PassSet::EMPTY);
+    let methods = &p.materials[1].subsurface;
+    match &methods[..] {
+        [SubsurfaceMethod::LevelOfDetail { min_width, .. }, SubsurfaceMethod::Diffusion { .. }] => {
+            assert!(
+                (min_width / (0.25 * rmax) - 1.0).abs() < 1e-6,
+                "{min_width} vs {rmax}"
+            )
+        }
+        m => panic!("{m:?}"),
+    }
+    assert_eq!(p.probe_queries.method, "on");
+    // lod = "off" in the scene: the diffusion alone
+    let off = load(&format!("{LAMP}{KETCHUP}lod = \"off\"\n{BALL_SAUCE}"));
+    let p = plan_of(&off, IntegratorKind::Path, PassSet::EMPTY);
+    assert!(
+        matches!(
+            &p.materials[1].subsurface[..],
+            [SubsurfaceMethod::Diffusion { .. }]
+        ),
+        "{:?}",
+        p.materials[1].subsurface
+    );
+    // forced (--lod force): every hit under LOD, so the plan has no probe
+    // query, and a render makes none, though it hits the ball
+    let mut forced = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
+    SubsurfaceOverrides {
+        lod: Some(LodMode::Force),
+        ..SubsurfaceOverrides::default()
+    }
+    .apply_all(&mut forced.materials)
+    .unwrap();
+    let p = plan_of(&forced, IntegratorKind::Path, PassSet::EMPTY);
+    match &p.materials[1].subsurface[..] {
+        [SubsurfaceMethod::LevelOfDetail { min_width, .. }] => assert_eq!(*min_width, 0.0),
+        m => panic!("{m:?}"),
+    }
+    assert_eq!(p.probe_queries.method, "off");
+    let c = counters(&forced, IntegratorKind::Path, false);
+    assert_eq!(c.effect_rays[Effect::Probe as usize], 0, "{c:?}");
+    assert!(c.effect_rays[Effect::Direct as usize] > 0, "{c:?}");
+    let full = counters(&s, IntegratorKind::Path, false);
+    assert!(full.effect_rays[Effect::Probe as usize] > 0, "{full:?}");
 }
