@@ -8,8 +8,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
+#[cfg(feature = "subsurface")]
 use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
-use lucent::error::{InputError, Param, ParamError};
+use lucent::error::InputError;
+#[cfg(feature = "subsurface")]
+use lucent::error::{Param, ParamError};
 use lucent::farm::part::{self, Identity};
 use lucent::film::cryptomatte;
 use lucent::film::exr_layers::{
@@ -19,6 +22,7 @@ use lucent::film::passes::PassSet;
 use lucent::film::region::Region;
 use lucent::film::ToneMap;
 use lucent::integrator::IntegratorKind;
+#[cfg(feature = "subsurface")]
 use lucent::materials::{SubsurfaceOverrides, WalkBoundary};
 use lucent::render::{self, RenderOptions};
 use lucent::scene;
@@ -38,6 +42,7 @@ struct Cli {
 #[derive(Clone, Copy, ValueEnum)]
 enum IntegratorArg {
     Path,
+    #[cfg(feature = "subsurface")]
     Randomwalk,
 }
 
@@ -146,6 +151,7 @@ enum Command {
     /// Measure error against time for every sampling choice of the
     /// subsurface estimator: results.csv, plots and report.md in the output
     /// directory (resumes from results.csv; see src/tools/study/mod.rs).
+    #[cfg(feature = "subsurface")]
     Study(StudyArgs),
 }
 
@@ -220,6 +226,7 @@ fn parse_checkpoint(s: &str) -> Result<f64, String> {
 
 /// Subsurface sampling choices that override every subsurface material's
 /// own (see docs/scene-format.md for what each means).
+#[cfg(feature = "subsurface")]
 #[derive(clap::Args)]
 struct SubsurfaceArgs {
     /// Radius sampler: uniform | table[:N] | table-uniform[:N] | analytic | mixture.
@@ -318,12 +325,14 @@ impl FileArgs {
     }
 }
 
+#[cfg(feature = "subsurface")]
 #[derive(Clone, Copy, ValueEnum)]
 enum BoundaryArg {
     Dielectric,
     Diffuse,
 }
 
+#[cfg(feature = "subsurface")]
 #[derive(Clone, Copy, ValueEnum)]
 enum AxesArg {
     Curvature,
@@ -331,12 +340,14 @@ enum AxesArg {
     Mis3,
 }
 
+#[cfg(feature = "subsurface")]
 #[derive(Clone, Copy, ValueEnum)]
 enum ChannelArg {
     Single,
     Mis,
 }
 
+#[cfg(feature = "subsurface")]
 fn parse_radius(s: &str) -> Result<RadiusSampler, ParamError> {
     RadiusSampler::parse(s)
 }
@@ -345,7 +356,16 @@ fn parse_aov(s: &str) -> Result<PassSet, String> {
     PassSet::parse_list(s).map_err(|e| e.problem())
 }
 
+#[cfg(feature = "subsurface")]
 impl SubsurfaceArgs {
+    /// Applies the overrides to every subsurface material of `materials`;
+    /// returns them as the render's identity records them.
+    fn apply(&self, materials: &mut [lucent::materials::Material]) -> Result<String, Error> {
+        let o = self.overrides();
+        o.apply_all(materials).map_err(option_error)?;
+        Ok(format!("{o:?}"))
+    }
+
     fn overrides(&self) -> SubsurfaceOverrides {
         SubsurfaceOverrides {
             radius: self.radius,
@@ -368,6 +388,19 @@ impl SubsurfaceArgs {
             }),
             roughness: self.roughness,
         }
+    }
+}
+
+/// A build without the `subsurface` feature has no subsurface materials,
+/// and so no options that override them.
+#[cfg(not(feature = "subsurface"))]
+#[derive(clap::Args)]
+struct SubsurfaceArgs {}
+
+#[cfg(not(feature = "subsurface"))]
+impl SubsurfaceArgs {
+    fn apply(&self, _: &mut [lucent::materials::Material]) -> Result<String, Error> {
+        Ok(String::new())
     }
 }
 
@@ -398,6 +431,7 @@ fn main() -> ExitCode {
                 .unwrap_or_else(Backend::default_available);
             let integrator = match integrator {
                 IntegratorArg::Path => IntegratorKind::Path,
+                #[cfg(feature = "subsurface")]
                 IntegratorArg::Randomwalk => IntegratorKind::RandomWalk,
             };
             let opts = RenderOptions {
@@ -414,7 +448,7 @@ fn main() -> ExitCode {
                     backend,
                     &opts,
                     aov,
-                    &subsurface.overrides(),
+                    &subsurface,
                     &file,
                     &split,
                     Preview { tonemap, exposure },
@@ -429,6 +463,7 @@ fn main() -> ExitCode {
             exposure,
             quiet,
         } => run_merge(&parts, &output, tonemap, exposure, quiet),
+        #[cfg(feature = "subsurface")]
         Command::Study(args) => run_study(args),
         Command::Bench(args) => run_bench(args),
         Command::Info => {
@@ -471,6 +506,7 @@ fn exit_code(e: &Error) -> u8 {
 
 /// A subsurface override from the command line out of its domain, named by
 /// its option.
+#[cfg(feature = "subsurface")]
 fn option_error(e: ParamError) -> Error {
     let (argument, problem) = match e.param {
         Param::RmaxQuantile => ("--rmax-quantile", e.problem()),
@@ -523,7 +559,7 @@ fn run_render(
     backend: Backend,
     opts: &RenderOptions,
     aov: Option<PassSet>,
-    overrides: &SubsurfaceOverrides,
+    subsurface: &SubsurfaceArgs,
     file: &scene::OutputSettings,
     split: &SplitArgs,
     preview: Preview,
@@ -545,9 +581,7 @@ fn run_render(
     let mut scene = scene::load(scene_path)?;
     let scene_bytes = scene::load::read_regular_file(scene_path, scene::load::MAX_SCENE_BYTES)
         .map_err(|e| InputError::new(scene_path, format!("cannot read scene file: {e}")))?;
-    overrides
-        .apply_all(&mut scene.materials)
-        .map_err(option_error)?;
+    let overrides = subsurface.apply(&mut scene.materials)?;
     let (w, h) = (scene.camera.width, scene.camera.height);
     let spp = opts.spp.unwrap_or(scene.settings.spp);
     let region = match (split.crop, split.tile) {
@@ -580,7 +614,7 @@ fn run_render(
         seed: opts.seed.unwrap_or(scene.settings.seed),
         spp,
         options: format!(
-            "accel={} integrator={:?} {overrides:?}",
+            "accel={} integrator={:?} {overrides}",
             backend.name(),
             opts.integrator
         ),
@@ -734,7 +768,9 @@ fn frame_header(
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect();
+    #[cfg_attr(not(feature = "subsurface"), allow(unused_mut))]
     let mut sampling = Vec::new();
+    #[cfg(feature = "subsurface")]
     for (i, m) in scene.materials.iter().enumerate() {
         let lucent::materials::Material::Subsurface(ss) = m else {
             continue;
@@ -760,6 +796,7 @@ fn frame_header(
         integrator: Some(
             match opts.integrator {
                 IntegratorKind::Path => "path",
+                #[cfg(feature = "subsurface")]
                 IntegratorKind::RandomWalk => "randomwalk",
             }
             .into(),
@@ -883,6 +920,7 @@ fn report_rejected_rays(accel: &dyn accel::Accel) {
     }
 }
 
+#[cfg(feature = "subsurface")]
 #[derive(clap::Args)]
 struct StudyArgs {
     /// The scene description (TOML; needs a subsurface material).
@@ -924,15 +962,18 @@ struct StudyArgs {
     quiet: bool,
 }
 
+#[cfg(feature = "subsurface")]
 fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, String> {
     lucent::tools::study::config::parse_integrator(s)
         .ok_or_else(|| format!("expected diffusion or randomwalk, found \"{s}\""))
 }
 
+#[cfg(feature = "subsurface")]
 fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, String> {
     lucent::tools::study::Axis::parse(s).ok_or_else(|| format!("unknown axis \"{s}\""))
 }
 
+#[cfg(feature = "subsurface")]
 fn run_study(a: StudyArgs) -> Result<(), Error> {
     use lucent::tools::study;
     let out = a.output.clone().unwrap_or_else(|| {
@@ -1087,5 +1128,10 @@ fn info() -> String {
             s.push_str(&format!(" ({})", b.name()));
         }
     }
+    s.push_str(if cfg!(feature = "subsurface") {
+        "\nsubsurface: yes"
+    } else {
+        "\nsubsurface: no (built without the `subsurface` feature)"
+    });
     s
 }

@@ -12,11 +12,14 @@
 //! passes (light paths, light groups, data, ID coverage) measure.
 
 pub mod aov;
+#[cfg(feature = "subsurface")]
 pub mod diffuse_boundary;
 pub mod interaction;
 pub mod path;
 pub mod plan;
+#[cfg(feature = "subsurface")]
 pub mod probe;
+#[cfg(feature = "subsurface")]
 pub mod randomwalk;
 
 use crate::accel::Accel;
@@ -96,7 +99,9 @@ pub enum IntegratorKind {
     /// [`path::radiance`]: the diffusion BSSRDF sampled with probe rays.
     #[default]
     Path,
-    /// [`randomwalk::radiance`]: a volumetric random walk in the medium.
+    /// [`randomwalk::radiance`]: a volumetric random walk in the medium
+    /// (only with the `subsurface` feature).
+    #[cfg(feature = "subsurface")]
     RandomWalk,
 }
 
@@ -114,6 +119,7 @@ impl IntegratorKind {
     ) -> crate::geometry::Vec3 {
         match self {
             IntegratorKind::Path => path::radiance(ctx, ray, rng, scratch, counters, rec),
+            #[cfg(feature = "subsurface")]
             IntegratorKind::RandomWalk => {
                 randomwalk::radiance(ctx, ray, rng, scratch, counters, rec)
             }

@@ -58,17 +58,31 @@
 
 use super::aov::{self, Event, Recorder, Source};
 use super::interaction::offset_along;
+#[cfg(feature = "subsurface")]
 use super::probe::{exit_curvature, sample_entry, ProbeTarget};
 use super::{Context, Counters, Interaction};
 use crate::accel::ProbeHits;
-use crate::bssrdf::curvature_correction::mean_curvature;
-use crate::bssrdf::ProbeRandoms;
+#[cfg(feature = "subsurface")]
+use crate::bssrdf::{curvature_correction::mean_curvature, ProbeRandoms};
 use crate::film::passes::Pass;
-use crate::fresnel;
 use crate::geometry::{Frame, Ray, Vec3};
-use crate::materials::microfacet::RoughCoat;
-use crate::materials::{dielectric, diffuse, Material, Subsurface};
-use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Draw, SampleRng};
+use crate::materials::{dielectric, diffuse, Material};
+#[cfg(feature = "subsurface")]
+use crate::materials::{microfacet::RoughCoat, Subsurface};
+use crate::sampling::{power, Draw, SampleRng};
+#[cfg(feature = "subsurface")]
+use crate::{
+    fresnel,
+    sampling::{cosine_hemisphere, cosine_hemisphere_pdf},
+};
+
+/// A build without the `subsurface` feature has no subsurface material:
+/// the bounce loop's handler of subsurface hits takes this uninhabited
+/// type, so it can never be called, and the compiler drops it and every
+/// path through it (docs/performance.md, "Zero cost for what is off").
+#[cfg(not(feature = "subsurface"))]
+#[derive(Clone, Copy)]
+pub(crate) enum Subsurface {}
 
 /// Bounces after which Russian roulette may end a path.
 const RR_START: u32 = 3;
@@ -85,6 +99,7 @@ const RR_START: u32 = 3;
 /// and each split level adds a path. Splitting the rough coat as well (its
 /// reflection sampled every time, besides next-event estimation) lowered
 /// relMSE by 8–10 % for 24 % more rays, a loss, so it chooses.
+#[cfg(feature = "subsurface")]
 pub(crate) const COAT_SPLIT_DEPTH: u32 = 1;
 
 /// Subsurface hits at depths below this sample two entry points from one
@@ -113,13 +128,21 @@ pub(crate) enum Lobe<'a> {
     Diffuse(Vec3),
     /// The entry-point lobe of a subsurface material (Sw or 1/π), outward
     /// side only; its spectral weight was already applied by the probe.
+    #[cfg(feature = "subsurface")]
     SubsurfaceEntry(&'a Subsurface),
     /// Where a random walk left the medium through a diffuse Fresnel
     /// boundary ([`super::diffuse_boundary::ExitLobe`]).
+    #[cfg(feature = "subsurface")]
     WalkExit(super::diffuse_boundary::ExitLobe),
     /// A subsurface material's rough coat at xo, sampled with probability
     /// `select` (its pdf, for MIS, is select × the visible-normal pdf).
+    #[cfg(feature = "subsurface")]
     Coat { coat: &'a RoughCoat, select: f32 },
+    /// Without the `subsurface` feature: no lobe (uninhabited), keeping
+    /// the lifetime the subsurface lobes borrow with.
+    #[cfg(not(feature = "subsurface"))]
+    #[allow(dead_code)]
+    Absent(&'a Subsurface),
 }
 
 impl Lobe<'_> {
@@ -127,41 +150,60 @@ impl Lobe<'_> {
     fn event(&self) -> Event {
         match self {
             Lobe::Diffuse(_) => Event::Diffuse,
+            #[cfg(feature = "subsurface")]
             Lobe::SubsurfaceEntry(_) | Lobe::WalkExit(_) => Event::Subsurface,
+            #[cfg(feature = "subsurface")]
             Lobe::Coat { .. } => Event::Specular,
+            #[cfg(not(feature = "subsurface"))]
+            Lobe::Absent(s) => match **s {},
         }
     }
     /// f(ωo, ωi) per steradian (ωo, ωi local; z > 0 is the lit side).
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             Lobe::Diffuse(albedo) => diffuse::eval(*albedo, wo, wi),
+            #[cfg(feature = "subsurface")]
             Lobe::SubsurfaceEntry(ss) => Vec3::splat(ss.lobe(wi.z)),
+            #[cfg(feature = "subsurface")]
             Lobe::WalkExit(exit) => Vec3::splat(exit.eval(wi)),
+            #[cfg(feature = "subsurface")]
             Lobe::Coat { coat, .. } => Vec3::splat(coat.eval(wo, wi)),
+            #[cfg(not(feature = "subsurface"))]
+            Lobe::Absent(s) => match **s {},
         }
     }
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             Lobe::Diffuse(_) => diffuse::pdf(wo, wi),
+            #[cfg(feature = "subsurface")]
             Lobe::SubsurfaceEntry(_) => cosine_hemisphere_pdf(wi.z),
+            #[cfg(feature = "subsurface")]
             Lobe::WalkExit(exit) => exit.pdf(wi),
+            #[cfg(feature = "subsurface")]
             Lobe::Coat { coat, select } => select * coat.pdf(wo, wi),
+            #[cfg(not(feature = "subsurface"))]
+            Lobe::Absent(s) => match **s {},
         }
     }
     /// Samples ωi; returns (ωi, f |cos| / pdf, pdf).
     pub(crate) fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<(Vec3, Vec3, f32)> {
         match self {
             Lobe::Diffuse(albedo) => diffuse::sample(*albedo, wo, u),
+            #[cfg(feature = "subsurface")]
             Lobe::SubsurfaceEntry(ss) => {
                 let wi = cosine_hemisphere(u);
                 let pdf = cosine_hemisphere_pdf(wi.z);
                 (pdf > 0.0).then(|| (wi, Vec3::splat(ss.lobe(wi.z) * wi.z / pdf), pdf))
             }
+            #[cfg(feature = "subsurface")]
             Lobe::WalkExit(exit) => exit.sample(u).map(|(wi, w, pdf)| (wi, Vec3::splat(w), pdf)),
+            #[cfg(feature = "subsurface")]
             Lobe::Coat { coat, select } => {
                 let (wi, w, pdf) = coat.sample(wo, u)?;
                 (*select > 0.0).then(|| (wi, Vec3::splat(w / select), select * pdf))
             }
+            #[cfg(not(feature = "subsurface"))]
+            Lobe::Absent(s) => match **s {},
         }
     }
 }
@@ -189,14 +231,17 @@ pub(crate) struct Vertex<'a> {
 pub(crate) enum Scatter<'a> {
     Vertex(Vertex<'a>),
     Continue(Ray, Event),
+    #[cfg(feature = "subsurface")]
     Absorbed,
     /// A subsurface hit under a coat ([`subsurface_probe`]).
+    #[cfg(feature = "subsurface")]
     Coated(Coated<'a>),
 }
 
 /// What a coated subsurface hit at xo turns into: the coat's lobe at xo
 /// (next-event estimation there), a path the coat reflected, and the
 /// entry vertex xi where this path goes on.
+#[cfg(feature = "subsurface")]
 pub(crate) struct Coated<'a> {
     /// The rough coat's vertex at xo and the throughput light sampled
     /// there is weighted by (β before the hit).
@@ -216,6 +261,7 @@ pub(crate) struct Coated<'a> {
 
 /// A ray the coat reflected: the ray, its throughput, and the vertex and
 /// lobe pdf it was sampled with (None for the mirror).
+#[cfg(feature = "subsurface")]
 pub(crate) type Reflected = (Ray, Vec3, Option<(Vec3, f32)>);
 
 /// A path to trace: its ray, throughput, the last non-specular vertex and
@@ -239,6 +285,7 @@ struct Branches {
 
 impl Branches {
     /// false when full.
+    #[cfg(feature = "subsurface")]
     fn push(&mut self, b: Branch) -> bool {
         if self.len == MAX_BRANCHES {
             return false;
@@ -281,6 +328,7 @@ pub fn radiance<R: Recorder>(
 
 /// The bounce loop both integrators share; `subsurface` handles hits on
 /// subsurface objects (and may scale the throughput `beta`).
+#[cfg(feature = "subsurface")]
 pub(crate) fn trace<'s, R: Recorder>(
     ctx: &'s Context,
     camera_ray: Ray,
@@ -341,8 +389,10 @@ fn trace_at<'s, R: Recorder>(
 }
 
 /// One path from `start` until it ends; paths split off on the way are
-/// pushed on `stack`.
+/// pushed on `stack`. (Without the `subsurface` feature neither
+/// `subsurface` nor `stack` is used: no material calls for them.)
 #[inline(always)]
+#[cfg_attr(not(feature = "subsurface"), allow(unused_variables))]
 fn follow<'s, R: Recorder>(
     ctx: &'s Context,
     start: Branch,
@@ -420,6 +470,7 @@ fn follow<'s, R: Recorder>(
                 let (next, e) = dielectric_bounce(ctx, *eta, &si, wo, &mut beta, rng);
                 Scatter::Continue(next, e)
             }
+            #[cfg(feature = "subsurface")]
             Material::Subsurface(ss) => {
                 if R::ON {
                     rec.surface(ss.albedo(), si.shading_frame_facing(wo).n);
@@ -429,11 +480,13 @@ fn follow<'s, R: Recorder>(
         };
         // Light sampled at the vertex counts this much (½ at an entry
         // point of an antithetic pair, whose twin is sampled too).
+        #[cfg_attr(not(feature = "subsurface"), allow(unused_mut))]
         let mut nee_scale = 1.0;
         // Borrowed, not moved out: the vertex stays where it was built.
         // At the first hit the path's class becomes that of what scattered;
         // the coat's reflections are specular.
         let first = R::ON && depth == 0;
+        #[cfg(feature = "subsurface")]
         let coat_event = if first { Event::Specular } else { event };
         let vertex = match &scatter {
             Scatter::Vertex(v) => {
@@ -453,7 +506,9 @@ fn follow<'s, R: Recorder>(
                 }
                 continue;
             }
+            #[cfg(feature = "subsurface")]
             Scatter::Absorbed => break,
+            #[cfg(feature = "subsurface")]
             Scatter::Coated(c) => {
                 if let (Some((v, b)), true) = (&c.coat, ctx.plan.area_lights) {
                     let (d, light) = direct_lighting(ctx, v, rng, counters);
@@ -582,6 +637,7 @@ fn dielectric_bounce(
 /// medium weighted by 1 − Fr or 1 − E.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
+#[cfg(feature = "subsurface")]
 fn subsurface_probe<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
@@ -669,6 +725,7 @@ fn subsurface_probe<'s>(
 /// The smooth coat's reflection: the mirror direction about the shading
 /// normal, which keeps highlights smooth on tessellated meshes; where it
 /// would reflect below the surface the geometric normal is used instead.
+#[cfg(feature = "subsurface")]
 fn mirror(ctx: &Context, si: &Interaction, wo: Vec3, n_out: Vec3) -> Ray {
     let ns_out = if si.ns.dot(n_out) >= 0.0 {
         si.ns
@@ -686,6 +743,7 @@ fn mirror(ctx: &Context, si: &Interaction, wo: Vec3, n_out: Vec3) -> Ray {
 /// and (for the emission MIS weight) the vertex and the lobe's pdf; None
 /// when the sample is lost (below the microsurface or the geometric
 /// surface).
+#[cfg(feature = "subsurface")]
 fn coat_reflection(
     ctx: &Context,
     v: &Vertex,
@@ -706,6 +764,7 @@ fn coat_reflection(
 /// below `ctx.pair_depth` an antithetic pair ([`PAIR_DEPTH`]), whose second
 /// vertex comes back with its own throughput for light sampling.
 #[allow(clippy::too_many_arguments)]
+#[cfg(feature = "subsurface")]
 fn entries<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
@@ -759,6 +818,7 @@ fn entries<'s>(
 
 /// What [`entries`] found as a [`Scatter`]: the entry vertex (with its
 /// pair's, if any), or the end of the path.
+#[cfg(feature = "subsurface")]
 fn entry_scatter<'s>(e: (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>)) -> Scatter<'s> {
     match e {
         (Some(v), None) => Scatter::Vertex(v),
@@ -775,6 +835,7 @@ fn entry_scatter<'s>(e: (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>)) -> Sca
 /// The area integral at xo: one entry point xi from a probe ray with
 /// randoms `u`, and the probe's weight; None when the probe finds nothing.
 #[allow(clippy::too_many_arguments)]
+#[cfg(feature = "subsurface")]
 fn probe_entry<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
@@ -894,4 +955,21 @@ fn direct_lighting(
     }
     let w = power(pdf_light, v.lobe.pdf(v.wo_local, wi_local));
     (f * ls.radiance * (wi_local.z.abs() * w / pdf_light), source)
+}
+
+/// Without the `subsurface` feature there are no subsurface hits.
+#[cfg(not(feature = "subsurface"))]
+#[allow(clippy::too_many_arguments)]
+fn subsurface_probe<'s>(
+    _: &Context,
+    ss: &'s Subsurface,
+    _: &Interaction,
+    _: Vec3,
+    _: &mut Vec3,
+    _: &mut SampleRng,
+    _: &mut Scratch,
+    _: &mut Counters,
+    _: u32,
+) -> Scatter<'s> {
+    match *ss {}
 }

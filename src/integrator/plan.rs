@@ -1,7 +1,6 @@
 //! What a scene needs simulated, decided once before rendering, so a scene
 //! without lights, environment or subsurface materials pays nothing for them.
 
-use crate::materials::Material;
 use crate::scene::Scene;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,7 +24,7 @@ impl Plan {
             subsurface: scene
                 .objects
                 .iter()
-                .any(|o| matches!(scene.materials[o.material], Material::Subsurface(_))),
+                .any(|o| scene.materials[o.material].is_subsurface()),
         }
     }
 }
