@@ -916,6 +916,12 @@ fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3
 /// power heuristic against lobe sampling of the same direction; and the
 /// light triangle it sampled ([`aov::NO_LIGHT`] when none). (A plain index,
 /// not a [`Source`]: the pair then still fits in two registers.)
+///
+/// The lobe is matched once here, not in both its `eval` and its `pdf`: the
+/// diffuse lobe (every vertex of a diffuse scene) gets an instance of its
+/// own, so a scene without subsurface materials executes what a build
+/// without the `subsurface` feature does (docs/performance.md, "Zero cost
+/// for what is off").
 fn direct_lighting(
     ctx: &Context,
     v: &Vertex,
@@ -926,6 +932,37 @@ fn direct_lighting(
     let Some(ls) = ctx.lights.sample(u_pick, [u0, u1]) else {
         return (Vec3::ZERO, aov::NO_LIGHT);
     };
+    match v.lobe {
+        Lobe::Diffuse(albedo) => light_sample(
+            ctx,
+            v,
+            &ls,
+            counters,
+            |wo, wi| diffuse::eval(albedo, wo, wi),
+            diffuse::pdf,
+        ),
+        _ => light_sample(
+            ctx,
+            v,
+            &ls,
+            counters,
+            |wo, wi| v.lobe.eval(wo, wi),
+            |wo, wi| v.lobe.pdf(wo, wi),
+        ),
+    }
+}
+
+/// [`direct_lighting`] of the light sample `ls`, with the lobe's `eval`
+/// and `pdf`.
+#[inline(always)]
+fn light_sample(
+    ctx: &Context,
+    v: &Vertex,
+    ls: &crate::lights::LightSample,
+    counters: &mut Counters,
+    eval: impl Fn(Vec3, Vec3) -> Vec3,
+    pdf: impl Fn(Vec3, Vec3) -> f32,
+) -> (Vec3, u32) {
     let source = ls.index;
     let to_light = ls.point - v.p;
     let dist2 = to_light.length_squared();
@@ -938,7 +975,7 @@ fn direct_lighting(
         return (Vec3::ZERO, source);
     }
     let wi_local = v.frame.to_local(wi);
-    let f = v.lobe.eval(v.wo_local, wi_local);
+    let f = eval(v.wo_local, wi_local);
     if f == Vec3::ZERO {
         return (Vec3::ZERO, source);
     }
@@ -953,7 +990,7 @@ fn direct_lighting(
     {
         return (Vec3::ZERO, source);
     }
-    let w = power(pdf_light, v.lobe.pdf(v.wo_local, wi_local));
+    let w = power(pdf_light, pdf(v.wo_local, wi_local));
     (f * ls.radiance * (wi_local.z.abs() * w / pdf_light), source)
 }
 
