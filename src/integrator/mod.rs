@@ -10,6 +10,8 @@
 //! materials, selected with [`IntegratorKind`]; [`diffuse_boundary`] is
 //! its optional diffuse Fresnel boundary model. [`aov`] records what the
 //! passes (light paths, light groups, data, ID coverage) measure.
+//! `probe`, `randomwalk` and `diffuse_boundary` exist only with the
+//! `subsurface` feature (the default).
 
 pub mod aov;
 #[cfg(feature = "subsurface")]
