@@ -2,8 +2,8 @@
 # The whole test suite, from a fresh Debian 12 machine: installs what is
 # missing, checks formatting, lints and rust-version, runs every test with
 # the default features (Embree 3, Embree 4 and our BVH, compared), then the BVH tests on
-# its portable (non-SSE) path, and lints and tests the BVH-only build
-# (`--no-default-features`) too.
+# its portable (non-SSE) path, and lints and tests the build with no default
+# feature (`--no-default-features`: our BVH only, no subsurface support) too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -40,8 +40,11 @@ cargo test --lib --test bvh_brute_force --features bvh-portable
 
 # Same target dir: only lucent itself is rebuilt, the dependencies are
 # reused. The library's own tests, and the command-line tests whose
-# expectations depend on the backends the binary has (`info`, `--accel
-# embree` refused with exit 2); the Embree tests are not built here
-# (required-features), the rest test our BVH exactly as above.
-echo "--- BVH-only build (--no-default-features) ---"
-cargo test --no-default-features --lib --test cli --test bench_cli
+# expectations depend on the features the binary has (`info`, `--accel
+# embree` refused with exit 2, a subsurface scene refused with exit 2); the
+# Embree and subsurface tests are not built here (required-features), the
+# rest test our BVH exactly as above. One build turns off both features:
+# no code depends on the two together, so the default build and this one
+# compile every gated item both ways (the cheapest addition: no third build).
+echo "--- No default features: BVH only, no subsurface (--no-default-features) ---"
+cargo test --no-default-features --lib --test cli --test bench_cli --test subsurface_feature

@@ -7,6 +7,7 @@
 //! live apart in [`tools`]; the renderer modules never use them.
 
 pub mod accel;
+#[cfg(feature = "subsurface")]
 pub mod bssrdf;
 pub mod error;
 pub mod farm;

@@ -8,8 +8,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
+#[cfg(feature = "subsurface")]
 use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
-use lucent::error::{InputError, Param, ParamError};
+use lucent::error::InputError;
+#[cfg(feature = "subsurface")]
+use lucent::error::{Param, ParamError};
 use lucent::farm::part::{self, Identity};
 use lucent::film::cryptomatte;
 use lucent::film::exr_layers::{
@@ -19,6 +22,7 @@ use lucent::film::passes::PassSet;
 use lucent::film::region::Region;
 use lucent::film::ToneMap;
 use lucent::integrator::{effects, plan, IntegratorKind};
+#[cfg(feature = "subsurface")]
 use lucent::materials::{LodMode, SubsurfaceOverrides, WalkBoundary};
 use lucent::render::{self, RenderOptions};
 use lucent::scene;
@@ -38,6 +42,7 @@ struct Cli {
 #[derive(Clone, Copy, ValueEnum)]
 enum IntegratorArg {
     Path,
+    #[cfg(feature = "subsurface")]
     Randomwalk,
 }
 
@@ -161,6 +166,7 @@ enum Command {
     /// Measure error against time for every sampling choice of the
     /// subsurface estimator: results.csv, plots and report.md in the output
     /// directory (resumes from results.csv; see src/tools/study/mod.rs).
+    #[cfg(feature = "subsurface")]
     Study(StudyArgs),
 }
 
@@ -222,6 +228,7 @@ fn parse_checkpoint(s: &str) -> Result<f64, String> {
 
 /// Subsurface sampling choices that override every subsurface material's
 /// own (see docs/scene-format.md for what each means).
+#[cfg(feature = "subsurface")]
 #[derive(clap::Args)]
 struct SubsurfaceArgs {
     /// Radius sampler: uniform | table[:N] | table-uniform[:N] | analytic | mixture.
@@ -331,6 +338,7 @@ enum ExplainArg {
     Json,
 }
 
+#[cfg(feature = "subsurface")]
 #[derive(Clone, Copy, ValueEnum)]
 enum LodArg {
     Auto,
@@ -338,12 +346,14 @@ enum LodArg {
     Force,
 }
 
+#[cfg(feature = "subsurface")]
 #[derive(Clone, Copy, ValueEnum)]
 enum BoundaryArg {
     Dielectric,
     Diffuse,
 }
 
+#[cfg(feature = "subsurface")]
 #[derive(Clone, Copy, ValueEnum)]
 enum AxesArg {
     Curvature,
@@ -351,12 +361,14 @@ enum AxesArg {
     Mis3,
 }
 
+#[cfg(feature = "subsurface")]
 #[derive(Clone, Copy, ValueEnum)]
 enum ChannelArg {
     Single,
     Mis,
 }
 
+#[cfg(feature = "subsurface")]
 fn parse_radius(s: &str) -> Result<RadiusSampler, ParamError> {
     RadiusSampler::parse(s)
 }
@@ -365,7 +377,16 @@ fn parse_aov(s: &str) -> Result<PassSet, String> {
     PassSet::parse_list(s).map_err(|e| e.problem())
 }
 
+#[cfg(feature = "subsurface")]
 impl SubsurfaceArgs {
+    /// Applies the overrides to every subsurface material of `materials`;
+    /// returns them as the render's identity records them.
+    fn apply(&self, materials: &mut [lucent::materials::Material]) -> Result<String, Error> {
+        let o = self.overrides();
+        o.apply_all(materials).map_err(option_error)?;
+        Ok(format!("{o:?}"))
+    }
+
     fn overrides(&self) -> SubsurfaceOverrides {
         SubsurfaceOverrides {
             radius: self.radius,
@@ -393,6 +414,19 @@ impl SubsurfaceArgs {
                 LodArg::Force => LodMode::Force,
             }),
         }
+    }
+}
+
+/// A build without the `subsurface` feature has no subsurface materials,
+/// and so no options that override them.
+#[cfg(not(feature = "subsurface"))]
+#[derive(clap::Args)]
+struct SubsurfaceArgs {}
+
+#[cfg(not(feature = "subsurface"))]
+impl SubsurfaceArgs {
+    fn apply(&self, _: &mut [lucent::materials::Material]) -> Result<String, Error> {
+        Ok(String::new())
     }
 }
 
@@ -425,6 +459,7 @@ fn main() -> ExitCode {
                 .unwrap_or_else(Backend::default_available);
             let integrator = match integrator {
                 IntegratorArg::Path => IntegratorKind::Path,
+                #[cfg(feature = "subsurface")]
                 IntegratorArg::Randomwalk => IntegratorKind::RandomWalk,
             };
             let opts = RenderOptions {
@@ -436,13 +471,7 @@ fn main() -> ExitCode {
                 stats,
             };
             if let Some(format) = explain {
-                return finish(run_explain(
-                    &scene,
-                    integrator,
-                    aov,
-                    &subsurface.overrides(),
-                    format,
-                ));
+                return finish(run_explain(&scene, integrator, aov, &subsurface, format));
             }
             file.settings().and_then(|file| {
                 run_render(
@@ -451,7 +480,7 @@ fn main() -> ExitCode {
                     backend,
                     &opts,
                     aov,
-                    &subsurface.overrides(),
+                    &subsurface,
                     &file,
                     &split,
                     Preview { tonemap, exposure },
@@ -466,6 +495,7 @@ fn main() -> ExitCode {
             exposure,
             quiet,
         } => run_merge(&parts, &output, tonemap, exposure, quiet),
+        #[cfg(feature = "subsurface")]
         Command::Study(args) => run_study(args),
         Command::Bench(args) => run_bench(args),
         Command::Info => {
@@ -513,6 +543,7 @@ fn exit_code(e: &Error) -> u8 {
 
 /// A subsurface override from the command line out of its domain, named by
 /// its option.
+#[cfg(feature = "subsurface")]
 fn option_error(e: ParamError) -> Error {
     let (argument, problem) = match e.param {
         Param::RmaxQuantile => ("--rmax-quantile", e.problem()),
@@ -565,7 +596,7 @@ fn run_render(
     backend: Backend,
     opts: &RenderOptions,
     aov: Option<PassSet>,
-    overrides: &SubsurfaceOverrides,
+    subsurface: &SubsurfaceArgs,
     file: &scene::OutputSettings,
     split: &SplitArgs,
     preview: Preview,
@@ -587,9 +618,7 @@ fn run_render(
     let mut scene = scene::load(scene_path)?;
     let scene_bytes = scene::load::read_regular_file(scene_path, scene::load::MAX_SCENE_BYTES)
         .map_err(|e| InputError::new(scene_path, format!("cannot read scene file: {e}")))?;
-    overrides
-        .apply_all(&mut scene.materials)
-        .map_err(option_error)?;
+    let overrides = subsurface.apply(&mut scene.materials)?;
     let (w, h) = (scene.camera.width, scene.camera.height);
     let spp = opts.spp.unwrap_or(scene.settings.spp);
     let region = match (split.crop, split.tile) {
@@ -628,7 +657,7 @@ fn run_render(
         seed: opts.seed.unwrap_or(scene.settings.seed),
         spp,
         options: format!(
-            "accel={} integrator={:?} {overrides:?}",
+            "accel={} integrator={:?} {overrides}",
             backend.name(),
             opts.integrator
         ),
@@ -730,13 +759,11 @@ fn run_explain(
     scene_path: &Path,
     integrator: IntegratorKind,
     aov: Option<PassSet>,
-    overrides: &SubsurfaceOverrides,
+    subsurface: &SubsurfaceArgs,
     format: ExplainArg,
 ) -> Result<(), Error> {
     let mut scene = scene::load(scene_path)?;
-    overrides
-        .apply_all(&mut scene.materials)
-        .map_err(option_error)?;
+    subsurface.apply(&mut scene.materials)?;
     let plan = render_plan(&scene, integrator, aov.unwrap_or(scene.output.aovs));
     match format {
         ExplainArg::Text => print!("{}", plan::text::render(&plan)),
@@ -786,7 +813,9 @@ fn frame_header(
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect();
+    #[cfg_attr(not(feature = "subsurface"), allow(unused_mut))]
     let mut sampling = Vec::new();
+    #[cfg(feature = "subsurface")]
     for (i, m) in scene.materials.iter().enumerate() {
         let lucent::materials::Material::Subsurface(ss) = m else {
             continue;
@@ -812,6 +841,7 @@ fn frame_header(
         integrator: Some(
             match opts.integrator {
                 IntegratorKind::Path => "path",
+                #[cfg(feature = "subsurface")]
                 IntegratorKind::RandomWalk => "randomwalk",
             }
             .into(),
@@ -945,6 +975,7 @@ fn report_rejected_rays(accel: &dyn accel::Accel) {
     }
 }
 
+#[cfg(feature = "subsurface")]
 #[derive(clap::Args)]
 struct StudyArgs {
     /// The scene description (TOML; needs a subsurface material).
@@ -986,15 +1017,18 @@ struct StudyArgs {
     quiet: bool,
 }
 
+#[cfg(feature = "subsurface")]
 fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, String> {
     lucent::tools::study::config::parse_integrator(s)
         .ok_or_else(|| format!("expected diffusion or randomwalk, found \"{s}\""))
 }
 
+#[cfg(feature = "subsurface")]
 fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, String> {
     lucent::tools::study::Axis::parse(s).ok_or_else(|| format!("unknown axis \"{s}\""))
 }
 
+#[cfg(feature = "subsurface")]
 fn run_study(a: StudyArgs) -> Result<(), Error> {
     use lucent::tools::study;
     let out = a.output.clone().unwrap_or_else(|| {
@@ -1149,5 +1183,10 @@ fn info() -> String {
             s.push_str(&format!(" ({})", b.name()));
         }
     }
+    s.push_str(if cfg!(feature = "subsurface") {
+        "\nsubsurface: yes"
+    } else {
+        "\nsubsurface: no (built without the `subsurface` feature)"
+    });
     s
 }

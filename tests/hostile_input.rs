@@ -449,6 +449,7 @@ fn a_film_that_cannot_be_allocated_is_an_error_not_an_abort() {
 
 // --- (4) bench and study leave their output directory as it was
 
+#[cfg(feature = "subsurface")]
 #[test]
 fn a_study_refuses_a_directory_it_cannot_resume_before_writing_in_it() {
     let dir = tempfile::tempdir().unwrap();

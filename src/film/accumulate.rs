@@ -115,10 +115,13 @@ impl FixedPoint {
         // integer-valued and |v| ≤ 2^95, converted exactly without the
         // slow f64 → i128 library call: hi = v truncated to a multiple of
         // 2^48 (|hi| ≤ 2^47), lo = v − hi·2^48 (exact: the low bits of v,
-        // |lo| < 2^48); both fit an i64
-        let hi = (v * (2f64).powi(-48)).trunc();
-        let lo = v - hi * (2f64).powi(48);
-        (((hi as i64 as i128) << 48) + lo as i64 as i128, clamped)
+        // |lo| < 2^48); both fit an i64. The cast truncates towards zero
+        // (one cvttsd2si; f64::trunc is a library call on x86-64 without
+        // SSE4.1, 19 instructions a channel: docs/performance.md, "Zero
+        // cost for what is off").
+        let hi = (v * (2f64).powi(-48)) as i64;
+        let lo = v - hi as f64 * (2f64).powi(48);
+        (((hi as i128) << 48) + lo as i64 as i128, clamped)
     }
 
     /// The mean of `n` samples whose terms sum to `sum`, as f32 (0 when n

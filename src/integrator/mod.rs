@@ -11,14 +11,19 @@
 //! its optional diffuse Fresnel boundary model. [`aov`] records what the
 //! passes (light paths, light groups, data, ID coverage) measure.
 //! [`effects`] counts ray queries and time per effect for `--stats`.
+//! `probe`, `randomwalk` and `diffuse_boundary` exist only with the
+//! `subsurface` feature (the default).
 
 pub mod aov;
+#[cfg(feature = "subsurface")]
 pub mod diffuse_boundary;
 pub mod effects;
 pub mod interaction;
 pub mod path;
 pub mod plan;
+#[cfg(feature = "subsurface")]
 pub mod probe;
+#[cfg(feature = "subsurface")]
 pub mod randomwalk;
 
 use crate::accel::Accel;
@@ -107,7 +112,9 @@ pub enum IntegratorKind {
     /// [`path::radiance`]: the diffusion BSSRDF sampled with probe rays.
     #[default]
     Path,
-    /// [`randomwalk::radiance`]: a volumetric random walk in the medium.
+    /// [`randomwalk::radiance`]: a volumetric random walk in the medium
+    /// (only with the `subsurface` feature).
+    #[cfg(feature = "subsurface")]
     RandomWalk,
 }
 
@@ -125,6 +132,7 @@ impl IntegratorKind {
     ) -> crate::geometry::Vec3 {
         match self {
             IntegratorKind::Path => path::radiance::<R, T>(ctx, ray, rng, scratch, counters, rec),
+            #[cfg(feature = "subsurface")]
             IntegratorKind::RandomWalk => {
                 randomwalk::radiance::<R, T>(ctx, ray, rng, scratch, counters, rec)
             }

@@ -65,18 +65,34 @@
 
 use super::aov::{self, Event, Recorder, Source};
 use super::interaction::offset_along;
+#[cfg(feature = "subsurface")]
 use super::probe::{entry_on_segment, exit_curvature, ProbeTarget};
 use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::ProbeHits;
+#[cfg(feature = "subsurface")]
 use crate::bssrdf::curvature_correction::{mean_curvature, CurvatureCorrection, ExitFactor};
+#[cfg(feature = "subsurface")]
 use crate::bssrdf::{ProbeRandoms, ProbeSegment};
 use crate::film::passes::Pass;
-use crate::fresnel;
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::materials::lod::Cone;
-use crate::materials::microfacet::RoughCoat;
-use crate::materials::{dielectric, diffuse, Material, Subsurface};
-use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power, Draw, SampleRng};
+use crate::materials::{dielectric, diffuse, Material};
+#[cfg(feature = "subsurface")]
+use crate::materials::{microfacet::RoughCoat, Subsurface};
+use crate::sampling::{power, Draw, SampleRng};
+#[cfg(feature = "subsurface")]
+use crate::{
+    fresnel,
+    sampling::{cosine_hemisphere, cosine_hemisphere_pdf},
+};
+
+/// A build without the `subsurface` feature has no subsurface material:
+/// the bounce loop's handler of subsurface hits takes this uninhabited
+/// type, so it can never be called, and the compiler drops it and every
+/// path through it (docs/performance.md, "Zero cost for what is off").
+#[cfg(not(feature = "subsurface"))]
+#[derive(Clone, Copy)]
+pub(crate) enum Subsurface {}
 
 /// Bounces after which Russian roulette may end a path.
 pub(crate) const RR_START: u32 = 3;
@@ -93,6 +109,7 @@ pub(crate) const RR_START: u32 = 3;
 /// and each split level adds a path. Splitting the rough coat as well (its
 /// reflection sampled every time, besides next-event estimation) lowered
 /// relMSE by 8–10 % for 24 % more rays, a loss, so it chooses.
+#[cfg(feature = "subsurface")]
 pub(crate) const COAT_SPLIT_DEPTH: u32 = 1;
 
 /// Subsurface hits at depths below this sample two entry points from one
@@ -121,13 +138,21 @@ pub(crate) enum Lobe<'a> {
     Diffuse(Vec3),
     /// The entry-point lobe of a subsurface material (Sw or 1/π), outward
     /// side only; its spectral weight was already applied by the probe.
+    #[cfg(feature = "subsurface")]
     SubsurfaceEntry(&'a Subsurface),
     /// Where a random walk left the medium through a diffuse Fresnel
     /// boundary ([`super::diffuse_boundary::ExitLobe`]).
+    #[cfg(feature = "subsurface")]
     WalkExit(super::diffuse_boundary::ExitLobe),
     /// A subsurface material's rough coat at xo, sampled with probability
     /// `select` (its pdf, for MIS, is select × the visible-normal pdf).
+    #[cfg(feature = "subsurface")]
     Coat { coat: &'a RoughCoat, select: f32 },
+    /// Without the `subsurface` feature: no lobe (uninhabited), keeping
+    /// the lifetime the subsurface lobes borrow with.
+    #[cfg(not(feature = "subsurface"))]
+    #[allow(dead_code)]
+    Absent(&'a Subsurface),
 }
 
 impl Lobe<'_> {
@@ -135,41 +160,60 @@ impl Lobe<'_> {
     fn event(&self) -> Event {
         match self {
             Lobe::Diffuse(_) => Event::Diffuse,
+            #[cfg(feature = "subsurface")]
             Lobe::SubsurfaceEntry(_) | Lobe::WalkExit(_) => Event::Subsurface,
+            #[cfg(feature = "subsurface")]
             Lobe::Coat { .. } => Event::Specular,
+            #[cfg(not(feature = "subsurface"))]
+            Lobe::Absent(s) => match **s {},
         }
     }
     /// f(ωo, ωi) per steradian (ωo, ωi local; z > 0 is the lit side).
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             Lobe::Diffuse(albedo) => diffuse::eval(*albedo, wo, wi),
+            #[cfg(feature = "subsurface")]
             Lobe::SubsurfaceEntry(ss) => Vec3::splat(ss.lobe(wi.z)),
+            #[cfg(feature = "subsurface")]
             Lobe::WalkExit(exit) => Vec3::splat(exit.eval(wi)),
+            #[cfg(feature = "subsurface")]
             Lobe::Coat { coat, .. } => Vec3::splat(coat.eval(wo, wi)),
+            #[cfg(not(feature = "subsurface"))]
+            Lobe::Absent(s) => match **s {},
         }
     }
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             Lobe::Diffuse(_) => diffuse::pdf(wo, wi),
+            #[cfg(feature = "subsurface")]
             Lobe::SubsurfaceEntry(_) => cosine_hemisphere_pdf(wi.z),
+            #[cfg(feature = "subsurface")]
             Lobe::WalkExit(exit) => exit.pdf(wi),
+            #[cfg(feature = "subsurface")]
             Lobe::Coat { coat, select } => select * coat.pdf(wo, wi),
+            #[cfg(not(feature = "subsurface"))]
+            Lobe::Absent(s) => match **s {},
         }
     }
     /// Samples ωi; returns (ωi, f |cos| / pdf, pdf).
     pub(crate) fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<(Vec3, Vec3, f32)> {
         match self {
             Lobe::Diffuse(albedo) => diffuse::sample(*albedo, wo, u),
+            #[cfg(feature = "subsurface")]
             Lobe::SubsurfaceEntry(ss) => {
                 let wi = cosine_hemisphere(u);
                 let pdf = cosine_hemisphere_pdf(wi.z);
                 (pdf > 0.0).then(|| (wi, Vec3::splat(ss.lobe(wi.z) * wi.z / pdf), pdf))
             }
+            #[cfg(feature = "subsurface")]
             Lobe::WalkExit(exit) => exit.sample(u).map(|(wi, w, pdf)| (wi, Vec3::splat(w), pdf)),
+            #[cfg(feature = "subsurface")]
             Lobe::Coat { coat, select } => {
                 let (wi, w, pdf) = coat.sample(wo, u)?;
                 (*select > 0.0).then(|| (wi, Vec3::splat(w / select), select * pdf))
             }
+            #[cfg(not(feature = "subsurface"))]
+            Lobe::Absent(s) => match **s {},
         }
     }
 }
@@ -197,14 +241,17 @@ pub(crate) struct Vertex<'a> {
 pub(crate) enum Scatter<'a> {
     Vertex(Vertex<'a>),
     Continue(Ray, Event),
+    #[cfg(feature = "subsurface")]
     Absorbed,
     /// A subsurface hit under a coat ([`subsurface_probe`]).
+    #[cfg(feature = "subsurface")]
     Coated(Coated<'a>),
 }
 
 /// What a coated subsurface hit at xo turns into: the coat's lobe at xo
 /// (next-event estimation there), a path the coat reflected, and the
 /// entry vertex xi where this path goes on.
+#[cfg(feature = "subsurface")]
 pub(crate) struct Coated<'a> {
     /// The rough coat's vertex at xo and the throughput light sampled
     /// there is weighted by (β before the hit).
@@ -224,6 +271,7 @@ pub(crate) struct Coated<'a> {
 
 /// A ray the coat reflected: the ray, its throughput, and the vertex and
 /// lobe pdf it was sampled with (None for the mirror).
+#[cfg(feature = "subsurface")]
 pub(crate) type Reflected = (Ray, Vec3, Option<(Vec3, f32)>);
 
 /// A path to trace: its ray, throughput, the last non-specular vertex and
@@ -249,6 +297,7 @@ struct Branches {
 
 impl Branches {
     /// false when full.
+    #[cfg(feature = "subsurface")]
     fn push(&mut self, b: Branch) -> bool {
         if self.len == MAX_BRANCHES {
             return false;
@@ -295,6 +344,7 @@ pub fn radiance<R: Recorder, T: Clock>(
 
 /// The bounce loop both integrators share; `subsurface` handles hits on
 /// subsurface objects (and may scale the throughput `beta`).
+#[cfg(feature = "subsurface")]
 pub(crate) fn trace<'s, R: Recorder, T: Clock>(
     ctx: &'s Context,
     camera_ray: Ray,
@@ -360,8 +410,10 @@ fn trace_at<'s, R: Recorder, T: Clock>(
 }
 
 /// One path from `start` until it ends; paths split off on the way are
-/// pushed on `stack`.
+/// pushed on `stack`. (Without the `subsurface` feature neither
+/// `subsurface` nor `stack` is used: no material calls for them.)
 #[inline(always)]
+#[cfg_attr(not(feature = "subsurface"), allow(unused_variables))]
 fn follow<'s, R: Recorder, T: Clock>(
     ctx: &'s Context,
     start: Branch,
@@ -451,6 +503,7 @@ fn follow<'s, R: Recorder, T: Clock>(
                 let (next, e) = dielectric_bounce(ctx, *eta, &si, wo, &mut beta, rng);
                 Scatter::Continue(next, e)
             }
+            #[cfg(feature = "subsurface")]
             Material::Subsurface(ss) => {
                 if R::ON {
                     rec.surface(ss.albedo(), si.shading_frame_facing(wo).n);
@@ -472,11 +525,13 @@ fn follow<'s, R: Recorder, T: Clock>(
         let (cone_specular, cone_rough) = (cone.specular(hit.t), cone.rough(hit.t));
         // Light sampled at the vertex counts this much (½ at an entry
         // point of an antithetic pair, whose twin is sampled too).
+        #[cfg_attr(not(feature = "subsurface"), allow(unused_mut))]
         let mut nee_scale = 1.0;
         // Borrowed, not moved out: the vertex stays where it was built.
         // At the first hit the path's class becomes that of what scattered;
         // the coat's reflections are specular.
         let first = R::ON && depth == 0;
+        #[cfg(feature = "subsurface")]
         let coat_event = if first { Event::Specular } else { event };
         let vertex = match &scatter {
             Scatter::Vertex(v) => {
@@ -497,7 +552,9 @@ fn follow<'s, R: Recorder, T: Clock>(
                 }
                 continue;
             }
+            #[cfg(feature = "subsurface")]
             Scatter::Absorbed => break,
+            #[cfg(feature = "subsurface")]
             Scatter::Coated(c) => {
                 if let (Some((v, b)), true) = (&c.coat, ctx.plan.area_lights) {
                     let t0 = T::now();
@@ -635,6 +692,7 @@ fn dielectric_bounce(
 /// medium weighted by 1 − Fr or 1 − E.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
+#[cfg(feature = "subsurface")]
 fn subsurface_probe<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
@@ -724,6 +782,7 @@ fn subsurface_probe<'s>(
 /// The smooth coat's reflection: the mirror direction about the shading
 /// normal, which keeps highlights smooth on tessellated meshes; where it
 /// would reflect below the surface the geometric normal is used instead.
+#[cfg(feature = "subsurface")]
 fn mirror(ctx: &Context, si: &Interaction, wo: Vec3, n_out: Vec3) -> Ray {
     let ns_out = if si.ns.dot(n_out) >= 0.0 {
         si.ns
@@ -741,6 +800,7 @@ fn mirror(ctx: &Context, si: &Interaction, wo: Vec3, n_out: Vec3) -> Ray {
 /// and (for the emission MIS weight) the vertex and the lobe's pdf; None
 /// when the sample is lost (below the microsurface or the geometric
 /// surface).
+#[cfg(feature = "subsurface")]
 fn coat_reflection(
     ctx: &Context,
     v: &Vertex,
@@ -764,6 +824,7 @@ fn coat_reflection(
 /// probe: the entry lobe at xo itself, weighted by the profile's plane
 /// integral ([`crate::materials::lod`]).
 #[allow(clippy::too_many_arguments)]
+#[cfg(feature = "subsurface")]
 fn entries<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
@@ -833,6 +894,7 @@ fn entries<'s>(
 /// scaled by the profile's plane integral A_plane and, on a convex surface
 /// with the curvature correction on, f(κo) — the full estimator's mean on
 /// a flat or spherical surface ([`crate::materials::lod`]).
+#[cfg(feature = "subsurface")]
 #[inline(never)]
 fn lod_entry<'s>(
     ctx: &Context,
@@ -860,6 +922,7 @@ fn lod_entry<'s>(
 
 /// What [`entries`] found as a [`Scatter`]: the entry vertex (with its
 /// pair's, if any), or the end of the path.
+#[cfg(feature = "subsurface")]
 fn entry_scatter<'s>(e: (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>)) -> Scatter<'s> {
     match e {
         (Some(v), None) => Scatter::Vertex(v),
@@ -878,6 +941,7 @@ fn entry_scatter<'s>(e: (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>)) -> Sca
 /// probe finds nothing. `exit`: the material's curvature correction and
 /// its exit half at xo, if it has one.
 #[allow(clippy::too_many_arguments)]
+#[cfg(feature = "subsurface")]
 fn probe_entry<'s>(
     ctx: &Context,
     ss: &'s Subsurface,
@@ -949,6 +1013,12 @@ fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3
 /// power heuristic against lobe sampling of the same direction; and the
 /// light triangle it sampled ([`aov::NO_LIGHT`] when none). (A plain index,
 /// not a [`Source`]: the pair then still fits in two registers.)
+///
+/// The lobe is matched once here, not in both its `eval` and its `pdf`: the
+/// diffuse lobe (every vertex of a diffuse scene) gets an instance of its
+/// own, so a scene without subsurface materials executes what a build
+/// without the `subsurface` feature does (docs/performance.md, "Zero cost
+/// for what is off").
 fn direct_lighting(
     ctx: &Context,
     v: &Vertex,
@@ -959,6 +1029,37 @@ fn direct_lighting(
     let Some(ls) = ctx.lights.sample(u_pick, [u0, u1]) else {
         return (Vec3::ZERO, aov::NO_LIGHT);
     };
+    match v.lobe {
+        Lobe::Diffuse(albedo) => light_sample(
+            ctx,
+            v,
+            &ls,
+            counters,
+            |wo, wi| diffuse::eval(albedo, wo, wi),
+            diffuse::pdf,
+        ),
+        _ => light_sample(
+            ctx,
+            v,
+            &ls,
+            counters,
+            |wo, wi| v.lobe.eval(wo, wi),
+            |wo, wi| v.lobe.pdf(wo, wi),
+        ),
+    }
+}
+
+/// [`direct_lighting`] of the light sample `ls`, with the lobe's `eval`
+/// and `pdf`.
+#[inline(always)]
+fn light_sample(
+    ctx: &Context,
+    v: &Vertex,
+    ls: &crate::lights::LightSample,
+    counters: &mut Counters,
+    eval: impl Fn(Vec3, Vec3) -> Vec3,
+    pdf: impl Fn(Vec3, Vec3) -> f32,
+) -> (Vec3, u32) {
     let source = ls.index;
     let to_light = ls.point - v.p;
     let dist2 = to_light.length_squared();
@@ -971,7 +1072,7 @@ fn direct_lighting(
         return (Vec3::ZERO, source);
     }
     let wi_local = v.frame.to_local(wi);
-    let f = v.lobe.eval(v.wo_local, wi_local);
+    let f = eval(v.wo_local, wi_local);
     if f == Vec3::ZERO {
         return (Vec3::ZERO, source);
     }
@@ -986,6 +1087,24 @@ fn direct_lighting(
     {
         return (Vec3::ZERO, source);
     }
-    let w = power(pdf_light, v.lobe.pdf(v.wo_local, wi_local));
+    let w = power(pdf_light, pdf(v.wo_local, wi_local));
     (f * ls.radiance * (wi_local.z.abs() * w / pdf_light), source)
+}
+
+/// Without the `subsurface` feature there are no subsurface hits.
+#[cfg(not(feature = "subsurface"))]
+#[allow(clippy::too_many_arguments)]
+fn subsurface_probe<'s>(
+    _: &Context,
+    ss: &'s Subsurface,
+    _: &Interaction,
+    _: Vec3,
+    _: &mut Vec3,
+    _: &mut SampleRng,
+    _: &mut Scratch,
+    _: &mut Counters,
+    _: u32,
+    _: f32,
+) -> Scatter<'s> {
+    match *ss {}
 }

@@ -6,13 +6,17 @@
 pub mod dielectric;
 pub mod diffuse;
 pub mod lod;
+#[cfg(feature = "subsurface")]
 pub mod microfacet;
+#[cfg(feature = "subsurface")]
 pub mod subsurface;
 
+#[cfg(feature = "subsurface")]
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
 pub use lod::LodMode;
+#[cfg(feature = "subsurface")]
 pub use subsurface::{CurvatureMode, Subsurface, SubsurfaceOverrides, WalkBoundary};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -22,6 +26,23 @@ pub enum Material {
     /// A smooth dielectric interface with relative index of refraction η
     /// (inside over outside): specular reflection and refraction.
     Dielectric { eta: f32 },
-    /// A dielectric boundary over a scattering medium: the Burley BSSRDF.
+    /// A dielectric boundary over a scattering medium: the Burley BSSRDF
+    /// (only with the `subsurface` feature).
+    #[cfg(feature = "subsurface")]
     Subsurface(Arc<Subsurface>),
+}
+
+impl Material {
+    /// Whether this is a subsurface material.
+    #[cfg(feature = "subsurface")]
+    pub fn is_subsurface(&self) -> bool {
+        matches!(self, Material::Subsurface(_))
+    }
+
+    /// Whether this is a subsurface material: never, in a build without
+    /// the `subsurface` feature.
+    #[cfg(not(feature = "subsurface"))]
+    pub fn is_subsurface(&self) -> bool {
+        false
+    }
 }

@@ -8,21 +8,31 @@
 //! the parameter (`sigma_s` is given as `sigma_s_prime`, `mfp` as `dmfp`,
 //! the radius sampler as `radius`).
 
+#[cfg(feature = "subsurface")]
 use std::sync::Arc;
 
 use super::checked::{Cx, Res};
-use super::format::{MaterialDef, MaterialKind, Spanned, Triple3};
+#[cfg(feature = "subsurface")]
+use super::format::Triple3;
+use super::format::{MaterialDef, MaterialKind, Spanned};
 use super::key_path::key_segment;
+#[cfg(feature = "subsurface")]
 use super::MAX_SUBSURFACE_RADIUS;
+#[cfg(feature = "subsurface")]
 use crate::bssrdf::{
     AlbedoSource, ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler,
     SubsurfaceParams,
 };
+#[cfg(feature = "subsurface")]
 use crate::error::{Constraint, InputError, Param, ParamError};
+#[cfg(feature = "subsurface")]
 use crate::materials::lod::DEFAULT_THRESHOLD;
-use crate::materials::{CurvatureMode, LodMode, Material, Subsurface, WalkBoundary};
+use crate::materials::Material;
+#[cfg(feature = "subsurface")]
+use crate::materials::{CurvatureMode, LodMode, Subsurface, WalkBoundary};
 
 /// The keys a `type = "subsurface"` material accepts.
+#[cfg(feature = "subsurface")]
 const SUBSURFACE_KEYS: &[&str] = &[
     "preset",
     "sigma_s_prime",
@@ -48,11 +58,13 @@ const SUBSURFACE_KEYS: &[&str] = &[
 ];
 
 /// The parameter forms, for messages.
+#[cfg(feature = "subsurface")]
 const FORMS: &str =
     "give exactly one of: `preset`; `sigma_s_prime` + `sigma_a` + `albedo`; `albedo` + `dmfp`";
 
 /// The material `name` (its table `m`), lengths in scene units given
 /// `units_per_mm`.
+#[cfg_attr(not(feature = "subsurface"), allow(unused_variables))]
 pub(super) fn material(
     cx: &Cx,
     name: &str,
@@ -62,9 +74,8 @@ pub(super) fn material(
 ) -> Res<Material> {
     let field = format!("materials.{}", key_segment(name));
     let d = m.get_ref();
-    let kind = *cx
-        .required(&d.kind, Some(m.span()), &format!("{field}.type"))?
-        .get_ref();
+    let kind_def = cx.required(&d.kind, Some(m.span()), &format!("{field}.type"))?;
+    let kind = *kind_def.get_ref();
     let missing = |key: &str| {
         cx.err(
             m.span(),
@@ -90,6 +101,15 @@ pub(super) fn material(
                 eta: cx.positive(e, &format!("{field}.eta"))?,
             })
         }
+        // Refused where the type is named: nothing of the material is read.
+        #[cfg(not(feature = "subsurface"))]
+        MaterialKind::Subsurface => Err(cx.err(
+            kind_def.span(),
+            &format!("{field}.type"),
+            "this build of lucent has no subsurface support: built without the `subsurface` \
+             feature",
+        )),
+        #[cfg(feature = "subsurface")]
         MaterialKind::Subsurface => {
             cx.only_keys(&field, kind.name(), d.present_keys(), SUBSURFACE_KEYS)?;
             let mut ss = Subsurface::new(
@@ -157,6 +177,7 @@ pub(super) fn material(
 /// range (the scale made it too large), else the material's length key:
 /// `dmfp`, `sigma_a` (a small coefficient is a long path), the preset, or
 /// `rmax_quantile` when that is given.
+#[cfg(feature = "subsurface")]
 fn check_rmax(
     cx: &Cx,
     field: &str,
@@ -214,10 +235,12 @@ fn check_rmax(
 }
 
 /// A boolean option, true when absent.
+#[cfg(feature = "subsurface")]
 fn flag(b: &Option<Spanned<bool>>) -> bool {
     b.as_ref().map(|b| *b.get_ref()).unwrap_or(true)
 }
 
+#[cfg(feature = "subsurface")]
 fn text(v: &Option<Spanned<String>>) -> Option<(&str, std::ops::Range<usize>)> {
     v.as_ref().map(|s| (s.get_ref().as_str(), s.span()))
 }
@@ -225,6 +248,7 @@ fn text(v: &Option<Spanned<String>>) -> Option<(&str, std::ops::Range<usize>)> {
 /// The scene key of the material table `m` that holds bssrdf parameter
 /// `p`, with its span; None for derived values (d, rmax) and for
 /// `units_per_mm`, which is not a material key.
+#[cfg(feature = "subsurface")]
 fn key_of(p: Param, m: &Spanned<MaterialDef>) -> Option<(&'static str, std::ops::Range<usize>)> {
     let key = match p {
         Param::Albedo => "albedo",
@@ -249,6 +273,7 @@ fn key_of(p: Param, m: &Spanned<MaterialDef>) -> Option<(&'static str, std::ops:
 /// `e` located at the key of material `field` (table `m`) that holds the
 /// parameter, and named as that key; at the table itself for derived
 /// values.
+#[cfg(feature = "subsurface")]
 fn locate_param(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, e: &ParamError) -> InputError {
     match key_of(e.param, m) {
         Some((key, span)) => {
@@ -266,6 +291,7 @@ fn locate_param(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, e: &ParamError) 
 /// Rejects keys of two parameter forms together: names the first key of
 /// each, at the later one's line (`albedo` belongs to the measured and the
 /// artist form).
+#[cfg(feature = "subsurface")]
 fn one_form(cx: &Cx, field: &str, m: &Spanned<MaterialDef>) -> Res<()> {
     let present = m.get_ref().present_keys();
     let span_of = |k: &str| {
@@ -293,6 +319,7 @@ fn one_form(cx: &Cx, field: &str, m: &Spanned<MaterialDef>) -> Res<()> {
 }
 
 /// A triple checked as f32 and kept as written (no 1.2000000476837158).
+#[cfg(feature = "subsurface")]
 fn triple(cx: &Cx, field: &str, v: &Option<Spanned<Triple3>>, k: &str) -> Res<Option<[f64; 3]>> {
     v.as_ref()
         .map(|t| cx.vec3(t, &format!("{field}.{k}")).map(|_| t.get_ref().0))
@@ -301,6 +328,7 @@ fn triple(cx: &Cx, field: &str, v: &Option<Spanned<Triple3>>, k: &str) -> Res<Op
 
 /// The medium parameters of a subsurface material, from whichever of the
 /// three forms its table uses.
+#[cfg(feature = "subsurface")]
 fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res<SubsurfaceParams> {
     let d = m.get_ref();
     let f = |k: &str| format!("{field}.{k}");
@@ -373,6 +401,7 @@ fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res
 /// The measured form as given in a scene: σs' (reduced), σa, g, A, η.
 /// g and σs' as written are checked here, before σs = σs'/(1 − g) (g = 1
 /// would make that infinite), so that the loader's σs(1 − g) is σs' again.
+#[cfg(feature = "subsurface")]
 fn measured(
     sigma_s_prime: [f64; 3],
     sigma_a: [f64; 3],
@@ -402,6 +431,7 @@ fn measured(
 
 /// The sampling options of a subsurface material (defaults for the keys it
 /// does not give).
+#[cfg(feature = "subsurface")]
 fn sampling_options(cx: &Cx, field: &str, m: &Spanned<MaterialDef>) -> Res<ProbeOptions> {
     let d = m.get_ref();
     let f = |k: &str| format!("{field}.{k}");

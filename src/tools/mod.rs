@@ -19,7 +19,10 @@
 //! it and names the offending file and line.
 
 pub mod bench;
+#[cfg(feature = "subsurface")]
 pub mod halfspace;
 pub mod plot;
+#[cfg(feature = "subsurface")]
 pub mod sphere_albedo;
+#[cfg(feature = "subsurface")]
 pub mod study;

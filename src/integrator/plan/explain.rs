@@ -26,13 +26,21 @@
 //! zero throughput after the first scattering event, and flights are chosen
 //! by throughput, so none is spent on it after that.
 
+// Without subsurface support the per-material plan has only surface
+// materials: the channel helpers and the mutable collections go unused.
+#![cfg_attr(not(feature = "subsurface"), allow(unused_mut, dead_code))]
+
 use serde::{Deserialize, Serialize};
 
 use super::{emits, Plan};
 use crate::film::passes::PassSet;
-use crate::integrator::path::{COAT_SPLIT_DEPTH, PAIR_DEPTH, RR_START};
+#[cfg(feature = "subsurface")]
+use crate::integrator::path::COAT_SPLIT_DEPTH;
+use crate::integrator::path::{PAIR_DEPTH, RR_START};
 use crate::integrator::IntegratorKind;
-use crate::materials::{Material, Subsurface, WalkBoundary};
+use crate::materials::Material;
+#[cfg(feature = "subsurface")]
+use crate::materials::{Subsurface, WalkBoundary};
 use crate::scene::Scene;
 
 /// The version of the JSON schema.
@@ -188,6 +196,7 @@ impl Explanation {
     /// The plan of `scene` rendered with `opts`.
     pub fn new(scene: &Scene, opts: &PlanOptions) -> Self {
         let flags = Plan::new(scene);
+        #[cfg(feature = "subsurface")]
         let walk = opts.integrator == IntegratorKind::RandomWalk;
         let users = |i: usize| -> Vec<String> {
             scene
@@ -257,7 +266,7 @@ impl Explanation {
 
         let mut specular_materials = Vec::new();
         let mut specular_why = Vec::new();
-        let mut probes_needed = Vec::new();
+        let mut probes_needed: Vec<String> = Vec::new();
         let mut materials = Vec::new();
         for (i, m) in scene.materials.iter().enumerate() {
             let objects = users(i);
@@ -268,6 +277,7 @@ impl Explanation {
                 kind: match m {
                     Material::Diffuse { .. } => "diffuse",
                     Material::Dielectric { .. } => "dielectric",
+                    #[cfg(feature = "subsurface")]
                     Material::Subsurface(_) => "subsurface",
                 }
                 .into(),
@@ -282,11 +292,13 @@ impl Explanation {
                     specular_materials.push(mname.clone());
                     specular_why.push(format!("{mname}: Fresnel reflection or refraction"));
                 }
-                Material::Subsurface(ss) if !used => {
+                #[cfg(feature = "subsurface")]
+                Material::Subsurface(_) if !used => {
                     mp.subsurface = vec![SubsurfaceMethod::None {
                         reason: "no object uses it".into(),
                     }];
                 }
+                #[cfg(feature = "subsurface")]
                 Material::Subsurface(ss) if walk => {
                     walk_material(ss, &mut mp);
                     if ss.boundary == WalkBoundary::Dielectric && ss.params.medium.is_some() {
@@ -294,6 +306,7 @@ impl Explanation {
                         specular_why.push(format!("{mname}: the walk's dielectric boundary"));
                     }
                 }
+                #[cfg(feature = "subsurface")]
                 Material::Subsurface(ss) => {
                     let active = diffusion_material(ss, opts.pair_depth, &mut mp);
                     if active {
@@ -324,7 +337,11 @@ impl Explanation {
             },
             materials: specular_materials,
         };
-        let probe_queries = if walk {
+        #[cfg(feature = "subsurface")]
+        let walk_off = walk;
+        #[cfg(not(feature = "subsurface"))]
+        let walk_off = false;
+        let probe_queries = if walk_off {
             choice("off", "random-walk integrator: no probe rays")
         } else if probes_needed.is_empty() {
             choice(
@@ -359,6 +376,7 @@ impl Explanation {
             schema: SCHEMA,
             integrator: match opts.integrator {
                 IntegratorKind::Path => "path",
+                #[cfg(feature = "subsurface")]
                 IntegratorKind::RandomWalk => "randomwalk",
             }
             .into(),
@@ -400,6 +418,7 @@ fn channels(active: [bool; 3], reason: impl Into<String>) -> Channels {
 
 /// A used subsurface material under the diffusion estimator; whether it
 /// has an active channel (and so casts probes).
+#[cfg(feature = "subsurface")]
 fn diffusion_material(ss: &Subsurface, pair_depth: u32, mp: &mut MaterialPlan) -> bool {
     let o = ss.probe.options();
     let active: [bool; 3] = std::array::from_fn(|c| ss.params.active(c));
@@ -486,6 +505,7 @@ fn diffusion_material(ss: &Subsurface, pair_depth: u32, mp: &mut MaterialPlan) -
 }
 
 /// A used subsurface material under the random walk.
+#[cfg(feature = "subsurface")]
 fn walk_material(ss: &Subsurface, mp: &mut MaterialPlan) {
     let Some(medium) = ss.params.medium else {
         mp.subsurface = vec![SubsurfaceMethod::None {

@@ -17,7 +17,6 @@
 pub mod explain;
 pub mod text;
 
-use crate::materials::Material;
 use crate::scene::Scene;
 
 pub use explain::{Explanation, PlanOptions};
@@ -41,7 +40,7 @@ impl Plan {
             subsurface: scene
                 .objects
                 .iter()
-                .any(|o| matches!(scene.materials[o.material], Material::Subsurface(_))),
+                .any(|o| scene.materials[o.material].is_subsurface()),
         }
     }
 }

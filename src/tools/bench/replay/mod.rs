@@ -123,5 +123,6 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
     })
 }
 
-#[cfg(test)]
+// Their scene (tests/fixtures/marble-ball.toml) has a subsurface material.
+#[cfg(all(test, feature = "subsurface"))]
 mod tests;
