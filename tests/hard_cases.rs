@@ -1008,3 +1008,38 @@ fn documented_subsurface_examples_load_and_render() {
     }
     assert!(n >= 1, "no subsurface example in docs/scene-format.md");
 }
+
+/// An emitter brighter than the accumulator's range (|x| ≤ 2^31,
+/// `film::accumulate`) in every pixel: each pixel is the clamp value, and
+/// every sample channel is counted as clamped, summed over all tiles and
+/// threads (the render summary reports the count).
+#[test]
+fn radiance_beyond_the_accumulator_range_is_clamped_and_counted() {
+    let (w, h, spp) = (40u32, 24u32, 3u64);
+    let s = load_str(
+        &format!(
+            "[camera]\nlook_from = [0, 0, 4]\nlook_at = [0, 0, 0]\nresolution = [{w}, {h}]\n\
+             [render]\nspp = {spp}\nseed = 1\nmax_depth = 1\n\
+             [materials.lamp]\ntype = \"diffuse\"\nalbedo = [0, 0, 0]\n\
+             [[shapes]]\nname = \"sun\"\ntype = \"quad\"\nmaterial = \"lamp\"\n\
+             emission = [1e10, 1e10, 1e10]\nscale = 4\n"
+        ),
+        Path::new("clamp.toml"),
+    )
+    .unwrap();
+    for threads in [1, 2] {
+        let a = accel::build(&s.meshes, Backend::Bvh).unwrap();
+        let opts = RenderOptions {
+            threads: Some(threads),
+            ..Default::default()
+        };
+        let (film, stats) = render(&s, a.as_ref(), &opts).unwrap();
+        let clamp = 2f32.powi(31);
+        assert!(
+            film.pixels.iter().all(|p| *p == Vec3::splat(clamp)),
+            "every pixel sees the emitter, clamped to 2^31"
+        );
+        assert_eq!(stats.counters.clamped, w as u64 * h as u64 * spp * 3);
+        assert_eq!(stats.counters.nonfinite, 0);
+    }
+}

@@ -560,6 +560,35 @@ impl SubsurfaceParams {
 mod tests {
     use super::*;
 
+    /// Lengths carry the scene's unit, so scaling every given length by k
+    /// scales every coefficient by 1/k — the zero-length channel's
+    /// optically thick stand-in included (it is tied to the shortest given
+    /// length, not to the unit).
+    #[test]
+    fn the_artist_medium_scales_with_its_lengths_zero_length_channel_included() {
+        let albedo = [0.6, 0.4, 0.2];
+        let mfp = [0.5, 0.0, 2.0];
+        for volume_mfp in [false, true] {
+            let m = Medium::from_reflectance(albedo, mfp, 1.3, volume_mfp, AlbedoSource::Table);
+            // the zero-length channel absorbs only, far denser than the rest
+            assert_eq!(m.sigma_s[1], 0.0);
+            assert!(m.sigma_a[1] >= 1e5 * (m.sigma_s[0] + m.sigma_a[0]));
+            for k in [1e-3, 0.25, 40.0] {
+                let scaled = mfp.map(|l| l * k);
+                let mk =
+                    Medium::from_reflectance(albedo, scaled, 1.3, volume_mfp, AlbedoSource::Table);
+                for c in 0..3 {
+                    for (a, b) in [(m.sigma_s[c], mk.sigma_s[c]), (m.sigma_a[c], mk.sigma_a[c])] {
+                        assert!(
+                            (b * k - a).abs() <= 1e-12 * a.abs(),
+                            "channel {c}, k {k}: {a} vs {b}·k"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn presets_are_complete_and_case_insensitive() {
         assert_eq!(PRESETS.len(), 12);
