@@ -19,8 +19,10 @@
 //! dark side (the rest). Each region's share is its part of the whole
 //! figure. `--map` writes σ²/(R² + ε) per pixel and channel as an EXR.
 //! The time is the wall time of the samples (no accel build), ms per spp;
-//! `--pair-depth 0` renders with one probe per subsurface hit instead of
-//! the camera vertex's antithetic pair (`integrator::path`), and `--axes`,
+//! `--pair-depth N` samples an antithetic probe pair at subsurface hits
+//! below depth N (default 0: one probe, `integrator::path`), `--cv-depth N`
+//! adds the plane control variate below depth N (default 1, the camera
+//! vertex; 0: off, `integrator::control_variate`), and `--axes`,
 //! `--specular`, `--exit-sw`, `--renormalize` override the materials'
 //! choices as on the command line.
 
@@ -73,6 +75,7 @@ fn main() {
         die("usage: pixel_variance SCENE.toml [options] (see the source)")
     };
     let pair_depth: Option<u32> = arg(&args, "--pair-depth");
+    let cv_depth: Option<u32> = arg(&args, "--cv-depth");
     let mut scene = scene::load(Path::new(path)).unwrap_or_else(|e| die(&e.to_string()));
     if let Some(w) = arg::<u32>(&args, "--width") {
         let c = &scene.camera;
@@ -104,6 +107,9 @@ fn main() {
     let mut ctx = Context::new(&scene, accel.as_ref());
     if let Some(p) = pair_depth {
         ctx.pair_depth = p;
+    }
+    if let Some(c) = cv_depth {
+        ctx.cv_depth = c;
     }
     let (w, h) = (scene.camera.width, scene.camera.height);
     if let Some(r) = &reference {

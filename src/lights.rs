@@ -35,6 +35,7 @@ struct LightTri {
     pdf_area: f32,
 }
 /// A point sampled on a light.
+#[derive(Clone, Copy, Debug)]
 pub struct LightSample {
     pub point: Vec3,
     /// Front-face geometric normal at the point.

@@ -92,7 +92,8 @@ fn diffusion(coat: &str, exit: &str, active: &[&str], inactive: &[&str]) -> Valu
     json!({
         "subsurface": [{"method": "level-of-detail"}, {
             "method": "diffusion", "axes": "curvature", "channel": "mis",
-            "radius": "analytic", "pair_depth": 1, "curvature_correction": true
+            "radius": "analytic", "pair_depth": 0, "control_variate_depth": 1,
+            "curvature_correction": true
         }],
         "coat": {"method": coat},
         "exit_lobe": {"method": exit},
@@ -201,6 +202,45 @@ fn ketchup_blue_is_off_with_the_presets_given_albedo_and_on_with_the_table() {
                 )
             ]),
         ),
+    );
+}
+
+#[test]
+fn the_control_variate_is_planned_only_under_area_lights() {
+    // It models next-event estimation of area lights: under the
+    // environment alone there is nothing for it to model, and the plan
+    // says so; with a lamp it is on at the camera vertex.
+    let diffusion_of = |s: &Scene| -> Value {
+        let v = serde_json::to_value(plan_of(s, IntegratorKind::Path, PassSet::EMPTY)).unwrap();
+        let m = v["materials"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == "sauce")
+            .unwrap()
+            .clone();
+        m["subsurface"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|x| x["method"] == "diffusion")
+            .unwrap()
+            .clone()
+    };
+    let env = load(&format!(
+        "[environment]\nradiance = [0.5, 0.5, 0.5]\n{KETCHUP}{BALL_SAUCE}"
+    ));
+    let d = diffusion_of(&env);
+    assert_eq!(d["control_variate_depth"], 0, "{d}");
+    let why = d["reason"].as_str().unwrap();
+    assert!(why.contains("no area light"), "{why}");
+    let lit = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
+    let d = diffusion_of(&lit);
+    assert_eq!(d["control_variate_depth"], 1, "{d}");
+    let why = d["reason"].as_str().unwrap();
+    assert!(
+        why.contains("control variate") && why.contains("depth < 1"),
+        "{why}"
     );
 }
 

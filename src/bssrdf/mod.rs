@@ -56,8 +56,8 @@ pub mod radius;
 pub use fresnel_moment::{sw, sw_normalization, transmittance};
 pub use params::{AlbedoSource, Measured, Preset, SubsurfaceParams, PRESETS};
 pub use probe::{
-    pick_hit, ChannelStrategy, ProbeAxes, ProbeEntry, ProbeOptions, ProbeRandoms, ProbeSampler,
-    ProbeSegment,
+    pick_hit, ChannelStrategy, PlaneModel, ProbeAxes, ProbeEntry, ProbeOptions, ProbeRandoms,
+    ProbeSampler, ProbeSegment,
 };
 pub use profile::Fit;
 pub use radius::{RadialDist, RadiusSampler, TableSpacing};

@@ -40,7 +40,7 @@
 //!   = [`TANGENT_PROB_MIN`] and 1 − 2ε ≥ ½, the argument above bounds the
 //!   weight of one hit by
 //!   (√3/ε_min) · n_active · A / CDF(Rmax)^(renormalize) (× total)
-//!   (√3/0.02 ≈ 86.6 against mis3's 4√3 ≈ 6.9), for any geometry: larger
+//!   (√3/0.005 ≈ 346 against mis3's 4√3 ≈ 6.9), for any geometry: larger
 //!   than mis3's, but finite, where normal-only's is not.
 //! - [`ChannelStrategy::Single`]: pick one active channel uniformly and
 //!   estimate only it (the others get 0 from this sample) — the seed.
@@ -114,7 +114,7 @@ impl ProbeAxes {
 /// [`ProbeAxes::Curvature`]: it keeps every surface within Rmax reachable
 /// (so the estimator stays unbiased on any geometry) and bounds the weight
 /// of a hit by (√3/ε_min)·n_active·A (module docs).
-pub const TANGENT_PROB_MIN: f64 = 0.02;
+pub const TANGENT_PROB_MIN: f64 = 0.005;
 
 /// κ·d at and beyond which [`ProbeAxes::Curvature`] uses mis3's ¼.
 pub const TANGENT_PROB_FULL_AT: f64 = 1.0;
@@ -274,10 +274,33 @@ pub struct ProbeSegment {
 #[derive(Clone, Copy)]
 struct Shared {
     channel: usize,
+    /// The sampled axis (T, B, N: 0, 1, 2).
+    axis: usize,
     r: f64,
     h: f64,
     probs: [f64; 3],
     axes: [DVec3; 3],
+}
+
+/// A probe along the normal N at xo as the tangent plane there would weigh
+/// it ([`ProbeSampler::sample_probe_and_plane`]): the model of the plane
+/// control variate (`integrator::control_variate`). On that plane T and B
+/// probes never land, so a hit at xo + d has the density P(N)·p_disk(r),
+/// r = |d|, and
+///
+///   E[1[V = N] · weight · h(d)] = ∫_disk Rd(|d|) h(d) dA
+///
+/// for any h: with h = 1, the plane integral A_plane
+/// ([`ProbeSampler::planar_reflectance`]); with h odd in d, 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlaneModel {
+    /// Rd(r) / (P(N)·p_disk(r)) per channel (the channel strategy's, as in
+    /// [`ProbeSampler::weigh`]).
+    pub weight: Vec3,
+    /// d = r (cos φ T + sin φ B), the disk point's offset from xo (world).
+    pub offset: Vec3,
+    /// P(N), the probability of the normal axis at xo.
+    pub p_normal: f32,
 }
 
 /// An entry point weighed by [`ProbeSampler::weigh`].
@@ -446,6 +469,64 @@ impl ProbeSampler {
         ])
     }
 
+    /// [`sample_probe`](Self::sample_probe), bit for bit, and for a probe
+    /// along the normal its [`PlaneModel`]: what it would weigh were the
+    /// surface the tangent plane at xo (None for probes along T or B).
+    pub fn sample_probe_and_plane(
+        &self,
+        xo: Vec3,
+        frame: &Frame,
+        curvature: f32,
+        u: &ProbeRandoms,
+    ) -> Option<(ProbeSegment, Option<PlaneModel>)> {
+        let shared = self.sample_shared(frame, curvature, u)?;
+        Some((
+            self.segment(xo, frame, &shared, u.angle),
+            self.plane_model(frame, &shared, u.angle),
+        ))
+    }
+
+    /// [`sample_probe_pair`](Self::sample_probe_pair), bit for bit, and
+    /// the first probe's [`PlaneModel`] (the twin's is the same with the
+    /// offset negated).
+    pub fn sample_probe_pair_and_plane(
+        &self,
+        xo: Vec3,
+        frame: &Frame,
+        curvature: f32,
+        u: &ProbeRandoms,
+    ) -> Option<([ProbeSegment; 2], Option<PlaneModel>)> {
+        let shared = self.sample_shared(frame, curvature, u)?;
+        Some((
+            [
+                self.segment(xo, frame, &shared, u.angle),
+                self.segment(xo, frame, &shared, (u.angle + 0.5).fract()),
+            ],
+            self.plane_model(frame, &shared, u.angle),
+        ))
+    }
+
+    /// The plane model of the probe of `shared` at `angle` (turns) when its
+    /// axis is the normal: the disk point's offset d = r (cos φ T + sin φ B)
+    /// and the weight [`weigh`](Self::weigh) gives a hit there on the plane
+    /// through xo ⟂ N, where probes along T and B run parallel to the
+    /// surface and only N's density counts.
+    #[inline(always)]
+    fn plane_model(&self, frame: &Frame, shared: &Shared, angle: f64) -> Option<PlaneModel> {
+        if shared.axis != AXIS_N {
+            return None;
+        }
+        let (sin, cos) = crate::sampling::sin_cos_turns(angle as f32);
+        let [_, t1, t2] = shared.axes;
+        let d = (t1 * cos as f64 + t2 * sin as f64) * shared.r;
+        let w = self.weights(d, frame, frame.n.as_dvec3(), shared.probs, shared.channel)?;
+        Some(PlaneModel {
+            weight: Vec3::from_array(w),
+            offset: d.as_vec3(),
+            p_normal: shared.probs[AXIS_N] as f32,
+        })
+    }
+
     /// What a probe samples before its angle: the channel c, the radius r
     /// and the axis V (with the plane T', B' ⟂ V).
     #[inline(always)]
@@ -477,6 +558,7 @@ impl ProbeSampler {
         let h = (self.rmax * self.rmax - r * r).max(0.0).sqrt();
         Some(Shared {
             channel,
+            axis,
             r,
             h,
             probs,
@@ -493,6 +575,7 @@ impl ProbeSampler {
             h,
             probs,
             axes: [v, t1, t2],
+            ..
         } = *shared;
         // The angle in f32: its rounding moves p0 by ~1e-7·r, below the f32
         // rounding of p0 itself.

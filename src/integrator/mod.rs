@@ -11,10 +11,13 @@
 //! its optional diffuse Fresnel boundary model. [`aov`] records what the
 //! passes (light paths, light groups, data, ID coverage) measure.
 //! [`effects`] counts ray queries and time per effect for `--stats`.
-//! `probe`, `randomwalk` and `diffuse_boundary` exist only with the
-//! `subsurface` feature (the default).
+//! [`control_variate`] is the probe estimator's plane control variate.
+//! `probe`, `control_variate`, `randomwalk` and `diffuse_boundary` exist
+//! only with the `subsurface` feature (the default).
 
 pub mod aov;
+#[cfg(feature = "subsurface")]
+pub mod control_variate;
 #[cfg(feature = "subsurface")]
 pub mod diffuse_boundary;
 pub mod effects;
@@ -45,9 +48,13 @@ pub struct Context<'a> {
     /// Per mesh, what [`Interaction::new`] reads.
     pub shading: Vec<interaction::MeshShading>,
     /// Subsurface hits at depths below this sample an antithetic pair of
-    /// entry points ([`path::PAIR_DEPTH`], the default); 0 turns the pair
-    /// off (one probe per hit), for measurements and tests.
+    /// entry points ([`path::PAIR_DEPTH`], the default: 0, off); for
+    /// measurements and tests.
     pub pair_depth: u32,
+    /// Subsurface hits at depths below this add the plane control variate
+    /// (`control_variate::CV_DEPTH`, the default: the camera vertex); 0
+    /// turns it off, for measurements and tests.
+    pub cv_depth: u32,
     /// The camera's pixel angle, for the footprint cone of subsurface
     /// level of detail ([`crate::materials::lod`]).
     pub camera_spread: crate::materials::lod::CameraSpread,
@@ -75,6 +82,10 @@ impl<'a> Context<'a> {
             ray_epsilon: extent * 1e-6,
             shading,
             pair_depth: path::PAIR_DEPTH,
+            #[cfg(feature = "subsurface")]
+            cv_depth: control_variate::CV_DEPTH,
+            #[cfg(not(feature = "subsurface"))]
+            cv_depth: 0,
             camera_spread: crate::materials::lod::CameraSpread::new(
                 scene.camera.fov_y,
                 scene.camera.height,

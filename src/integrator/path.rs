@@ -11,12 +11,16 @@
 //! twice — by sampling a point on an area light (next-event estimation)
 //! and by sampling the lobe — and the two are combined with the power
 //! heuristic (Veach 1997, §9.2). The area integral is estimated with one
-//! probe ray (King et al. 2013; [`crate::bssrdf::probe`]), or at the
-//! camera vertex with an antithetic pair of them (below). Paths end at
-//! `max_depth` bounces or by Russian roulette once their throughput is
-//! small (pbrt-v4 §13.1.1).
+//! probe ray (King et al. 2013; [`crate::bssrdf::probe`]); at the camera
+//! vertex its next-event estimate gets the plane control variate
+//! ([`super::control_variate`]: the light a model of the surface predicts
+//! at the probe's disk point, less its known mean, is subtracted; the light
+//! sample is drawn ahead, in [`entries`], so the model and the entry point
+//! use the same one). An antithetic pair of probes (below) is the other
+//! option, off by default. Paths end at `max_depth` bounces or by Russian
+//! roulette once their throughput is small (pbrt-v4 §13.1.1).
 //!
-//! **The antithetic probe pair** ([`PAIR_DEPTH`]). At a subsurface hit xo
+//! **The antithetic probe pair** ([`PAIR_DEPTH`], off by default). At a subsurface hit xo
 //! of the camera path, one probe's random numbers (channel, radius r, axis
 //! V, angle φ) give two probes, at φ and at φ + π, and so two entry points
 //! x₁, x₂ with the probe weights W_k = Rd(|xo − x_k|) / p(x_k) × (hits on
@@ -37,10 +41,14 @@
 //! δ and −δ on a plane (to first order in κr on a surface of curvature
 //! κ), and that change — the irradiance turning across a lit curved body,
 //! and the probe weights' own spread — is most of one probe's noise on a
-//! smoothly lit body: on scenes/smooth-sphere.toml the pair has 0.36× the
-//! relMSE per sample for 1.34× the rays (docs/accuracy.md, "Smooth
-//! sphere"). Deeper vertices use one probe: their share of the image is
-//! small and the second probe and light sample cost the same there.
+//! smoothly lit body: on scenes/smooth-sphere.toml the pair has 0.37× one
+//! plain probe's relMSE per sample for 1.34× the rays. The control
+//! variate takes most of the same noise for no ray (0.48×), and so
+//! replaced the pair as the default: per unit of work the two are close,
+//! and the pair with the control variate too is best by ~10 %
+//! (docs/accuracy.md, "The plane control variate"). Deeper vertices use
+//! one probe: their share of the image is small and the second probe and
+//! light sample cost the same there.
 //!
 //! **Coated subsurface hits.** The coat at xo reflects a fraction (Fr for
 //! the smooth coat, E(μo) for the rough one) and passes the rest into the
@@ -64,6 +72,8 @@
 //! cast ([`crate::materials::lod`]); the coat is unchanged.
 
 use super::aov::{self, Event, Recorder, Source};
+#[cfg(feature = "subsurface")]
+use super::control_variate;
 use super::interaction::offset_along;
 #[cfg(feature = "subsurface")]
 use super::probe::{entry_on_segment, exit_curvature, ProbeTarget};
@@ -72,9 +82,10 @@ use crate::accel::ProbeHits;
 #[cfg(feature = "subsurface")]
 use crate::bssrdf::curvature_correction::{mean_curvature, CurvatureCorrection, ExitFactor};
 #[cfg(feature = "subsurface")]
-use crate::bssrdf::{ProbeRandoms, ProbeSegment};
+use crate::bssrdf::{PlaneModel, ProbeRandoms, ProbeSegment};
 use crate::film::passes::Pass;
 use crate::geometry::{Frame, Ray, Vec3};
+use crate::lights::LightSample;
 use crate::materials::lod::Cone;
 use crate::materials::{dielectric, diffuse, Material};
 #[cfg(feature = "subsurface")]
@@ -116,9 +127,11 @@ pub(crate) const COAT_SPLIT_DEPTH: u32 = 1;
 /// probe's randoms, the second at the opposite angle φ + π (antithetic),
 /// and sample light at both, each weighted ½; the path goes on from one of
 /// them, chosen with probability ½ (module docs). Light varying linearly
-/// across the profile cancels between the two. 1: the camera vertex only
-/// (the default of [`Context::pair_depth`]).
-pub const PAIR_DEPTH: u32 = 1;
+/// across the profile cancels between the two. 0: off, the default of
+/// [`Context::pair_depth`] since the plane control variate takes most of
+/// the same noise without the second probe (module docs); 1 turns it on at
+/// the camera vertex.
+pub const PAIR_DEPTH: u32 = 0;
 
 /// Paths waiting to be traced after the current one ends; more than this
 /// many at once never happens with [`COAT_SPLIT_DEPTH`] ≤ 4.
@@ -267,7 +280,27 @@ pub(crate) struct Coated<'a> {
     /// throughput light sampled there is weighted by; when Some, light
     /// sampled at `entry` counts ½ too.
     pub(crate) pair: Option<(Vertex<'a>, Vec3)>,
+    /// What the plane control variate drew and adds ([`Ahead`]).
+    pub(crate) ahead: Ahead,
 }
+
+/// The plane control variate's part of a subsurface hit
+/// ([`super::control_variate`]): when it applies, the light samples drawn
+/// ahead for next-event estimation at the entry point (and at its pair's
+/// twin), which its model used, and its terms, each × the throughput, with
+/// the light they sampled ([`aov::NO_LIGHT`]: none). The terms count
+/// whether or not the probes found an entry point.
+#[cfg(feature = "subsurface")]
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Ahead {
+    pub(crate) lights: Option<[Option<LightSample>; 2]>,
+    pub(crate) terms: [(Vec3, u32); 2],
+}
+
+/// What [`entries`] found: the entry vertex, its pair's twin with its
+/// throughput, and the control variate's part.
+#[cfg(feature = "subsurface")]
+type Entries<'s> = (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>, Ahead);
 
 /// A ray the coat reflected: the ray, its throughput, and the vertex and
 /// lobe pdf it was sampled with (None for the mirror).
@@ -316,8 +349,8 @@ impl Branches {
 }
 
 /// The radiance arriving along `camera_ray`: one sample of L, with the
-/// BSSRDF estimated by one probe ray per subsurface hit (an antithetic pair
-/// at the camera vertex); its parts go to `rec` ([`aov`]), its effects'
+/// BSSRDF estimated by one probe ray per subsurface hit (with the plane
+/// control variate at the camera vertex); its parts go to `rec` ([`aov`]), its effects'
 /// time to `T` ([`super::effects`]).
 pub fn radiance<R: Recorder, T: Clock>(
     ctx: &Context,
@@ -527,6 +560,9 @@ fn follow<'s, R: Recorder, T: Clock>(
         // point of an antithetic pair, whose twin is sampled too).
         #[cfg_attr(not(feature = "subsurface"), allow(unused_mut))]
         let mut nee_scale = 1.0;
+        // The light sample drawn ahead for the vertex, if any ([`Ahead`]).
+        #[cfg(feature = "subsurface")]
+        let mut nee_ahead: Option<Option<LightSample>> = None;
         // Borrowed, not moved out: the vertex stays where it was built.
         // At the first hit the path's class becomes that of what scattered;
         // the coat's reflections are specular.
@@ -565,7 +601,8 @@ fn follow<'s, R: Recorder, T: Clock>(
                     rec.light(c, aov::sampled(coat_event, depth), Source::Light(light));
                 }
                 // What the entry's throughput was multiplied by here (2 when
-                // it alone goes on for both); its pair's the same.
+                // it alone goes on for both, 0 when the reflection does);
+                // its pair's and the control variate's the same.
                 let mut entry_mul = 1.0;
                 let (next, follow_reflected) = match (&c.entry, c.reflected) {
                     (Some(v), Some((r, mut b, p))) => {
@@ -582,7 +619,10 @@ fn follow<'s, R: Recorder, T: Clock>(
                             cone: cone_specular,
                         });
                         match branch.map(|br| stack.push(br)) {
-                            Some(false) if rng.uniform() < 0.5 => (None, Some((r, 2.0 * b, p))),
+                            Some(false) if rng.uniform() < 0.5 => {
+                                entry_mul = 0.0;
+                                (None, Some((r, 2.0 * b, p)))
+                            }
                             Some(false) => {
                                 beta *= 2.0;
                                 entry_mul = 2.0;
@@ -594,15 +634,31 @@ fn follow<'s, R: Recorder, T: Clock>(
                     (Some(v), None) => (Some(v), None),
                     (None, reflected) => (None, reflected),
                 };
+                // The control variate's terms, which count whether or not
+                // the probes found an entry point.
+                let lights = c.ahead.lights;
+                if lights.is_some() && entry_mul > 0.0 {
+                    let ev = if first { Event::Subsurface } else { event };
+                    for (t, light) in c.ahead.terms {
+                        if light != aov::NO_LIGHT {
+                            let t = entry_mul * t;
+                            l += t;
+                            rec.light(t, aov::sampled(ev, depth), Source::Light(light));
+                        }
+                    }
+                }
                 match (next, follow_reflected) {
                     (Some(v), _) => {
                         if first {
                             event = v.lobe.event();
                         }
+                        nee_ahead = lights.map(|ls| ls[0]);
                         if let Some((pv, b)) = &c.pair {
                             if ctx.plan.area_lights {
                                 let t0 = T::now();
-                                let (d, light) = direct_lighting(ctx, pv, rng, counters);
+                                let ahead = lights.map(|ls| ls[1]);
+                                let (d, light) =
+                                    direct_lighting_ahead(ctx, pv, ahead, rng, counters);
                                 T::lap(counters, Effect::Direct, t0);
                                 let c = (entry_mul * *b) * d;
                                 l += c;
@@ -628,6 +684,9 @@ fn follow<'s, R: Recorder, T: Clock>(
         // Next-event estimation, then continue by sampling the lobe.
         if ctx.plan.area_lights {
             let t0 = T::now();
+            #[cfg(feature = "subsurface")]
+            let (d, light) = direct_lighting_ahead(ctx, vertex, nee_ahead, rng, counters);
+            #[cfg(not(feature = "subsurface"))]
             let (d, light) = direct_lighting(ctx, vertex, rng, counters);
             T::lap(counters, Effect::Direct, t0);
             let c = (nee_scale * beta) * d;
@@ -718,13 +777,14 @@ fn subsurface_probe<'s>(
         } else if split {
             *beta *= 1.0 - fr;
             let reflected = Some((mirror(ctx, si, wo, n_out), beta_in * fr, None));
-            let (entry, pair) =
+            let (entry, pair, ahead) =
                 entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
             return Scatter::Coated(Coated {
                 coat: None,
                 reflected,
                 entry,
                 pair,
+                ahead,
             });
         } else if rng.uniform() < fr {
             // Specular reflection with probability Fr: weight 1.
@@ -768,14 +828,16 @@ fn subsurface_probe<'s>(
             reflected,
             entry: None,
             pair: None,
+            ahead: Ahead::default(),
         });
     }
-    let (entry, pair) = entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
+    let (entry, pair, ahead) = entries(ctx, ss, si, wo, beta, rng, scratch, counters, depth, width);
     Scatter::Coated(Coated {
         coat: Some((v, beta_in)),
         reflected: None,
         entry,
         pair,
+        ahead,
     })
 }
 
@@ -819,10 +881,11 @@ fn coat_reflection(
 /// The entry vertices the path goes on from at a subsurface hit at
 /// `depth`, `beta` scaled by the chosen one's probe weight: one probe, or
 /// below `ctx.pair_depth` an antithetic pair ([`PAIR_DEPTH`]), whose second
-/// vertex comes back with its own throughput for light sampling. Where the
-/// material's level-of-detail rule applies to the footprint `width`, no
-/// probe: the entry lobe at xo itself, weighted by the profile's plane
-/// integral ([`crate::materials::lod`]).
+/// vertex comes back with its own throughput for light sampling; below
+/// `ctx.cv_depth` with the plane control variate's light samples and terms
+/// ([`super::control_variate`]). Where the material's level-of-detail rule
+/// applies to the footprint `width`, no probe: the entry lobe at xo itself,
+/// weighted by the profile's plane integral ([`crate::materials::lod`]).
 #[allow(clippy::too_many_arguments)]
 #[cfg(feature = "subsurface")]
 fn entries<'s>(
@@ -836,37 +899,93 @@ fn entries<'s>(
     counters: &mut Counters,
     depth: u32,
     width: f32,
-) -> (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>) {
+) -> Entries<'s> {
     let frame_o = si.shading_frame_facing(wo);
     let mesh = &ctx.scene.meshes[si.geom as usize];
     let kappa = exit_curvature(mesh, si.prim);
     if ss.lod().applies(width, kappa) {
-        return (Some(lod_entry(ctx, ss, si, frame_o, beta)), None);
+        return (
+            Some(lod_entry(ctx, ss, si, frame_o, beta)),
+            None,
+            Ahead::default(),
+        );
     }
+    let cv = control_variate::applies(ctx.cv_depth, ctx.plan.area_lights, depth);
+    // The control variate's light samples, drawn before the probe's randoms.
+    let lights = cv.then(|| [draw_light(ctx, rng), None]);
     let u = ProbeRandoms::from_rng(rng);
     // The curvature correction's exit half, once for both probes of a pair.
     let exit = ss
         .curvature_correction()
         .map(|cc| (cc, cc.at_exit(mean_curvature(mesh, si.prim))));
+    let beta_in = *beta;
     if depth >= ctx.pair_depth {
-        let e = ss
-            .probe
-            .sample_probe(si.p, &frame_o, kappa, &u)
-            .and_then(|seg| probe_entry(ctx, ss, si, &seg, exit, &u, scratch, counters));
+        let (seg, plane) = if cv {
+            match ss.probe.sample_probe_and_plane(si.p, &frame_o, kappa, &u) {
+                Some(sp) => sp,
+                None => return (None, None, Ahead::default()),
+            }
+        } else {
+            match ss.probe.sample_probe(si.p, &frame_o, kappa, &u) {
+                Some(seg) => (seg, None),
+                None => return (None, None, Ahead::default()),
+            }
+        };
+        let mut ahead = Ahead::default();
+        if let Some(lights) = lights {
+            ahead.lights = Some(lights);
+            if let (Some(ls), Some(pm)) = (&lights[0], &plane) {
+                let model = CvModel::new(ctx, ss, si, &frame_o, exit.map(|e| e.1));
+                let c = model.one_probe(pm, ls);
+                ahead.terms[0] = (-(beta_in * model.f_o) * c, ls.index);
+            }
+        }
+        let e = probe_entry(ctx, ss, si, &seg, exit, &u, scratch, counters);
         return match e {
             Some((v, w)) => {
                 *beta *= w;
-                (Some(v), None)
+                (Some(v), None, ahead)
             }
-            None => (None, None),
+            None => (None, None, ahead),
         };
     }
+    // The pair: with the control variate, a light sample for the twin too.
+    let lights = lights.map(|[a, _]| [a, draw_light(ctx, rng)]);
     // The twin's randoms are u's with the angle at φ + π
     // (ProbeSampler::sample_probe_pair), which changes none of what
     // entry_on_segment reads.
-    let Some([seg_a, seg_b]) = ss.probe.sample_probe_pair(si.p, &frame_o, kappa, &u) else {
-        return (None, None);
+    let ([seg_a, seg_b], plane) = if cv {
+        match ss
+            .probe
+            .sample_probe_pair_and_plane(si.p, &frame_o, kappa, &u)
+        {
+            Some(sp) => sp,
+            None => return (None, None, Ahead::default()),
+        }
+    } else {
+        match ss.probe.sample_probe_pair(si.p, &frame_o, kappa, &u) {
+            Some(segs) => (segs, None),
+            None => return (None, None, Ahead::default()),
+        }
     };
+    let mut ahead = Ahead::default();
+    if let Some(lights) = lights {
+        ahead.lights = Some(lights);
+        if let Some(pm) = &plane {
+            let model = CvModel::new(ctx, ss, si, &frame_o, exit.map(|e| e.1));
+            let g0 = lights.map(|l| l.map_or(Vec3::ZERO, |ls| model.g(Vec3::ZERO, &ls)));
+            // The term split by light sample (it is linear in the g_k), so
+            // each part is recorded with the light it sampled.
+            for (k, light) in lights.iter().enumerate() {
+                if let Some(ls) = light {
+                    let mut gk = [Vec3::ZERO; 2];
+                    gk[k] = g0[k];
+                    let c = control_variate::pair(pm, model.a_plane, gk);
+                    ahead.terms[k] = (-(beta_in * model.f_o) * c, ls.index);
+                }
+            }
+        }
+    }
     let a = probe_entry(ctx, ss, si, &seg_a, exit, &u, scratch, counters);
     let b = probe_entry(ctx, ss, si, &seg_b, exit, &u, scratch, counters);
     match (a, b) {
@@ -880,13 +999,82 @@ fn entries<'s>(
                 (vb, (va, wa), wb)
             };
             *beta = beta0 * w_go;
-            (Some(go), Some((other, 0.5 * beta0 * w_other)))
+            (Some(go), Some((other, 0.5 * beta0 * w_other)), ahead)
         }
         (Some((v, w)), None) | (None, Some((v, w))) => {
             *beta *= 0.5 * w;
-            (Some(v), None)
+            (Some(v), None, ahead)
         }
-        (None, None) => (None, None),
+        (None, None) => (None, None, ahead),
+    }
+}
+
+/// The plane control variate's model at a subsurface exit point xo
+/// ([`super::control_variate`]): g, the light a sample brings through the
+/// entry lobe at a model point, unshadowed, and the constants of its term.
+#[cfg(feature = "subsurface")]
+struct CvModel<'s> {
+    ss: &'s Subsurface,
+    xo: Vec3,
+    n: Vec3,
+    kappa: f32,
+    /// A_plane per channel.
+    a_plane: Vec3,
+    /// f(κo): the curvature correction of the model surface (1 without).
+    f_o: Vec3,
+}
+
+#[cfg(feature = "subsurface")]
+impl<'s> CvModel<'s> {
+    fn new(
+        ctx: &Context,
+        ss: &'s Subsurface,
+        si: &Interaction,
+        frame_o: &Frame,
+        exit: Option<ExitFactor>,
+    ) -> Self {
+        let mesh = &ctx.scene.meshes[si.geom as usize];
+        CvModel {
+            ss,
+            xo: si.p,
+            n: frame_o.n,
+            kappa: mean_curvature(mesh, si.prim),
+            a_plane: Vec3::from_array(ss.probe.planar_reflectance().map(|a| a as f32)),
+            f_o: exit.map_or(Vec3::ONE, |e| e.at_exit_alone()),
+        }
+    }
+
+    /// g at the model point over the disk offset `d`: what light sample
+    /// `ls` brings through the entry lobe there, MIS-weighted as next-event
+    /// estimation weighs it, without a shadow ray.
+    fn g(&self, d: Vec3, ls: &LightSample) -> Vec3 {
+        let (p, n) = control_variate::model_point(self.xo, self.n, self.kappa, d);
+        let v = Vertex {
+            p,
+            ng: n,
+            frame: Frame::from_normal(n),
+            wo_local: Vec3::Z,
+            lobe: Lobe::SubsurfaceEntry(self.ss),
+        };
+        unshadowed(
+            &v,
+            ls,
+            |wo, wi| v.lobe.eval(wo, wi),
+            |wo, wi| v.lobe.pdf(wo, wi),
+        )
+        .unwrap_or(Vec3::ZERO)
+    }
+
+    /// C of one probe along N with plane model `pm` and light sample `ls`.
+    fn one_probe(&self, pm: &PlaneModel, ls: &LightSample) -> Vec3 {
+        let d = pm.offset;
+        control_variate::one_probe(
+            pm,
+            self.a_plane,
+            self.g(Vec3::ZERO, ls),
+            self.g(d, ls),
+            self.g(-d, ls),
+        )
     }
 }
 
@@ -921,18 +1109,20 @@ fn lod_entry<'s>(
 }
 
 /// What [`entries`] found as a [`Scatter`]: the entry vertex (with its
-/// pair's, if any), or the end of the path.
+/// pair's, if any, and the control variate's part), or the end of the
+/// path.
 #[cfg(feature = "subsurface")]
-fn entry_scatter<'s>(e: (Option<Vertex<'s>>, Option<(Vertex<'s>, Vec3)>)) -> Scatter<'s> {
+fn entry_scatter(e: Entries<'_>) -> Scatter<'_> {
     match e {
-        (Some(v), None) => Scatter::Vertex(v),
-        (entry @ Some(_), pair) => Scatter::Coated(Coated {
+        (Some(v), None, ahead) if ahead.lights.is_none() => Scatter::Vertex(v),
+        (None, _, ahead) if ahead.lights.is_none() => Scatter::Absorbed,
+        (entry, pair, ahead) => Scatter::Coated(Coated {
             coat: None,
             reflected: None,
             entry,
             pair,
+            ahead,
         }),
-        (None, _) => Scatter::Absorbed,
     }
 }
 
@@ -1009,31 +1199,61 @@ fn emission_weight(ctx: &Context, si: &Interaction, wo: Vec3, prev: Option<(Vec3
     }
 }
 
+/// One light sample for next-event estimation (three randoms); None
+/// without lights or on a degenerate emitter.
+#[inline(always)]
+fn draw_light(ctx: &Context, rng: &mut SampleRng) -> Option<LightSample> {
+    let [u_pick, u0, u1] = rng.uniform3();
+    ctx.lights.sample(u_pick, [u0, u1])
+}
+
 /// Next-event estimation at a vertex: one light sample, weighted by the
 /// power heuristic against lobe sampling of the same direction; and the
 /// light triangle it sampled ([`aov::NO_LIGHT`] when none). (A plain index,
 /// not a [`Source`]: the pair then still fits in two registers.)
-///
-/// The lobe is matched once here, not in both its `eval` and its `pdf`: the
-/// diffuse lobe (every vertex of a diffuse scene) gets an instance of its
-/// own, so a scene without subsurface materials executes what a build
-/// without the `subsurface` feature does (docs/performance.md, "Zero cost
-/// for what is off").
 fn direct_lighting(
     ctx: &Context,
     v: &Vertex,
     rng: &mut SampleRng,
     counters: &mut Counters,
 ) -> (Vec3, u32) {
-    let [u_pick, u0, u1] = rng.uniform3();
-    let Some(ls) = ctx.lights.sample(u_pick, [u0, u1]) else {
+    let Some(ls) = draw_light(ctx, rng) else {
         return (Vec3::ZERO, aov::NO_LIGHT);
     };
+    lit_by(ctx, v, &ls, counters)
+}
+
+/// [`direct_lighting`] with the light sample drawn ahead (`Some`; its
+/// `None`: no light was found), or drawn now (`None`).
+#[cfg(feature = "subsurface")]
+fn direct_lighting_ahead(
+    ctx: &Context,
+    v: &Vertex,
+    ahead: Option<Option<LightSample>>,
+    rng: &mut SampleRng,
+    counters: &mut Counters,
+) -> (Vec3, u32) {
+    match ahead {
+        None => direct_lighting(ctx, v, rng, counters),
+        Some(Some(ls)) => lit_by(ctx, v, &ls, counters),
+        Some(None) => (Vec3::ZERO, aov::NO_LIGHT),
+    }
+}
+
+/// Next-event estimation at `v` with the light sample `ls`.
+///
+/// The lobe is matched once here, not in both its `eval` and its `pdf`: the
+/// diffuse lobe (every vertex of a diffuse scene) gets an instance of its
+/// own, so a scene without subsurface materials executes what a build
+/// without the `subsurface` feature does (docs/performance.md, "Zero cost
+/// for what is off").
+#[inline(always)]
+fn lit_by(ctx: &Context, v: &Vertex, ls: &LightSample, counters: &mut Counters) -> (Vec3, u32) {
     match v.lobe {
         Lobe::Diffuse(albedo) => light_sample(
             ctx,
             v,
-            &ls,
+            ls,
             counters,
             |wo, wi| diffuse::eval(albedo, wo, wi),
             diffuse::pdf,
@@ -1041,7 +1261,7 @@ fn direct_lighting(
         _ => light_sample(
             ctx,
             v,
-            &ls,
+            ls,
             counters,
             |wo, wi| v.lobe.eval(wo, wi),
             |wo, wi| v.lobe.pdf(wo, wi),
@@ -1049,34 +1269,21 @@ fn direct_lighting(
     }
 }
 
-/// [`direct_lighting`] of the light sample `ls`, with the lobe's `eval`
-/// and `pdf`.
+/// [`lit_by`] with the lobe's `eval` and `pdf`: [`unshadowed`], then the
+/// shadow ray.
 #[inline(always)]
 fn light_sample(
     ctx: &Context,
     v: &Vertex,
-    ls: &crate::lights::LightSample,
+    ls: &LightSample,
     counters: &mut Counters,
     eval: impl Fn(Vec3, Vec3) -> Vec3,
     pdf: impl Fn(Vec3, Vec3) -> f32,
 ) -> (Vec3, u32) {
     let source = ls.index;
-    let to_light = ls.point - v.p;
-    let dist2 = to_light.length_squared();
-    if dist2 <= 0.0 {
+    let Some(c) = unshadowed(v, ls, eval, pdf) else {
         return (Vec3::ZERO, source);
-    }
-    let wi = to_light / dist2.sqrt();
-    let cos_l = -wi.dot(ls.normal);
-    if cos_l <= 0.0 || wi.dot(v.ng) <= 0.0 {
-        return (Vec3::ZERO, source);
-    }
-    let wi_local = v.frame.to_local(wi);
-    let f = eval(v.wo_local, wi_local);
-    if f == Vec3::ZERO {
-        return (Vec3::ZERO, source);
-    }
-    let pdf_light = ls.pdf_area * dist2 / cos_l;
+    };
     counters.ray(Effect::Direct);
     let origin = offset_along(v.p, v.ng, ctx.ray_epsilon);
     // t is in units of |d| = the distance to the light point; stop just short
@@ -1087,8 +1294,38 @@ fn light_sample(
     {
         return (Vec3::ZERO, source);
     }
+    (c, source)
+}
+
+/// What light sample `ls` brings to `v` through its lobe (`eval`, `pdf`),
+/// MIS-weighted by the power heuristic, were nothing in between; None where
+/// it brings nothing (behind the vertex or the light, or the lobe is 0),
+/// so no shadow ray is needed.
+#[inline(always)]
+fn unshadowed(
+    v: &Vertex,
+    ls: &LightSample,
+    eval: impl Fn(Vec3, Vec3) -> Vec3,
+    pdf: impl Fn(Vec3, Vec3) -> f32,
+) -> Option<Vec3> {
+    let to_light = ls.point - v.p;
+    let dist2 = to_light.length_squared();
+    if dist2 <= 0.0 {
+        return None;
+    }
+    let wi = to_light / dist2.sqrt();
+    let cos_l = -wi.dot(ls.normal);
+    if cos_l <= 0.0 || wi.dot(v.ng) <= 0.0 {
+        return None;
+    }
+    let wi_local = v.frame.to_local(wi);
+    let f = eval(v.wo_local, wi_local);
+    if f == Vec3::ZERO {
+        return None;
+    }
+    let pdf_light = ls.pdf_area * dist2 / cos_l;
     let w = power(pdf_light, pdf(v.wo_local, wi_local));
-    (f * ls.radiance * (wi_local.z.abs() * w / pdf_light), source)
+    Some(f * ls.radiance * (wi_local.z.abs() * w / pdf_light))
 }
 
 /// Without the `subsurface` feature there are no subsurface hits.

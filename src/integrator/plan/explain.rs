@@ -55,6 +55,9 @@ pub struct PlanOptions {
     /// Subsurface hits below this depth sample an antithetic probe pair
     /// (`crate::integrator::Context::pair_depth`).
     pub pair_depth: u32,
+    /// Subsurface hits below this depth add the plane control variate
+    /// (`crate::integrator::Context::cv_depth`).
+    pub cv_depth: u32,
 }
 
 impl Default for PlanOptions {
@@ -63,6 +66,10 @@ impl Default for PlanOptions {
             integrator: IntegratorKind::Path,
             passes: PassSet::default(),
             pair_depth: PAIR_DEPTH,
+            #[cfg(feature = "subsurface")]
+            cv_depth: crate::integrator::control_variate::CV_DEPTH,
+            #[cfg(not(feature = "subsurface"))]
+            cv_depth: 0,
         }
     }
 }
@@ -128,6 +135,9 @@ pub enum SubsurfaceMethod {
         radius: String,
         /// Hits below this depth sample an antithetic pair of probes.
         pair_depth: u32,
+        /// Hits below this depth add the plane control variate (where
+        /// the scene has area lights).
+        control_variate_depth: u32,
         /// Whether the diffusion weight is corrected for curvature.
         curvature_correction: bool,
         reason: String,
@@ -308,7 +318,7 @@ impl Explanation {
                 }
                 #[cfg(feature = "subsurface")]
                 Material::Subsurface(ss) => {
-                    let active = diffusion_material(ss, opts.pair_depth, &mut mp);
+                    let active = diffusion_material(ss, opts, flags.area_lights, &mut mp);
                     if active {
                         probes_needed.push(mname.clone());
                     }
@@ -416,10 +426,37 @@ fn channels(active: [bool; 3], reason: impl Into<String>) -> Channels {
     }
 }
 
+/// Why the diffusion estimator samples as it does: probes (a pair below
+/// `pair_depth`) and the plane control variate below `cv_depth` (0 where
+/// the scene has no area light, though `asked` was more).
+#[cfg(feature = "subsurface")]
+fn diffusion_reason(pair_depth: u32, cv_depth: u32, area_lights: bool, asked: u32) -> String {
+    let probes = if pair_depth > 0 {
+        format!("an antithetic pair of probe rays at depth < {pair_depth}, one probe deeper")
+    } else {
+        "one probe ray a hit".into()
+    };
+    let cv = if cv_depth > 0 {
+        format!(", the plane control variate on next-event estimation at depth < {cv_depth}")
+    } else if asked > 0 && !area_lights {
+        ", no control variate (it models area-light sampling; the scene has no area light)".into()
+    } else {
+        String::new()
+    };
+    format!("the integrator's default: {probes} samples the profile{cv}")
+}
+
 /// A used subsurface material under the diffusion estimator; whether it
 /// has an active channel (and so casts probes).
 #[cfg(feature = "subsurface")]
-fn diffusion_material(ss: &Subsurface, pair_depth: u32, mp: &mut MaterialPlan) -> bool {
+fn diffusion_material(
+    ss: &Subsurface,
+    opts: &PlanOptions,
+    area_lights: bool,
+    mp: &mut MaterialPlan,
+) -> bool {
+    let pair_depth = opts.pair_depth;
+    let cv_depth = if area_lights { opts.cv_depth } else { 0 };
     let o = ss.probe.options();
     let active: [bool; 3] = std::array::from_fn(|c| ss.params.active(c));
     let any = active.iter().any(|&a| a);
@@ -439,16 +476,9 @@ fn diffusion_material(ss: &Subsurface, pair_depth: u32, mp: &mut MaterialPlan) -
                 channel: o.channel.name().into(),
                 radius: o.radius.name(),
                 pair_depth,
+                control_variate_depth: cv_depth,
                 curvature_correction: ss.curvature_correction().is_some(),
-                reason: if pair_depth > 0 {
-                    format!(
-                        "the integrator's default: probe rays sample the profile, an \
-                     antithetic pair at depth < {pair_depth}, one probe deeper"
-                    )
-                } else {
-                    "the integrator's default: probe rays sample the profile, one probe a hit"
-                        .into()
-                },
+                reason: diffusion_reason(pair_depth, cv_depth, area_lights, opts.cv_depth),
             }
         } else {
             SubsurfaceMethod::None {

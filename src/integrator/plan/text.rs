@@ -62,6 +62,7 @@ pub fn render(p: &Explanation) -> String {
                     channel,
                     radius,
                     pair_depth,
+                    control_variate_depth,
                     curvature_correction,
                     reason,
                 } => row(
@@ -70,6 +71,7 @@ pub fn render(p: &Explanation) -> String {
                     "diffusion",
                     &format!(
                         "axes={axes} channel={channel} radius={radius} pair_depth={pair_depth} \
+                         control_variate_depth={control_variate_depth} \
                          curvature_correction={}; {reason}",
                         if *curvature_correction { "on" } else { "off" }
                     ),
