@@ -58,6 +58,10 @@ pub struct Context<'a> {
     /// The camera's pixel angle, for the footprint cone of subsurface
     /// level of detail ([`crate::materials::lod`]).
     pub camera_spread: crate::materials::lod::CameraSpread,
+    /// Per mesh with a subsurface material, its triangles' curvatures
+    /// ([`probe::MeshCurvature`]); None for the others.
+    #[cfg(feature = "subsurface")]
+    pub curvature: Vec<Option<probe::MeshCurvature>>,
 }
 
 impl<'a> Context<'a> {
@@ -73,6 +77,19 @@ impl<'a> Context<'a> {
             .meshes
             .iter()
             .map(interaction::MeshShading::new)
+            .collect();
+        #[cfg(feature = "subsurface")]
+        let curvature = scene
+            .meshes
+            .iter()
+            .zip(&scene.objects)
+            .map(|(m, o)| {
+                matches!(
+                    scene.materials[o.material],
+                    crate::materials::Material::Subsurface(_)
+                )
+                .then(|| probe::MeshCurvature::new(m))
+            })
             .collect();
         Context {
             scene,
@@ -91,6 +108,27 @@ impl<'a> Context<'a> {
                 scene.camera.height,
                 scene.camera.look_at - scene.camera.look_from,
             ),
+            #[cfg(feature = "subsurface")]
+            curvature,
+        }
+    }
+
+    /// The curvatures of triangle `prim` of mesh `geom`: the probe axes'
+    /// ([`probe::exit_curvature`]) and the mean curvature
+    /// ([`crate::bssrdf::curvature_correction::mean_curvature`]), from the
+    /// cache where the mesh has one.
+    #[cfg(feature = "subsurface")]
+    #[inline]
+    pub fn curvatures(&self, geom: u32, prim: u32) -> (f32, f32) {
+        match &self.curvature[geom as usize] {
+            Some(c) => (c.exit(prim), c.mean(prim)),
+            None => {
+                let m = &self.scene.meshes[geom as usize];
+                (
+                    probe::exit_curvature(m, prim),
+                    crate::bssrdf::curvature_correction::mean_curvature(m, prim),
+                )
+            }
         }
     }
 

@@ -76,11 +76,11 @@ use super::aov::{self, Event, Recorder, Source};
 use super::control_variate;
 use super::interaction::offset_along;
 #[cfg(feature = "subsurface")]
-use super::probe::{entry_on_segment, exit_curvature, ProbeTarget};
+use super::probe::{entry_on_segment, ProbeTarget};
 use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::ProbeHits;
 #[cfg(feature = "subsurface")]
-use crate::bssrdf::curvature_correction::{mean_curvature, CurvatureCorrection, ExitFactor};
+use crate::bssrdf::curvature_correction::{CurvatureCorrection, ExitFactor};
 #[cfg(feature = "subsurface")]
 use crate::bssrdf::{PlaneModel, ProbeRandoms, ProbeSegment};
 use crate::film::passes::Pass;
@@ -901,8 +901,7 @@ fn entries<'s>(
     width: f32,
 ) -> Entries<'s> {
     let frame_o = si.shading_frame_facing(wo);
-    let mesh = &ctx.scene.meshes[si.geom as usize];
-    let kappa = exit_curvature(mesh, si.prim);
+    let (kappa, k_mean) = ctx.curvatures(si.geom, si.prim);
     if ss.lod().applies(width, kappa) {
         return (
             Some(lod_entry(ctx, ss, si, frame_o, beta)),
@@ -915,9 +914,7 @@ fn entries<'s>(
     let lights = cv.then(|| [draw_light(ctx, rng), None]);
     let u = ProbeRandoms::from_rng(rng);
     // The curvature correction's exit half, once for both probes of a pair.
-    let exit = ss
-        .curvature_correction()
-        .map(|cc| (cc, cc.at_exit(mean_curvature(mesh, si.prim))));
+    let exit = ss.curvature_correction().map(|cc| (cc, cc.at_exit(k_mean)));
     let beta_in = *beta;
     if depth >= ctx.pair_depth {
         let (seg, plane) = if cv {
@@ -935,7 +932,7 @@ fn entries<'s>(
         if let Some(lights) = lights {
             ahead.lights = Some(lights);
             if let (Some(ls), Some(pm)) = (&lights[0], &plane) {
-                let model = CvModel::new(ctx, ss, si, &frame_o, exit.map(|e| e.1));
+                let model = CvModel::new(ss, si, &frame_o, k_mean, exit.map(|e| e.1));
                 let c = model.one_probe(pm, ls);
                 ahead.terms[0] = (-(beta_in * model.f_o) * c, ls.index);
             }
@@ -972,7 +969,7 @@ fn entries<'s>(
     if let Some(lights) = lights {
         ahead.lights = Some(lights);
         if let Some(pm) = &plane {
-            let model = CvModel::new(ctx, ss, si, &frame_o, exit.map(|e| e.1));
+            let model = CvModel::new(ss, si, &frame_o, k_mean, exit.map(|e| e.1));
             let g0 = lights.map(|l| l.map_or(Vec3::ZERO, |ls| model.g(Vec3::ZERO, &ls)));
             // The term split by light sample (it is linear in the g_k), so
             // each part is recorded with the light it sampled.
@@ -1026,19 +1023,20 @@ struct CvModel<'s> {
 
 #[cfg(feature = "subsurface")]
 impl<'s> CvModel<'s> {
+    /// The model at `si` (shading frame `frame_o`, mean curvature
+    /// `k_mean`), with the curvature correction's exit half if any.
     fn new(
-        ctx: &Context,
         ss: &'s Subsurface,
         si: &Interaction,
         frame_o: &Frame,
+        k_mean: f32,
         exit: Option<ExitFactor>,
     ) -> Self {
-        let mesh = &ctx.scene.meshes[si.geom as usize];
         CvModel {
             ss,
             xo: si.p,
             n: frame_o.n,
-            kappa: mean_curvature(mesh, si.prim),
+            kappa: k_mean,
             a_plane: Vec3::from_array(ss.probe.planar_reflectance().map(|a| a as f32)),
             f_o: exit.map_or(Vec3::ONE, |e| e.at_exit_alone()),
         }
@@ -1093,7 +1091,7 @@ fn lod_entry<'s>(
 ) -> Vertex<'s> {
     let mut w = ss.lod().albedo;
     if let Some(cc) = ss.curvature_correction() {
-        let k_o = mean_curvature(&ctx.scene.meshes[si.geom as usize], si.prim);
+        let (_, k_o) = ctx.curvatures(si.geom, si.prim);
         if let Some(f) = cc.weight(k_o, k_o) {
             w *= f;
         }
@@ -1153,7 +1151,7 @@ fn probe_entry<'s>(
     // the weight untouched, on flat and concave surfaces.
     let mut weight = ps.weight;
     if let Some((cc, exit)) = &exit {
-        let k_i = mean_curvature(target.mesh, ps.hit.prim);
+        let (_, k_i) = ctx.curvatures(si.geom, ps.hit.prim);
         if let Some(f) = cc.weight_from(exit, k_i) {
             weight *= f;
         }

@@ -10,6 +10,7 @@
 //! with the density the weights divide by (a χ² test).
 
 use crate::accel::{Accel, Hit, ProbeHits};
+use crate::bssrdf::curvature_correction::mean_curvature;
 use crate::bssrdf::{pick_hit, ProbeRandoms, ProbeSampler, ProbeSegment};
 use crate::geometry::{Frame, Mesh, Vec3};
 
@@ -63,6 +64,42 @@ pub fn exit_curvature(mesh: &Mesh, prim: u32) -> f32 {
     let r = mesh.bounding_radius();
     let floor = if r > 0.0 { 1.0 / r } else { 0.0 };
     curvature(mesh, prim).max(floor)
+}
+
+/// Per triangle of one mesh, the two curvatures a subsurface hit reads:
+/// [`exit_curvature`] (the probe axes' rule) and
+/// [`mean_curvature`] (the curvature correction and the control
+/// variate's model surface), computed once when the render starts
+/// ([`crate::integrator::Context`], for meshes with a subsurface
+/// material) instead of at every hit from the vertex normals: each is a
+/// deterministic function of the triangle, so the values, and the pixels,
+/// are the same bit for bit (tested). 8 bytes a triangle.
+#[derive(Clone, Debug, Default)]
+pub struct MeshCurvature {
+    /// (exit, mean) per triangle.
+    per_prim: Vec<[f32; 2]>,
+}
+
+impl MeshCurvature {
+    pub fn new(mesh: &Mesh) -> Self {
+        MeshCurvature {
+            per_prim: (0..mesh.triangle_count() as u32)
+                .map(|prim| [exit_curvature(mesh, prim), mean_curvature(mesh, prim)])
+                .collect(),
+        }
+    }
+
+    /// [`exit_curvature`] of triangle `prim`.
+    #[inline]
+    pub fn exit(&self, prim: u32) -> f32 {
+        self.per_prim[prim as usize][0]
+    }
+
+    /// [`mean_curvature`] of triangle `prim`.
+    #[inline]
+    pub fn mean(&self, prim: u32) -> f32 {
+        self.per_prim[prim as usize][1]
+    }
 }
 
 /// The object a probe searches: mesh `geom` of `accel`, and that mesh (for
@@ -938,6 +975,35 @@ mod tests {
         let mut big = cube.clone();
         big.transform(|p| p * 10.0, |n| n);
         assert!((exit_curvature(&big, 0) - floor / 10.0).abs() < 1e-7);
+    }
+
+    #[test]
+    fn the_curvature_cache_is_the_functions_bit_for_bit() {
+        // A smooth sphere (both curvatures > 0), the same sphere turned
+        // inside out (mean curvature 0: concave) and a flat quad.
+        let sphere = uv_sphere(Vec3::new(1.0, -2.0, 0.5), 2.5, 10);
+        let mut inside = sphere.clone();
+        inside.transform(|p| p, |n| -n);
+        let flat = planes(3.0, &[0.5]);
+        for (what, m) in [("sphere", &sphere), ("inside", &inside), ("flat", &flat)] {
+            let cache = MeshCurvature::new(m);
+            for prim in 0..m.triangle_count() as u32 {
+                assert_eq!(
+                    cache.exit(prim).to_bits(),
+                    exit_curvature(m, prim).to_bits()
+                );
+                assert_eq!(
+                    cache.mean(prim).to_bits(),
+                    mean_curvature(m, prim).to_bits()
+                );
+            }
+            let (k_exit, k_mean) = (cache.exit(0), cache.mean(0));
+            match what {
+                "sphere" => assert!(k_exit > 0.0 && k_mean > 0.0),
+                "inside" => assert!(k_exit > 0.0 && k_mean == 0.0),
+                _ => assert!(k_exit > 0.0 && k_mean == 0.0),
+            }
+        }
     }
 
     /// A closed thin wedge (triangular prism): faces z = ±x·tan(angle/2)
