@@ -207,8 +207,11 @@ fn each_light_group_holds_the_light_of_its_own_lights() {
             for (p, b) in out.film.pixels.iter().enumerate() {
                 for c in 0..3 {
                     let (v, want) = (l.get(p, c), if c == g { b[c] } else { 0.0 });
-                    // (the beauty sums a coat split's branches apart: ulps)
-                    let ok = (v - want).abs() <= 1e-5 * want;
+                    // (the beauty sums a coat split's branches apart: ulps;
+                    // a pixel of few samples can be slightly negative where
+                    // the control variate's model is lit and the surface
+                    // is not, `integrator::control_variate`)
+                    let ok = (v - want).abs() <= 1e-5 * want.abs();
                     assert!(
                         ok,
                         "{integrator:?}: {name} pixel {p} channel {c}: {v}, not {want}"

@@ -14,7 +14,7 @@
 //! entry point (its sampling weight is exactly 1) and a convex object (the
 //! lobe ray escapes), one camera sample is at most that weight times L.
 //! Renders with `ProbeOptions::default()` (the curvature rule, whose proven
-//! bound is √3/ε_min = 12.5× looser, `ProbeAxes::weight_bound`) are held
+//! bound is √3/ε_min = 50× looser, `ProbeAxes::weight_bound`) are held
 //! to the Mis3 bound all the same: on these scenes it holds, and a default
 //! that broke it would deserve a look.
 //!

@@ -113,7 +113,11 @@ impl ProbeAxes {
 /// The smallest probability of each tangent axis under
 /// [`ProbeAxes::Curvature`]: it keeps every surface within Rmax reachable
 /// (so the estimator stays unbiased on any geometry) and bounds the weight
-/// of a hit by (√3/ε_min)·n_active·A (module docs).
+/// of a hit by (√3/ε_min)·n_active·A (module docs). 0.005 since the plane
+/// control variate (`integrator::control_variate`), which models only
+/// probes along N: on the smooth sphere relMSE×spp with it falls from
+/// 0.079 at 0.02 to 0.052 at 0.005 and 0.049 at 0.002 (docs/accuracy.md,
+/// "The plane control variate"); the grazing scene keeps ε = ¼.
 pub const TANGENT_PROB_MIN: f64 = 0.005;
 
 /// κ·d at and beyond which [`ProbeAxes::Curvature`] uses mis3's ¼.

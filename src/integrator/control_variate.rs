@@ -30,11 +30,11 @@
 //! curvature correction the model surface would get everywhere) to what
 //! the probe gives.
 //!
-//! **Why E[C] = 0, exactly.** Given the light sample, d is symmetric (φ
+//! **Why E\[C\] = 0, exactly.** Given the light sample, d is symmetric (φ
 //! uniform) and W_plane depends on r only, so by [`PlaneModel`]'s identity
-//! E[1[V=N]·W_plane·ĝ(d)] = ∫_disk Rd(|d|) ĝ(d) dA = A_plane·g(0): the odd
+//! E\[1\[V=N\]·W_plane·ĝ(d)\] = ∫_disk Rd(|d|) ĝ(d) dA = A_plane·g(0): the odd
 //! part ½(g(d) − g(−d)) integrates to 0 over the disk. And
-//! E[1[V=N]] · A_plane/P(N) · g(0) = A_plane·g(0). The light sample is
+//! E\[1\[V=N\]\] · A_plane/P(N) · g(0) = A_plane·g(0). The light sample is
 //! drawn independently of the probe, so the mean over it is 0 too. The
 //! estimator stays unbiased whatever g is; how much variance it removes
 //! depends on how well W_plane·ĝ tracks W·g(xi) (measured below).
@@ -62,10 +62,11 @@
 //! shadow ray); the mean is unaffected.
 //!
 //! **Measured** (docs/accuracy.md, "The plane control variate"): on
-//! scenes/smooth-sphere.toml one probe with the term has half the relMSE
-//! per sample of one probe without it, for ~11 % more instructions; the
-//! antithetic pair, which it replaces as the default, has 0.7× its relMSE
-//! for ~29 % more.
+//! scenes/smooth-sphere.toml one probe with the term has 0.43× the relMSE
+//! per sample of one probe without it, for 14 % more instructions; the
+//! antithetic pair, which it replaces as the default, has 0.84× its
+//! relMSE for 25 % more, so the two reach a given error in about the same
+//! work (the pair 5 % slower). On the marble bunny it gains ~4 %.
 
 use crate::bssrdf::PlaneModel;
 use crate::geometry::Vec3;

@@ -15,14 +15,14 @@
 //! vertex its next-event estimate gets the plane control variate
 //! ([`super::control_variate`]: the light a model of the surface predicts
 //! at the probe's disk point, less its known mean, is subtracted; the light
-//! sample is drawn ahead, in [`entries`], so the model and the entry point
+//! sample is drawn ahead, in `entries`, so the model and the entry point
 //! use the same one). An antithetic pair of probes (below) is the other
 //! option, off by default. Paths end at `max_depth` bounces or by Russian
 //! roulette once their throughput is small (pbrt-v4 §13.1.1).
 //!
-//! **The antithetic probe pair** ([`PAIR_DEPTH`], off by default). At a subsurface hit xo
-//! of the camera path, one probe's random numbers (channel, radius r, axis
-//! V, angle φ) give two probes, at φ and at φ + π, and so two entry points
+//! **The antithetic probe pair** ([`PAIR_DEPTH`], off by default). At a
+//! subsurface hit xo of the camera path, one probe's random numbers
+//! (channel, radius r, axis V, angle φ) give two probes, at φ and at φ + π, and so two entry points
 //! x₁, x₂ with the probe weights W_k = Rd(|xo − x_k|) / p(x_k) × (hits on
 //! its segment). With β the throughput into the medium,
 //!
@@ -41,11 +41,12 @@
 //! δ and −δ on a plane (to first order in κr on a surface of curvature
 //! κ), and that change — the irradiance turning across a lit curved body,
 //! and the probe weights' own spread — is most of one probe's noise on a
-//! smoothly lit body: on scenes/smooth-sphere.toml the pair has 0.37× one
+//! smoothly lit body: on scenes/smooth-sphere.toml the pair has 0.36× one
 //! plain probe's relMSE per sample for 1.34× the rays. The control
-//! variate takes most of the same noise for no ray (0.48×), and so
-//! replaced the pair as the default: per unit of work the two are close,
-//! and the pair with the control variate too is best by ~10 %
+//! variate takes most of the same noise for no ray (0.43×), and so
+//! replaced the pair as the default: per unit of work the two are within
+//! 5 % (the control variate ahead), and the pair with the control variate
+//! too is best by another 5 % at 1.36× the default's work per sample
 //! (docs/accuracy.md, "The plane control variate"). Deeper vertices use
 //! one probe: their share of the image is small and the second probe and
 //! light sample cost the same there.
