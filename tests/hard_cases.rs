@@ -1014,6 +1014,47 @@ fn documented_subsurface_examples_load_and_render() {
 /// every sample channel is counted as clamped, summed over all tiles and
 /// threads (the render summary reports the count).
 #[test]
+fn non_finite_samples_are_discarded_and_counted() {
+    // Two facing emitters of 3e38 (near f32::MAX), the camera between
+    // them looking at one: every camera ray finds 3e38 at its first hit,
+    // and the lobe sample from there meets the other emitter, whose
+    // emission (MIS weight near 1: it fills the hemisphere) overflows the
+    // sum to +inf. Every sample is then discarded (its pixel stays black)
+    // and counted, the same on 1 and 2 threads.
+    let (w, h, spp) = (16u32, 12u32, 2u64);
+    let quad = |name: &str, rot: &str, z: i32| {
+        format!(
+            "[[shapes]]\nname = \"{name}\"\ntype = \"quad\"\nmaterial = \"lamp\"\n\
+             emission = [3e38, 3e38, 3e38]\nscale = 50\n{rot}translate = [0, 0, {z}]\n"
+        )
+    };
+    let s = load_str(
+        &format!(
+            "[camera]\nlook_from = [0, 0, 0]\nlook_at = [0, 0, -1]\nresolution = [{w}, {h}]\n\
+             [render]\nspp = {spp}\nseed = 1\nmax_depth = 3\n\
+             [materials.lamp]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]\n{}{}",
+            quad("a", "", -1),
+            quad("b", "rotate = [[180, 1, 0, 0]]\n", 1)
+        ),
+        Path::new("nonfinite.toml"),
+    )
+    .unwrap();
+    for threads in [1, 2] {
+        let a = accel::build(&s.meshes, Backend::Bvh).unwrap();
+        let opts = RenderOptions {
+            threads: Some(threads),
+            ..Default::default()
+        };
+        let (film, stats) = render(&s, a.as_ref(), &opts).unwrap();
+        assert_eq!(stats.counters.nonfinite, w as u64 * h as u64 * spp);
+        assert!(
+            film.pixels.iter().all(|p| *p == Vec3::ZERO),
+            "discarded samples leave their pixels black"
+        );
+    }
+}
+
+#[test]
 fn radiance_beyond_the_accumulator_range_is_clamped_and_counted() {
     let (w, h, spp) = (40u32, 24u32, 3u64);
     let s = load_str(
