@@ -3,7 +3,7 @@
 //!
 //!     cargo run --release --example pixel_variance -- SCENE.toml \
 //!         [--width N] [--spp N] [--seed N] [--axes A] [--specular BOOL] \
-//!         [--reference REF.exr] [--map OUT.exr] [--threads N]
+//!         [--reference REF.exr] [--map OUT.exr] [--image OUT.exr] [--threads N]
 //!
 //! Renders every pixel with `--spp` samples exactly as `lucent render`
 //! does (the same random streams), but keeps each pixel's sample variance
@@ -17,7 +17,8 @@
 //! highlight (the mirror direction at the centre hit meets an emitter),
 //! lit body (the emitter's centroid above the centre hit's horizon) and
 //! dark side (the rest). Each region's share is its part of the whole
-//! figure. `--map` writes σ²/(R² + ε) per pixel and channel as an EXR.
+//! figure. `--map` writes σ²/(R² + ε) per pixel and channel as an EXR,
+//! `--image` the pixels' means (the render of these samples).
 //! The time is the wall time of the samples (no accel build), ms per spp;
 //! `--pair-depth N` samples an antithetic probe pair at subsurface hits
 //! below depth N (default 0: one probe, `integrator::path`), `--cv-depth N`
@@ -173,6 +174,7 @@ fn main() {
     let mut count = [0usize; 5];
     let mut rays = 0u64;
     let mut map = Film::new(w, h);
+    let mut image = Film::new(w, h);
     let total_px = (w * h) as f64;
     for y in 0..h {
         for x in 0..w {
@@ -190,6 +192,11 @@ fn main() {
             share[region] += (e[0] + e[1] + e[2]) / (3.0 * total_px);
             count[region] += 1;
             map.set(x, y, Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32));
+            image.set(
+                x,
+                y,
+                Vec3::new(mean[0] as f32, mean[1] as f32, mean[2] as f32),
+            );
         }
     }
     let total: f64 = share.iter().sum();
@@ -217,6 +224,11 @@ fn main() {
     }
     if let Some(p) = arg::<String>(&args, "--map") {
         map.write_exr(Path::new(&p))
+            .unwrap_or_else(|e| die(&e.to_string()));
+    }
+    if let Some(p) = arg::<String>(&args, "--image") {
+        image
+            .write_exr(Path::new(&p))
             .unwrap_or_else(|e| die(&e.to_string()));
     }
 }
