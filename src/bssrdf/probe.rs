@@ -1055,4 +1055,66 @@ mod tests {
         }
         assert_eq!(n, 2 * 2000 * ProbeAxes::ALL.len());
     }
+
+    #[test]
+    fn the_plane_model_is_the_probe_on_the_tangent_plane() {
+        // For a probe along N the model's offset d is where the probe line
+        // crosses the tangent plane through xo, its weight what `weigh`
+        // gives a single hit there on a surface of normal N, and P(N) the
+        // axis probability; the pair's model is its first probe's. Probes
+        // along T or B have none. The segments are `sample_probe`'s and
+        // `sample_probe_pair`'s, bit for bit.
+        let params = SubsurfaceParams::from_preset("marble", 1.0, profile::Fit::Searchlight);
+        let s = ProbeSampler::new(&params.unwrap(), &ProbeOptions::default()).unwrap();
+        let mut rng = Rng::from_key(17);
+        let frame = Frame::from_normal(Vec3::new(0.3, -0.5, 0.8).normalize());
+        let xo = Vec3::new(0.25, -1.5, 3.0);
+        let (mut along_n, mut tangent) = (0, 0);
+        for i in 0..4000 {
+            let u = ProbeRandoms::from_rng(&mut rng);
+            // κ·d from 0 to ~1.3: ε from ε_min to ¼
+            let kappa = (i % 9) as f32 * 0.2;
+            let (seg, plane) = s.sample_probe_and_plane(xo, &frame, kappa, &u).unwrap();
+            let want = s.sample_probe(xo, &frame, kappa, &u).unwrap();
+            assert_eq!(
+                (seg.ray.o, seg.ray.d, seg.t_max),
+                (want.ray.o, want.ray.d, want.t_max)
+            );
+            let ([a, b], pair_plane) = s
+                .sample_probe_pair_and_plane(xo, &frame, kappa, &u)
+                .unwrap();
+            let [wa, wb] = s.sample_probe_pair(xo, &frame, kappa, &u).unwrap();
+            assert_eq!((a.ray.o, b.ray.o, a.ray.d), (wa.ray.o, wb.ray.o, wa.ray.d));
+            assert_eq!(plane, pair_plane);
+            let on_n = seg.ray.d.dot(frame.n) < -0.999;
+            let Some(pm) = plane else {
+                assert!(!on_n, "probe {i} along N without a model");
+                tangent += 1;
+                continue;
+            };
+            assert!(on_n, "probe {i}: a model for a probe along T or B");
+            along_n += 1;
+            let (o, d, n) = (seg.ray.o, seg.ray.d, frame.n);
+            let t = (xo - o).dot(n) / d.dot(n);
+            let p = o + d * t;
+            let r = s.rmax() as f32;
+            assert!(
+                (p - (xo + pm.offset)).length() < 1e-5 * r,
+                "probe {i}: crosses at {p}, model at {}",
+                xo + pm.offset
+            );
+            assert!(pm.offset.dot(n).abs() < 1e-5 * r && pm.offset.length() <= r * 1.0001);
+            let w = s.weigh(&seg, t, n, 1).unwrap().weight;
+            assert!(
+                (w - pm.weight).abs().max_element() <= 1e-3 * w.max_element(),
+                "probe {i}: weigh {w} against the model's {}",
+                pm.weight
+            );
+            assert_eq!(pm.p_normal, s.axis_probs(kappa)[AXIS_N] as f32);
+        }
+        assert!(
+            along_n > 2500 && tangent > 300,
+            "{along_n} along N, {tangent} along T/B"
+        );
+    }
 }
