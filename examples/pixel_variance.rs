@@ -20,10 +20,9 @@
 //! figure. `--map` writes σ²/(R² + ε) per pixel and channel as an EXR,
 //! `--image` the pixels' means (the render of these samples).
 //! The time is the wall time of the samples (no accel build), ms per spp;
-//! `--pair-depth N` samples an antithetic probe pair at subsurface hits
-//! below depth N (default 0: one probe, `integrator::path`), `--cv-depth N`
-//! adds the plane control variate below depth N (default 1, the camera
-//! vertex; 0: off, `integrator::control_variate`), and `--axes`,
+//! `--probe-pair true` samples an antithetic probe pair at the camera
+//! vertex (`integrator::path`), `--control-variate false` drops the plane
+//! control variate there (`integrator::control_variate`), and `--axes`,
 //! `--specular`, `--exit-sw`, `--renormalize` override the materials'
 //! choices as on the command line.
 
@@ -75,8 +74,6 @@ fn main() {
     let Some(path) = args.first() else {
         die("usage: pixel_variance SCENE.toml [options] (see the source)")
     };
-    let pair_depth: Option<u32> = arg(&args, "--pair-depth");
-    let cv_depth: Option<u32> = arg(&args, "--cv-depth");
     let mut scene = scene::load(Path::new(path)).unwrap_or_else(|e| die(&e.to_string()));
     if let Some(w) = arg::<u32>(&args, "--width") {
         let c = &scene.camera;
@@ -92,6 +89,8 @@ fn main() {
         specular: arg(&args, "--specular"),
         exit_sw: arg(&args, "--exit-sw"),
         renormalize: arg(&args, "--renormalize"),
+        control_variate: arg(&args, "--control-variate"),
+        probe_pair: arg(&args, "--probe-pair"),
         ..Default::default()
     };
     ov.apply_all(&mut scene.materials)
@@ -105,13 +104,7 @@ fn main() {
         Backend::Bvh
     };
     let accel = accel::build(&scene.meshes, backend).unwrap_or_else(|e| die(&e.to_string()));
-    let mut ctx = Context::new(&scene, accel.as_ref());
-    if let Some(p) = pair_depth {
-        ctx.pair_depth = p;
-    }
-    if let Some(c) = cv_depth {
-        ctx.cv_depth = c;
-    }
+    let ctx = Context::new(&scene, accel.as_ref());
     let (w, h) = (scene.camera.width, scene.camera.height);
     if let Some(r) = &reference {
         if (r.width, r.height) != (w, h) {

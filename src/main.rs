@@ -265,6 +265,14 @@ struct SubsurfaceArgs {
     /// (always probe) | force (every hit shaded with albedo A; for tests).
     #[arg(long, value_enum)]
     lod: Option<LodArg>,
+    /// At the camera vertex, the plane control variate on the light
+    /// sampled at the entry point (true by default).
+    #[arg(long)]
+    control_variate: Option<bool>,
+    /// At the camera vertex, an antithetic pair of probes (false by
+    /// default).
+    #[arg(long)]
+    probe_pair: Option<bool>,
 }
 
 /// How the EXR is stored (docs/output.md); each overrides the scene's
@@ -413,6 +421,8 @@ impl SubsurfaceArgs {
                 LodArg::Off => LodMode::Off,
                 LodArg::Force => LodMode::Force,
             }),
+            control_variate: self.control_variate,
+            probe_pair: self.probe_pair,
         }
     }
 }
@@ -1008,8 +1018,8 @@ struct StudyArgs {
     #[arg(long, default_value_t = 10.0)]
     firefly_k: f64,
     /// Only these axes (comma separated: radius, rmax, axes, channel,
-    /// renormalize, exit_sw, specular, backend, integrator, boundary, lod); the baseline
-    /// always runs.
+    /// renormalize, exit_sw, specular, backend, integrator, boundary, lod,
+    /// variance); the baseline always runs.
     #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
     only: Vec<lucent::tools::study::Axis>,
     /// No progress bars.

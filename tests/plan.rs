@@ -206,10 +206,11 @@ fn ketchup_blue_is_off_with_the_presets_given_albedo_and_on_with_the_table() {
 }
 
 #[test]
-fn the_control_variate_is_planned_only_under_area_lights() {
-    // It models next-event estimation of area lights: under the
-    // environment alone there is nothing for it to model, and the plan
-    // says so; with a lamp it is on at the camera vertex.
+fn the_variance_reduction_is_planned_as_the_material_asks_and_the_lights_allow() {
+    // The control variate models next-event estimation of area lights:
+    // under the environment alone there is nothing for it to model, and
+    // the plan says so; with a lamp it is on at the camera vertex, unless
+    // the material turns it off; the pair only where the material asks.
     let diffusion_of = |s: &Scene| -> Value {
         let v = serde_json::to_value(plan_of(s, IntegratorKind::Path, PassSet::EMPTY)).unwrap();
         let m = v["materials"]
@@ -241,6 +242,28 @@ fn the_control_variate_is_planned_only_under_area_lights() {
     assert!(
         why.contains("control variate") && why.contains("depth < 1"),
         "{why}"
+    );
+    // The material's choices: the pair instead, and neither.
+    let pair = load(&format!(
+        "{LAMP}{KETCHUP}control_variate = false\nprobe_pair = true\n{BALL_SAUCE}"
+    ));
+    let d = diffusion_of(&pair);
+    assert_eq!(
+        (&d["pair_depth"], &d["control_variate_depth"]),
+        (&json!(1), &json!(0))
+    );
+    let why = d["reason"].as_str().unwrap();
+    assert!(
+        why.contains("antithetic pair") && !why.contains("control variate"),
+        "{why}"
+    );
+    let neither = load(&format!(
+        "{LAMP}{KETCHUP}control_variate = false\n{BALL_SAUCE}"
+    ));
+    let d = diffusion_of(&neither);
+    assert_eq!(
+        (&d["pair_depth"], &d["control_variate_depth"]),
+        (&json!(0), &json!(0))
     );
 }
 

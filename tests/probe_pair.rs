@@ -19,6 +19,7 @@ use lucent::accel::{self, Backend};
 use lucent::integrator::aov::NoAov;
 use lucent::integrator::path::{radiance, Scratch};
 use lucent::integrator::{Context, Counters, NoClock};
+use lucent::materials::Material;
 use lucent::sampling::{Draw, SampleRng};
 
 const SCENE: &str = r#"
@@ -39,6 +40,7 @@ radiance = [0.03, 0.03, 0.03]
 [materials.marble]
 type = "subsurface"
 preset = "marble"
+MARBLE_OPTIONS
 
 [materials.lamp]
 type = "diffuse"
@@ -59,6 +61,22 @@ type = "sphere"
 material = "marble"
 subdivisions = 4
 "#;
+
+/// The scene with `options` added to the marble's material.
+fn scene(options: &str) -> lucent::scene::Scene {
+    lucent::scene::load_str(
+        &SCENE.replace("MARBLE_OPTIONS", options),
+        Path::new("probe_pair.toml"),
+    )
+    .unwrap()
+}
+
+/// Per channel mean and variance of `n` samples at pixel (x, y) of `scene`.
+fn stats_of(scene: &lucent::scene::Scene, x: u32, y: u32, n: u64) -> ([f64; 3], [f64; 3]) {
+    let accel = accel::build(&scene.meshes, Backend::Bvh).unwrap();
+    let ctx = Context::new(scene, accel.as_ref());
+    pixel_stats(&ctx, x, y, n)
+}
 
 /// Per channel mean and variance of `n` samples at pixel (x, y).
 fn pixel_stats(ctx: &Context, x: u32, y: u32, n: u64) -> ([f64; 3], [f64; 3]) {
@@ -83,21 +101,17 @@ fn pixel_stats(ctx: &Context, x: u32, y: u32, n: u64) -> ([f64; 3], [f64; 3]) {
 
 #[test]
 fn the_pair_keeps_the_mean_and_cuts_the_lit_bodys_variance() {
-    // (the control variate off: the pair alone against one probe)
-    let scene = lucent::scene::load_str(SCENE, Path::new("probe_pair.toml")).unwrap();
-    let accel = accel::build(&scene.meshes, Backend::Bvh).unwrap();
-    let mut ctx = Context::new(&scene, accel.as_ref());
-    ctx.cv_depth = 0;
+    // (the control variate off in both: the pair alone against one probe)
+    let pair = scene("control_variate = false\nprobe_pair = true");
+    let one = scene("control_variate = false");
     let n = 3000;
     // pixels on the right half of the sphere, all lit (the light is 45° to
     // the right of the camera): from facing the camera to near the rim
     let pixels: Vec<(u32, u32)> = (17..27).flat_map(|x| [(x, 14), (x, 18)]).collect();
     let (mut var_pair, mut var_one) = (0.0, 0.0);
     for &(x, y) in &pixels {
-        ctx.pair_depth = 1;
-        let (m2, v2) = pixel_stats(&ctx, x, y, n);
-        ctx.pair_depth = 0;
-        let (m1, v1) = pixel_stats(&ctx, x, y, n);
+        let (m2, v2) = stats_of(&pair, x, y, n);
+        let (m1, v1) = stats_of(&one, x, y, n);
         for c in 0..3 {
             assert!(
                 m1[c] > 0.05,
@@ -125,22 +139,27 @@ fn the_pair_keeps_the_mean_and_cuts_the_lit_bodys_variance() {
 
 #[test]
 fn the_control_variate_keeps_the_mean_and_cuts_the_lit_bodys_variance() {
-    let scene = lucent::scene::load_str(SCENE, Path::new("probe_pair.toml")).unwrap();
-    let accel = accel::build(&scene.meshes, Backend::Bvh).unwrap();
-    let mut ctx = Context::new(&scene, accel.as_ref());
+    let default = scene("");
+    let ss = default
+        .materials
+        .iter()
+        .find_map(|m| match m {
+            Material::Subsurface(ss) => Some(ss),
+            _ => None,
+        })
+        .unwrap();
     assert_eq!(
-        (ctx.pair_depth, ctx.cv_depth),
-        (0, 1),
-        "one probe with the control variate at the camera vertex is the default"
+        (ss.control_variate, ss.probe_pair),
+        (true, false),
+        "one probe with the control variate is the default"
     );
+    let one = scene("control_variate = false");
     let n = 3000;
     let pixels: Vec<(u32, u32)> = (17..27).flat_map(|x| [(x, 14), (x, 18)]).collect();
     let (mut var_cv, mut var_one) = (0.0, 0.0);
     for &(x, y) in &pixels {
-        ctx.cv_depth = 1;
-        let (m2, v2) = pixel_stats(&ctx, x, y, n);
-        ctx.cv_depth = 0;
-        let (m1, v1) = pixel_stats(&ctx, x, y, n);
+        let (m2, v2) = stats_of(&default, x, y, n);
+        let (m1, v1) = stats_of(&one, x, y, n);
         for c in 0..3 {
             assert!(
                 m1[c] > 0.05,

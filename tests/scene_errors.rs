@@ -508,6 +508,20 @@ fn cases() -> Vec<Case> {
             Some("materials.skin.fit"),
         ),
         case(
+            "subsurface control variate not a boolean",
+            format!("{CAM}{SSS}preset = \"skin1\"\ncontrol_variate = \"on\"\n"),
+            "expected a boolean",
+            Some("control_variate"),
+            Some("materials.skin.control_variate"),
+        ),
+        case(
+            "probe pair on a diffuse material",
+            format!("{CAM}{MAT}probe_pair = true\n"),
+            "`probe_pair` does not apply to type \"diffuse\"",
+            Some("probe_pair"),
+            Some("materials.white.probe_pair"),
+        ),
+        case(
             "subsurface renormalize not a boolean",
             format!("{CAM}{SSS}preset = \"skin1\"\nrenormalize = \"yes\"\n"),
             "expected a boolean",

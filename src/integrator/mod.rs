@@ -48,12 +48,14 @@ pub struct Context<'a> {
     /// Per mesh, what [`Interaction::new`] reads.
     pub shading: Vec<interaction::MeshShading>,
     /// Subsurface hits at depths below this sample an antithetic pair of
-    /// entry points ([`path::PAIR_DEPTH`], the default: 0, off); for
-    /// measurements and tests.
+    /// entry points on materials with `probe_pair` on
+    /// ([`path::PAIR_DEPTH`], the default: the camera vertex); 0 turns the
+    /// pair off everywhere.
     pub pair_depth: u32,
     /// Subsurface hits at depths below this add the plane control variate
-    /// (`control_variate::CV_DEPTH`, the default: the camera vertex); 0
-    /// turns it off, for measurements and tests.
+    /// on materials with `control_variate` on (the default;
+    /// `control_variate::CV_DEPTH`: the camera vertex); 0 turns it off
+    /// everywhere.
     pub cv_depth: u32,
     /// The camera's pixel angle, for the footprint cone of subsurface
     /// level of detail ([`crate::materials::lod`]).

@@ -124,15 +124,15 @@ pub(crate) const RR_START: u32 = 3;
 #[cfg(feature = "subsurface")]
 pub(crate) const COAT_SPLIT_DEPTH: u32 = 1;
 
-/// Subsurface hits at depths below this sample two entry points from one
-/// probe's randoms, the second at the opposite angle φ + π (antithetic),
-/// and sample light at both, each weighted ½; the path goes on from one of
-/// them, chosen with probability ½ (module docs). Light varying linearly
-/// across the profile cancels between the two. 0: off, the default of
-/// [`Context::pair_depth`] since the plane control variate takes most of
-/// the same noise without the second probe (module docs); 1 turns it on at
-/// the camera vertex.
-pub const PAIR_DEPTH: u32 = 0;
+/// Subsurface hits at depths below this, on materials with `probe_pair`
+/// on (off by default: the plane control variate takes most of the same
+/// noise without the second probe, module docs), sample two entry points
+/// from one probe's randoms, the second at the opposite angle φ + π
+/// (antithetic), and sample light at both, each weighted ½; the path goes
+/// on from one of them, chosen with probability ½ (module docs). Light
+/// varying linearly across the profile cancels between the two. 1: the
+/// camera vertex (the default of [`Context::pair_depth`]).
+pub const PAIR_DEPTH: u32 = 1;
 
 /// Paths waiting to be traced after the current one ends; more than this
 /// many at once never happens with [`COAT_SPLIT_DEPTH`] ≤ 4.
@@ -881,10 +881,11 @@ fn coat_reflection(
 
 /// The entry vertices the path goes on from at a subsurface hit at
 /// `depth`, `beta` scaled by the chosen one's probe weight: one probe, or
-/// below `ctx.pair_depth` an antithetic pair ([`PAIR_DEPTH`]), whose second
-/// vertex comes back with its own throughput for light sampling; below
-/// `ctx.cv_depth` with the plane control variate's light samples and terms
-/// ([`super::control_variate`]). Where the material's level-of-detail rule
+/// below `ctx.pair_depth` where the material asks for it an antithetic
+/// pair ([`PAIR_DEPTH`]), whose second vertex comes back with its own
+/// throughput for light sampling; below `ctx.cv_depth` where the material
+/// asks for it (the default) with the plane control variate's light
+/// samples and terms ([`super::control_variate`]). Where the material's level-of-detail rule
 /// applies to the footprint `width`, no probe: the entry lobe at xo itself,
 /// weighted by the profile's plane integral ([`crate::materials::lod`]).
 #[allow(clippy::too_many_arguments)]
@@ -910,14 +911,15 @@ fn entries<'s>(
             Ahead::default(),
         );
     }
-    let cv = control_variate::applies(ctx.cv_depth, ctx.plan.area_lights, depth);
+    let cv =
+        ss.control_variate && control_variate::applies(ctx.cv_depth, ctx.plan.area_lights, depth);
     // The control variate's light samples, drawn before the probe's randoms.
     let lights = cv.then(|| [draw_light(ctx, rng), None]);
     let u = ProbeRandoms::from_rng(rng);
     // The curvature correction's exit half, once for both probes of a pair.
     let exit = ss.curvature_correction().map(|cc| (cc, cc.at_exit(k_mean)));
     let beta_in = *beta;
-    if depth >= ctx.pair_depth {
+    if !(ss.probe_pair && depth < ctx.pair_depth) {
         let (seg, plane) = if cv {
             match ss.probe.sample_probe_and_plane(si.p, &frame_o, kappa, &u) {
                 Some(sp) => sp,

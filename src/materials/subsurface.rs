@@ -58,6 +58,12 @@ pub struct Subsurface {
     curvature: Option<CurvatureCorrection>,
     /// The level-of-detail rule ([`super::lod`]).
     lod: LodRule,
+    /// At the camera vertex, the plane control variate on the entry
+    /// point's light sample (`integrator::control_variate`; the default).
+    pub control_variate: bool,
+    /// At the camera vertex, an antithetic pair of probes instead of one
+    /// (`integrator::path`, `PAIR_DEPTH`; off by default).
+    pub probe_pair: bool,
 }
 
 /// The scene's `curvature_correction` setting.
@@ -92,6 +98,8 @@ impl PartialEq for Subsurface {
             && self.curvature_mode == o.curvature_mode
             && self.lod.mode == o.lod.mode
             && self.lod.threshold == o.lod.threshold
+            && self.control_variate == o.control_variate
+            && self.probe_pair == o.probe_pair
     }
 }
 
@@ -122,6 +130,8 @@ impl Subsurface {
             curvature_mode: CurvatureMode::default(),
             curvature,
             lod,
+            control_variate: true,
+            probe_pair: false,
         })
     }
 
@@ -270,6 +280,8 @@ pub struct SubsurfaceOverrides {
     pub boundary: Option<WalkBoundary>,
     pub roughness: Option<f32>,
     pub lod: Option<LodMode>,
+    pub control_variate: Option<bool>,
+    pub probe_pair: Option<bool>,
 }
 
 impl Subsurface {
@@ -280,7 +292,8 @@ impl Subsurface {
         let o = self.probe.options();
         format!(
             "radius={} rmax_quantile={} axes={} channel={} renormalize={} exit_sw={} \
-             specular={} roughness={} boundary={} lod={} lod_threshold={}",
+             specular={} roughness={} boundary={} lod={} lod_threshold={} \
+             control_variate={} probe_pair={}",
             o.radius.name(),
             o.rmax_quantile,
             o.axes.name(),
@@ -291,7 +304,9 @@ impl Subsurface {
             self.roughness,
             self.boundary.name(),
             self.lod.mode.name(),
-            self.lod.threshold
+            self.lod.threshold,
+            self.control_variate,
+            self.probe_pair
         )
     }
 }
@@ -319,6 +334,8 @@ impl SubsurfaceOverrides {
         .with_curvature_mode(ss.curvature_mode)
         .with_lod(self.lod.unwrap_or(ss.lod.mode), ss.lod.threshold);
         out.boundary = self.boundary.unwrap_or(ss.boundary);
+        out.control_variate = self.control_variate.unwrap_or(ss.control_variate);
+        out.probe_pair = self.probe_pair.unwrap_or(ss.probe_pair);
         Ok(out)
     }
 

@@ -184,6 +184,9 @@ pub struct MaterialDef {
     // subsurface: level of detail
     pub lod: Option<Spanned<String>>,
     pub lod_threshold: Option<Spanned<f64>>,
+    // subsurface: variance reduction at the camera vertex
+    pub control_variate: Option<Spanned<bool>>,
+    pub probe_pair: Option<Spanned<bool>>,
 }
 
 impl MaterialDef {
@@ -231,6 +234,11 @@ impl MaterialDef {
             "lod_threshold",
             self.lod_threshold.as_ref().map(|x| x.span()),
         );
+        add(
+            "control_variate",
+            self.control_variate.as_ref().map(|x| x.span()),
+        );
+        add("probe_pair", self.probe_pair.as_ref().map(|x| x.span()));
         v
     }
 }

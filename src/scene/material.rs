@@ -55,6 +55,8 @@ const SUBSURFACE_KEYS: &[&str] = &[
     "curvature_correction",
     "lod",
     "lod_threshold",
+    "control_variate",
+    "probe_pair",
 ];
 
 /// The parameter forms, for messages.
@@ -166,6 +168,12 @@ pub(super) fn material(
                 None => DEFAULT_THRESHOLD,
             };
             ss = ss.with_lod(lod, threshold);
+            if let Some(b) = &d.control_variate {
+                ss.control_variate = *b.get_ref();
+            }
+            if let Some(b) = &d.probe_pair {
+                ss.probe_pair = *b.get_ref();
+            }
             check_rmax(cx, &field, m, &ss, units_per_mm, units_def)?;
             Ok(Material::Subsurface(Arc::new(ss)))
         }

@@ -52,10 +52,12 @@ pub struct PlanOptions {
     pub integrator: IntegratorKind,
     /// The passes asked for (`--aov`, else the scene's `[output] aovs`).
     pub passes: PassSet,
-    /// Subsurface hits below this depth sample an antithetic probe pair
+    /// Subsurface hits below this depth, on materials with `probe_pair`,
+    /// sample an antithetic probe pair
     /// (`crate::integrator::Context::pair_depth`).
     pub pair_depth: u32,
-    /// Subsurface hits below this depth add the plane control variate
+    /// Subsurface hits below this depth, on materials with
+    /// `control_variate`, add the plane control variate
     /// (`crate::integrator::Context::cv_depth`).
     pub cv_depth: u32,
 }
@@ -455,8 +457,13 @@ fn diffusion_material(
     area_lights: bool,
     mp: &mut MaterialPlan,
 ) -> bool {
-    let pair_depth = opts.pair_depth;
-    let cv_depth = if area_lights { opts.cv_depth } else { 0 };
+    let pair_depth = if ss.probe_pair { opts.pair_depth } else { 0 };
+    let cv_depth = if ss.control_variate && area_lights {
+        opts.cv_depth
+    } else {
+        0
+    };
+    let cv_asked = if ss.control_variate { opts.cv_depth } else { 0 };
     let o = ss.probe.options();
     let active: [bool; 3] = std::array::from_fn(|c| ss.params.active(c));
     let any = active.iter().any(|&a| a);
@@ -478,7 +485,7 @@ fn diffusion_material(
                 pair_depth,
                 control_variate_depth: cv_depth,
                 curvature_correction: ss.curvature_correction().is_some(),
-                reason: diffusion_reason(pair_depth, cv_depth, area_lights, opts.cv_depth),
+                reason: diffusion_reason(pair_depth, cv_depth, area_lights, cv_asked),
             }
         } else {
             SubsurfaceMethod::None {

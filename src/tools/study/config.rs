@@ -33,10 +33,14 @@ pub enum Axis {
     /// Subsurface level of detail off (the baseline keeps the scene's,
     /// `auto` by default; `crate::materials::lod`).
     Lod,
+    /// The variance reduction at the camera vertex: the baseline's plane
+    /// control variate against none, the antithetic probe pair (the
+    /// previous default) and both (`crate::integrator::control_variate`).
+    Variance,
 }
 
 impl Axis {
-    pub const ALL: [Axis; 12] = [
+    pub const ALL: [Axis; 13] = [
         Axis::Baseline,
         Axis::Radius,
         Axis::RmaxQuantile,
@@ -49,6 +53,7 @@ impl Axis {
         Axis::Integrator,
         Axis::Boundary,
         Axis::Lod,
+        Axis::Variance,
     ];
 
     /// The name used in configuration names and the CSV.
@@ -66,6 +71,7 @@ impl Axis {
             Axis::Integrator => "integrator",
             Axis::Boundary => "boundary",
             Axis::Lod => "lod",
+            Axis::Variance => "variance",
         }
     }
 
@@ -143,6 +149,8 @@ fn full_probe(o: ProbeOptions) -> Overrides {
         boundary: None,
         roughness: None,
         lod: None,
+        control_variate: Some(true),
+        probe_pair: Some(false),
     }
 }
 
@@ -360,6 +368,28 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
             ..m.base
         },
     );
+    // The variance reduction at the camera vertex: the quick study keeps
+    // the pair (the previous default).
+    let variance: &[(&str, bool, bool)] = if quick {
+        &[("pair", false, true)]
+    } else {
+        &[
+            ("none", false, false),
+            ("pair", false, true),
+            ("pair+control-variate", true, true),
+        ]
+    };
+    for &(name, cv, pair) in variance {
+        m.vary(
+            Axis::Variance,
+            name.into(),
+            Overrides {
+                control_variate: Some(cv),
+                probe_pair: Some(pair),
+                ..m.base
+            },
+        );
+    }
     for &b in &backends[1..] {
         m.add(
             Axis::Backend,
@@ -436,6 +466,12 @@ pub fn describe(ov: &Overrides) -> String {
     }
     if let Some(l) = ov.lod {
         parts.push(format!("level of detail {}", l.name()));
+    }
+    if let Some(c) = ov.control_variate {
+        parts.push(format!("control variate {c}"));
+    }
+    if let Some(p) = ov.probe_pair {
+        parts.push(format!("probe pair {p}"));
     }
     parts.join(", ")
 }
