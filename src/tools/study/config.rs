@@ -33,9 +33,11 @@ pub enum Axis {
     /// Subsurface level of detail off (the baseline keeps the scene's,
     /// `auto` by default; `crate::materials::lod`).
     Lod,
-    /// The variance reduction at the camera vertex: the baseline's plane
-    /// control variate against none, the antithetic probe pair (the
-    /// previous default) and both (`crate::integrator::control_variate`).
+    /// The variance reduction at the camera vertex: the scene's (by
+    /// default the plane control variate, which the baseline keeps)
+    /// against the others of none, the control variate, the antithetic
+    /// probe pair (the previous default) and both
+    /// (`crate::integrator::control_variate`).
     Variance,
 }
 
@@ -149,8 +151,9 @@ fn full_probe(o: ProbeOptions) -> Overrides {
         boundary: None,
         roughness: None,
         lod: None,
-        control_variate: Some(true),
-        probe_pair: Some(false),
+        // the scene's own variance reduction (the variance axis varies it)
+        control_variate: None,
+        probe_pair: None,
     }
 }
 
@@ -175,6 +178,18 @@ fn scene_fresnel(scene: &Scene) -> Option<(bool, bool)> {
         Material::Subsurface(ss) => Some((ss.exit_sw, ss.specular)),
         _ => None,
     })
+}
+
+/// The first subsurface material's (control_variate, probe_pair).
+fn scene_variance(scene: &Scene) -> (bool, bool) {
+    scene
+        .materials
+        .iter()
+        .find_map(|m| match m {
+            Material::Subsurface(ss) => Some((ss.control_variate, ss.probe_pair)),
+            _ => None,
+        })
+        .unwrap_or((true, false))
 }
 
 /// The first subsurface material's random-walk boundary.
@@ -368,18 +383,21 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
             ..m.base
         },
     );
-    // The variance reduction at the camera vertex: the quick study keeps
-    // the pair (the previous default).
+    // The variance reduction at the camera vertex, each choice other than
+    // the scene's (the default: the control variate alone); the quick
+    // study keeps the pair (the previous default).
+    let own = scene_variance(scene);
     let variance: &[(&str, bool, bool)] = if quick {
         &[("pair", false, true)]
     } else {
         &[
             ("none", false, false),
+            ("control-variate", true, false),
             ("pair", false, true),
             ("pair+control-variate", true, true),
         ]
     };
-    for &(name, cv, pair) in variance {
+    for &(name, cv, pair) in variance.iter().filter(|v| (v.1, v.2) != own) {
         m.vary(
             Axis::Variance,
             name.into(),
