@@ -388,3 +388,55 @@ fn cli_bad_input_exits_2() {
     // Nothing half-made is left for the failed runs but the directory.
     assert!(!dir.path().join("out").join("results.csv").exists());
 }
+
+#[test]
+fn the_variance_axis_varies_the_camera_vertex_estimator_and_keeps_the_rest() {
+    // The baseline keeps the scene's variance reduction (by default the
+    // control variate alone); the full study adds each other choice, and
+    // every such row differs from the baseline in those two settings only.
+    let variance_rows = |extra: &str| {
+        let text = std::fs::read_to_string(scene("smooth-sphere.toml"))
+            .unwrap()
+            .replace(
+                "[materials.marble]\n",
+                &format!("[materials.marble]\n{extra}"),
+            );
+        let s = lucent::scene::load_str(&text, &scene("smooth-sphere.toml")).unwrap();
+        let m = config::matrix(&s, false, &[lucent::accel::Backend::Bvh]).unwrap();
+        let base = m[0].overrides;
+        assert_eq!((base.control_variate, base.probe_pair), (None, None));
+        let rows: Vec<_> = m.iter().filter(|c| c.axis == Axis::Variance).collect();
+        let mut names = Vec::new();
+        for c in &rows {
+            let ov = c.overrides;
+            assert_eq!(
+                config::Overrides {
+                    control_variate: None,
+                    probe_pair: None,
+                    ..ov
+                },
+                base,
+                "{}",
+                c.name
+            );
+            let want = match c.value.as_str() {
+                "none" => (false, false),
+                "control-variate" => (true, false),
+                "pair" => (false, true),
+                "pair+control-variate" => (true, true),
+                v => panic!("unexpected value {v}"),
+            };
+            assert_eq!(
+                (ov.control_variate, ov.probe_pair),
+                (Some(want.0), Some(want.1))
+            );
+            names.push(c.value.clone());
+        }
+        names
+    };
+    assert_eq!(variance_rows(""), ["none", "pair", "pair+control-variate"]);
+    assert_eq!(
+        variance_rows("probe_pair = true\ncontrol_variate = false\n"),
+        ["none", "control-variate", "pair+control-variate"]
+    );
+}
