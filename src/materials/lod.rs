@@ -77,7 +77,8 @@
 //!
 //! **Cost.** Two f32 per path (w, γ), one multiply-add per hit; the rule
 //! at a subsurface hit is two comparisons. Under LOD a hit casts no probe
-//! ray and samples no antithetic pair: light is sampled once at xo.
+//! ray, adds no control variate and samples no antithetic pair: light is
+//! sampled once at xo.
 
 use crate::geometry::Vec3;
 
