@@ -254,7 +254,8 @@ fn the_variance_reduction_is_planned_as_the_material_asks_and_the_lights_allow()
     );
     let why = d["reason"].as_str().unwrap();
     assert!(
-        why.contains("antithetic pair") && !why.contains("control variate"),
+        why.contains("antithetic pair")
+            && why.contains("no control variate (control_variate = false)"),
         "{why}"
     );
     let neither = load(&format!(

@@ -434,18 +434,18 @@ fn channels(active: [bool; 3], reason: impl Into<String>) -> Channels {
 #[cfg(feature = "subsurface")]
 fn diffusion_reason(pair_depth: u32, cv_depth: u32, area_lights: bool, asked: u32) -> String {
     let probes = if pair_depth > 0 {
-        format!("an antithetic pair of probe rays at depth < {pair_depth}, one probe deeper")
+        format!("an antithetic pair at depth < {pair_depth} (probe_pair), one probe deeper")
     } else {
-        "one probe ray a hit".into()
+        "one a hit".into()
     };
     let cv = if cv_depth > 0 {
-        format!(", the plane control variate on next-event estimation at depth < {cv_depth}")
+        format!("; the plane control variate on next-event estimation at depth < {cv_depth}")
     } else if asked > 0 && !area_lights {
-        ", no control variate (it models area-light sampling; the scene has no area light)".into()
+        "; no control variate (it models area-light sampling; the scene has no area light)".into()
     } else {
-        String::new()
+        "; no control variate (control_variate = false)".into()
     };
-    format!("the integrator's default: {probes} samples the profile{cv}")
+    format!("probe rays sample the profile: {probes}{cv}")
 }
 
 /// A used subsurface material under the diffusion estimator; whether it
