@@ -185,3 +185,37 @@ fn the_control_variate_keeps_the_mean_and_cuts_the_lit_bodys_variance() {
         "the control variate's variance is {ratio:.3} of one probe's"
     );
 }
+
+#[test]
+fn the_pair_keeps_the_mean_where_its_twin_often_misses() {
+    // The marble at 1 unit per mm: the profile (d ≈ 0.9 units) is as wide
+    // as the sphere (radius 1), so one probe of a pair often finds the
+    // sphere and its twin, across xo, does not; that probe then carries
+    // the pair's estimate alone, with weight ½ (`entries`). The pair's
+    // pixel means must still be one probe's.
+    let text = |options: &str| {
+        SCENE
+            .replace("units_per_mm = 0.1", "units_per_mm = 1.0")
+            .replace("MARBLE_OPTIONS", options)
+    };
+    let load = |options: &str| {
+        lucent::scene::load_str(&text(options), Path::new("probe_pair.toml")).unwrap()
+    };
+    let pair = load("control_variate = false\nprobe_pair = true");
+    let one = load("control_variate = false");
+    let n = 4000;
+    for &(x, y) in &[(16, 16), (20, 14), (23, 18), (12, 16)] {
+        let (m2, v2) = stats_of(&pair, x, y, n);
+        let (m1, v1) = stats_of(&one, x, y, n);
+        for c in 0..3 {
+            assert!(m1[c] > 0.0, "pixel ({x}, {y}) is black: {m1:?}");
+            let se = ((v1[c] + v2[c]) / n as f64).sqrt();
+            assert!(
+                (m1[c] - m2[c]).abs() < 5.0 * se,
+                "pixel ({x}, {y}) ch{c}: pair {} vs one probe {} (se {se})",
+                m2[c],
+                m1[c]
+            );
+        }
+    }
+}

@@ -232,6 +232,31 @@ mod tests {
     }
 
     #[test]
+    fn row_interpolates_bilinearly_between_x_and_eta_nodes() {
+        // Halfway between two x nodes (η at a node, then halfway between
+        // two η nodes too): the mean of the neighbouring nodes' h, at every
+        // ρ node, for both η rows the bilinear form reads.
+        let t = CurvatureTable::get().unwrap();
+        for ie in 0..t.etas.len() - 1 {
+            for ix in 0..t.xs.len() - 1 {
+                let x = 0.5 * (t.xs[ix] + t.xs[ix + 1]);
+                let at_node = t.row(x, t.etas[ie]);
+                let eta = 0.5 * (t.etas[ie] + t.etas[ie + 1]);
+                let between = t.row(x, eta);
+                for ir in 0..t.rhos.len() {
+                    let lo = 0.5 * (t.h[ie][ix][ir] + t.h[ie][ix + 1][ir]);
+                    let hi = 0.5 * (t.h[ie + 1][ix][ir] + t.h[ie + 1][ix + 1][ir]);
+                    assert!((at_node[ir] - lo).abs() < 1e-12, "η{ie} x{ix} ρ{ir}");
+                    assert!(
+                        (between[ir] - 0.5 * (lo + hi)).abs() < 1e-12,
+                        "η{ie} x{ix} ρ{ir}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn bad_files_name_line_and_field() {
         let head = "eta,x,rho,h,se_h,a_sphere,a_slab\n";
         let e = CurvatureTable::parse("eta,x\n", "f.csv").unwrap_err();

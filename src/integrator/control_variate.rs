@@ -281,6 +281,14 @@ mod tests {
             // over xo + d: the same tangential coordinates
             assert!(((p - xo).truncate() - d.truncate()).length() < 1e-5);
         }
+        // beyond the silhouette (κr > 1): the silhouette's point over d,
+        // on the sphere, its normal along d
+        for d in [Vec3::new(2.5, 0.0, 0.0), Vec3::new(-3.0, 4.0, 0.0)] {
+            let (p, m) = model_point(xo, n, k, d);
+            assert!(((p - centre).length() - 1.0 / k).abs() < 1e-5, "{p:?}");
+            assert!((m - d.normalize()).length() < 1e-6, "{m:?}");
+            assert!((p - (centre + d.normalize() / k)).length() < 1e-5, "{p:?}");
+        }
         // the plane: no sagitta, the same normal
         let d = Vec3::new(0.7, -0.2, 0.0);
         assert_eq!(model_point(xo, n, 0.0, d), (xo + d, n));
