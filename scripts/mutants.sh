@@ -49,7 +49,7 @@ TESTS_MATERIALS=(--lib --test coat --test dielectric --test furnace --test param
     --test specular_coat)
 TESTS_INTEGRATOR=(--lib --test coat --test dielectric --test furnace --test hard_cases
     --test probe_pair --test randomwalk --test slab --test specular_coat)
-TESTS_AOV=(--lib --test aov)
+TESTS_AOV=(--lib --test aov --test farm)
 TESTS=(--lib --test furnace --test slab --test randomwalk --test hard_cases
     --test bvh_brute_force --test dielectric --test specular_coat --test params_edges)
 if [ -n "${MUTANTS_TESTS:-}" ]; then
