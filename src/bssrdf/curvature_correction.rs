@@ -367,6 +367,36 @@ mod tests {
     /// from a sphere of 10⁵ diffusion lengths to one of 1/100, for two
     /// materials (marble, skin1) at two scales.
     #[test]
+    fn the_lookups_tail_follows_the_exact_factor_to_first_order() {
+        // Below the table's first node (bodies over 1024 diffusion lengths)
+        // f − 1 is first order in κ, and the lookup is linear from 1: it
+        // must match the exact factor's deviation from 1 to 1 % of itself
+        // (f − 1 is 1.5e-5 … 1.7e-3 there over the presets, below the
+        // interpolation tolerance of the test below, so that test cannot
+        // see the tail's sign or slope).
+        for name in ["marble", "skin1", "ketchup", "wholemilk"] {
+            let p = SubsurfaceParams::from_preset(name, 1.0, Fit::Searchlight).unwrap();
+            let s = ProbeSampler::new(&p, &ProbeOptions::default()).unwrap();
+            let cc = CurvatureCorrection::new(&p, &s).unwrap().unwrap();
+            for frac in [0.1, 0.37, 0.5, 0.93] {
+                let k = frac * 2f64.powi(-10) / cc.ld_max;
+                let (got, want) = (cc.factor(k as f32), cc.exact_factor(k));
+                for c in 0..3 {
+                    let dev = want[c] - 1.0;
+                    assert!(dev > 0.0, "{name} ch{c}: f − 1 = {dev}");
+                    assert!(
+                        (got[c] as f64 - want[c]).abs() <= 0.01 * dev + 2e-7,
+                        "{name} κℓd {:e} ch{c}: {} vs {}",
+                        frac * 2f64.powi(-10),
+                        got[c],
+                        want[c]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn lookup_matches_the_exact_factor() {
         for (name, scale) in [("marble", 1.0), ("skin1", 1.0), ("skin1", 0.01)] {
             let p = SubsurfaceParams::from_preset(name, scale, Fit::Searchlight).unwrap();
