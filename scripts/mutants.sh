@@ -190,8 +190,14 @@ if [ -n "$sample" ]; then
     fi
     mkdir -p mutants
     rec="mutants/sampled-seed-$seed.txt"
-    [ -f "$rec" ] || printf '# outcome\tseconds\tmutant (seed %s; commit %s)\n' \
-        "$seed" "$(git rev-parse --short HEAD)" >"$rec"
+    if [ -f "$rec" ]; then
+        # a continuation draws from this commit's list (names carry line
+        # numbers): say so in the record
+        printf '# continued at commit %s\n' "$(git rev-parse --short HEAD)" >>"$rec"
+    else
+        printf '# outcome\tseconds\tmutant (seed %s; commit %s)\n' \
+            "$seed" "$(git rev-parse --short HEAD)" >"$rec"
+    fi
     # Seeded permutation: sort by sha256 of seed and name.
     cargo mutants --list "${args[@]}" | while IFS= read -r m; do
         printf '%s\t%s\n' "$(printf '%s:%s' "$seed" "$m" | sha256sum | cut -c1-16)" "$m"

@@ -267,6 +267,41 @@ mod tests {
     }
 
     #[test]
+    fn the_pairs_term_removes_the_radial_spread_of_its_two_light_samples() {
+        // On the plane under a light constant across the disk, the pair's
+        // probes both land on the model with weight W_plane and see their
+        // own light samples g_1, g_2 at xo: the pair gives ½ W_plane (g_1 +
+        // g_2), and less its term that must be (A_plane/P(N))·½(g_1 + g_2),
+        // the same for every radius. Each sample's light must enter with
+        // its own sign: a term built from g_1 − g_2 keeps the mean (the
+        // samples are alike) but no longer cancels the spread, and fails
+        // here.
+        let s = sampler();
+        let frame = Frame::from_normal(Vec3::Z);
+        let mut rng = Rng::from_key(5);
+        let a = a_plane(&s);
+        let mut normal_probes = 0;
+        for _ in 0..2000 {
+            let u = ProbeRandoms::from_rng(&mut rng);
+            let g1 = Vec3::splat(0.2 + rng.uniform_f64() as f32);
+            let g2 = Vec3::new(1.5, 0.7, 0.1) * rng.uniform_f64() as f32;
+            let Some((_, Some(pm))) = s.sample_probe_and_plane(Vec3::ZERO, &frame, 0.0, &u) else {
+                continue;
+            };
+            normal_probes += 1;
+            let estimate = 0.5 * pm.weight * (g1 + g2);
+            let left = estimate - pair(&pm, a, [g1, g2]);
+            let want = a / pm.p_normal * 0.5 * (g1 + g2);
+            let scale = 1.0 + estimate.abs().max_element();
+            assert!(
+                (left - want).abs().max_element() < 1e-5 * scale,
+                "{left:?} against {want:?}"
+            );
+        }
+        assert!(normal_probes > 1900, "{normal_probes} of 2000 along N");
+    }
+
+    #[test]
     fn model_points_lie_on_the_sphere_with_its_normals() {
         let (xo, n, k) = (Vec3::new(1.0, 2.0, 3.0), Vec3::Z, 0.5f32);
         let centre = xo - n / k;

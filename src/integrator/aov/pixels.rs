@@ -784,6 +784,33 @@ mod tests {
         }
         assert_eq!(variance(s1, &sq, 4), (5.0f64 / 3.0 / 4.0) as f32);
         assert_eq!(variance(s1, &sq, 1), f32::INFINITY);
+        // against f64 on fractional samples, whose squares fill every limb,
+        // so n·Σq² − (Σq)² borrows across limbs: a borrow dropped between
+        // the second and third limb is an error of 1/(n²(n − 1)) in the
+        // result, far above f32 rounding
+        let mut rng = crate::sampling::Rng::from_key(7);
+        for n in [2u64, 3, 5, 16] {
+            for _ in 0..20 {
+                let xs: Vec<f32> = (0..n).map(|_| rng.uniform_f64() as f32).collect();
+                let (mut s1, mut sq) = (0i128, [0i128; 3]);
+                for &x in &xs {
+                    let q = FixedPoint::RADIANCE.to_fixed(x).0;
+                    s1 += q;
+                    for (a, b) in sq.iter_mut().zip(square_words(q)) {
+                        *a += b;
+                    }
+                }
+                let nf = n as f64;
+                let mean = xs.iter().map(|&x| x as f64).sum::<f64>() / nf;
+                let s2 = xs.iter().map(|&x| (x as f64 - mean).powi(2)).sum::<f64>() / (nf - 1.0);
+                let want = s2 / nf;
+                let got = variance(s1, &sq, n) as f64;
+                assert!(
+                    (got - want).abs() <= 1e-6 * want + 1e-12,
+                    "n = {n}, {xs:?}: {got} against {want}"
+                );
+            }
+        }
     }
 
     #[test]
