@@ -745,6 +745,8 @@ fn run_render(
     if keep.is_file() {
         let _ = std::fs::remove_file(&keep);
     }
+    // and a checkpoint a killed process was writing
+    lucent::film::stale::clean(&keep);
     if !quiet {
         eprintln!(
             "{}: {}{region} of {w}×{h}, samples {}..{} of {spp}, {} triangles: {}",

@@ -201,8 +201,10 @@ fn killed_and_resumed(options: &[&str]) {
         } else {
             // SIGKILL cannot be caught: a checkpoint being written at that
             // moment leaves its temporary (never the part itself, which is
-            // renamed into place whole)
-            let _ = fs::remove_file(d.join(format!(".cut.partial.exr.{pid}.tmp")));
+            // renamed into place whole); the resumed render removes it
+            // (film::stale), checked below. A stand-in for the moment the
+            // kill does not always hit:
+            fs::write(d.join(format!(".cut.partial.exr.{pid}.tmp")), b"cut").unwrap();
         }
         assert!(
             d.join("cut.partial.exr").is_file(),
@@ -218,8 +220,10 @@ fn killed_and_resumed(options: &[&str]) {
             pixels("cut.exr") == whole,
             "{signal} after {wait} ms: resumed image differs"
         );
-        // done: what was kept to resume from is gone
+        // done: what was kept to resume from is gone, and what the killed
+        // process was writing
         assert!(!d.join("cut.partial.exr").exists());
+        assert!(!d.join(format!(".cut.partial.exr.{pid}.tmp")).exists());
         fs::remove_file(d.join("cut.exr")).unwrap();
         fs::remove_file(d.join("cut.png")).unwrap();
     }

@@ -12,6 +12,7 @@ pub mod exr_layers;
 pub mod layers;
 pub mod passes;
 pub mod region;
+pub mod stale;
 pub mod tonemap;
 
 use std::fs;
@@ -194,6 +195,8 @@ impl Staged {
         path: &Path,
         write: impl FnOnce(&Path) -> Result<(), String>,
     ) -> Result<Staged, Error> {
+        // what a killed process left of this output (SIGKILL, `stale`)
+        stale::clean(path);
         let staged = Staged {
             tmp: temp_path(path),
             path: path.to_path_buf(),
