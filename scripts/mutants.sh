@@ -44,7 +44,8 @@ CORE=(src/bssrdf src/integrator src/materials src/accel/bvh)
 # mutant, then the scene-level tests that reach the folder's code. Only
 # these test binaries are built for a mutant.
 TESTS_BVH=(--lib --test bvh_brute_force)
-TESTS_BSSRDF=(--lib --test params_edges --test curvature --test hard_cases --test slab)
+TESTS_BSSRDF=(--lib --test params_edges --test curvature --test hard_cases --test slab
+    --test plan)
 TESTS_MATERIALS=(--lib --test coat --test dielectric --test furnace --test params_edges
     --test specular_coat)
 TESTS_INTEGRATOR=(--lib --test coat --test dielectric --test furnace --test hard_cases
