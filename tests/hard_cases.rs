@@ -1084,3 +1084,54 @@ fn radiance_beyond_the_accumulator_range_is_clamped_and_counted() {
         assert_eq!(stats.counters.nonfinite, 0);
     }
 }
+
+#[test]
+fn a_light_facing_away_lights_nothing() {
+    // Emission is one-sided (docs/scene-format.md). A square light faces
+    // up, away from a diffuse floor and a marble sphere below it, in a
+    // black world: light sampling from the floor and from the sphere's
+    // entry points (and the control variate's model points) meets only
+    // the light's back, so every pixel is exactly 0. A light sample taken
+    // from behind the light has a negative area-to-solid-angle pdf and
+    // would give negative pixels. The same light turned over (a control:
+    // the scene is not black for another reason) lights most pixels.
+    let (w, h) = (24u32, 16u32);
+    let film_with = |rotate: &str| {
+        let s = load_str(
+            &format!(
+                "units_per_mm = 0.1\n\
+                 [camera]\nlook_from = [0, -4, 0.6]\nlook_at = [0, 0, 0.3]\n\
+                 resolution = [{w}, {h}]\n\
+                 [render]\nspp = 8\nseed = 3\nmax_depth = 4\n\
+                 [materials.floor]\ntype = \"diffuse\"\nalbedo = [0.8, 0.8, 0.8]\n\
+                 [materials.marble]\ntype = \"subsurface\"\npreset = \"marble\"\n\
+                 [materials.lamp]\ntype = \"diffuse\"\nalbedo = [0, 0, 0]\n\
+                 [[shapes]]\nname = \"floor\"\ntype = \"quad\"\nmaterial = \"floor\"\nscale = 6\n\
+                 [[shapes]]\nname = \"ball\"\ntype = \"sphere\"\nsubdivisions = 3\n\
+                 material = \"marble\"\nscale = 0.3\ntranslate = [0, 0, 0.3]\n\
+                 [[shapes]]\nname = \"light\"\ntype = \"quad\"\nmaterial = \"lamp\"\n\
+                 emission = [40, 40, 40]\nscale = 0.5\n{rotate}translate = [0, 0, 0.9]\n"
+            ),
+            Path::new("facing-away.toml"),
+        )
+        .unwrap();
+        let a = accel::build(&s.meshes, Backend::Bvh).unwrap();
+        let (film, stats) = render(&s, a.as_ref(), &RenderOptions::default()).unwrap();
+        assert!(stats.counters.probes() > 0, "the sphere is in view");
+        film
+    };
+    let away = film_with("");
+    let lit = away.pixels.iter().filter(|p| **p != Vec3::ZERO).count();
+    assert_eq!(
+        lit,
+        0,
+        "{lit} pixels lit by a light facing away, e.g. {:?}",
+        away.pixels.iter().find(|p| **p != Vec3::ZERO)
+    );
+    let down = film_with("rotate = [[180, 1, 0, 0]]\n");
+    let lit = down.pixels.iter().filter(|p| p.min_element() > 0.0).count();
+    assert!(
+        lit > (w * h / 2) as usize,
+        "the light turned down lights only {lit} pixels"
+    );
+}
