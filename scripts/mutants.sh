@@ -47,9 +47,10 @@ TESTS_BVH=(--lib --test bvh_brute_force)
 TESTS_BSSRDF=(--lib --test params_edges --test curvature --test hard_cases --test slab
     --test plan)
 TESTS_MATERIALS=(--lib --test coat --test dielectric --test furnace --test params_edges
-    --test specular_coat --test plan)
+    --test specular_coat --test plan --test lod)
 TESTS_INTEGRATOR=(--lib --test coat --test dielectric --test furnace --test hard_cases
-    --test plan --test probe_pair --test randomwalk --test slab --test specular_coat)
+    --test plan --test probe_pair --test randomwalk --test slab --test specular_coat
+    --test lod)
 TESTS_AOV=(--lib --test aov --test farm)
 TESTS=(--lib --test furnace --test slab --test randomwalk --test hard_cases
     --test bvh_brute_force --test dielectric --test specular_coat --test params_edges)

@@ -267,3 +267,55 @@ fn cli_lod_flag_overrides_the_scene() {
         .unwrap();
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// On a sphere large enough for LOD (2R ≥ Rmax) in a constant
+/// environment, the light entering is the same everywhere, and LOD forced
+/// must give the full estimator's mean: A_plane times the curvature
+/// correction f(κo) of the sphere (module docs of `materials::lod`,
+/// "Curvature"), which the full estimator's probe hits carry as well. With
+/// the correction off both lose it alike; with it on, LOD must multiply by
+/// f, not divide.
+#[test]
+fn forced_lod_on_a_sphere_keeps_the_curvature_correction() {
+    let scene = |correction: &str| {
+        load_str(
+            &format!(
+                "units_per_mm = 0.1\n\
+                 [camera]\nlook_from = [0, 0, 3.2]\nlook_at = [0, 0, 0]\nfov_y = 30\n\
+                 resolution = [32, 32]\n\
+                 [render]\nmax_depth = 8\n\
+                 [environment]\nradiance = [1, 1, 1]\n\
+                 [materials.marble]\ntype = \"subsurface\"\npreset = \"marble\"\n\
+                 curvature_correction = \"{correction}\"\n\
+                 [[shapes]]\nname = \"ball\"\ntype = \"sphere\"\nsubdivisions = 5\n\
+                 material = \"marble\"\n"
+            ),
+            Path::new("lod-sphere.toml"),
+        )
+        .unwrap()
+    };
+    let mut means = Vec::new();
+    for correction in ["auto", "off"] {
+        let base = scene(correction);
+        let (full, cf) = run(&with_lod(&base, LodMode::Off), 64, 1);
+        let (lod, cl) = run(&with_lod(&base, LodMode::Force), 64, 1);
+        assert!(cf.probes() > 0 && cl.probes() == 0);
+        let ((m_full, se_full), (m_lod, se_lod)) = (mean_se(&full), mean_se(&lod));
+        eprintln!("correction {correction}: full {m_full:.5?} ± {se_full:.5?}, lod {m_lod:.5?} ± {se_lod:.5?}");
+        for c in 0..3 {
+            let se = (se_full[c].powi(2) + se_lod[c].powi(2)).sqrt();
+            assert!(
+                (m_full[c] - m_lod[c]).abs() < 4.0 * se + 2e-3 * m_full[c],
+                "correction {correction} ch{c}: full {} lod {}",
+                m_full[c],
+                m_lod[c]
+            );
+        }
+        means.push(m_full);
+    }
+    // not vacuous: the correction changes this sphere's image by more than
+    // the tolerance above
+    let ratio = [0, 1, 2].map(|c| means[0][c] / means[1][c]);
+    eprintln!("auto / off: {ratio:.4?}");
+    assert!(ratio.iter().all(|r| *r > 1.03), "{ratio:?}");
+}
