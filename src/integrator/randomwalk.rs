@@ -426,3 +426,46 @@ pub fn sample_hg(d: Vec3, g: f64, u: [f32; 2]) -> Vec3 {
     );
     Frame::from_normal(d).to_world(local).normalize()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Rng;
+
+    #[test]
+    fn henyey_greenstein_directions_have_its_legendre_moments() {
+        // The Henyey–Greenstein phase function's Legendre moments are g^l:
+        // E[cos θ] = g and E[P2(cos θ)] = g², θ the angle to the incoming
+        // direction. A wrong inverted CDF (e.g. the s term's division made
+        // a product) moves both far beyond 5 standard errors.
+        let d = Vec3::new(0.3, -0.5, 0.8).normalize();
+        let mut rng = Rng::from_key(17);
+        for g in [-0.7, 0.0005, 0.3, 0.9] {
+            let n = 200_000;
+            let (mut s1, mut s2, mut q1, mut q2) = (0.0, 0.0, 0.0, 0.0);
+            for _ in 0..n {
+                let u = [rng.uniform_f64() as f32, rng.uniform_f64() as f32];
+                let w = sample_hg(d, g, u);
+                assert!((w.length() - 1.0).abs() < 1e-5);
+                let c = w.dot(d) as f64;
+                let p2 = 1.5 * c * c - 0.5;
+                s1 += c;
+                q1 += c * c;
+                s2 += p2;
+                q2 += p2 * p2;
+            }
+            let nf = n as f64;
+            let (m1, m2) = (s1 / nf, s2 / nf);
+            let se1 = ((q1 / nf - m1 * m1) / nf).sqrt();
+            let se2 = ((q2 / nf - m2 * m2) / nf).sqrt();
+            assert!(
+                (m1 - g).abs() < 5.0 * se1 + 1e-4,
+                "g = {g}: E[cos] = {m1} ± {se1}"
+            );
+            assert!(
+                (m2 - g * g).abs() < 5.0 * se2 + 1e-4,
+                "g = {g}: E[P2] = {m2} ± {se2}"
+            );
+        }
+    }
+}
