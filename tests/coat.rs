@@ -108,9 +108,14 @@ fn render_film(scene: &Scene, backend: Backend) -> Film {
 
 /// What the coat reflects at μo: E from the material's table, or Fr.
 fn coat_albedo(scene: &Scene) -> f32 {
-    let Material::Subsurface(ss) = &scene.materials[0] else {
-        panic!("materials are sorted by name: slab first");
-    };
+    let ss = scene
+        .materials
+        .iter()
+        .find_map(|m| match m {
+            Material::Subsurface(ss) => Some(ss),
+            _ => None,
+        })
+        .expect("the slab's material");
     match ss.rough_coat() {
         Some(c) => c.albedo(MU_O),
         None => lucent::fresnel::dielectric(MU_O, ETA),
@@ -177,4 +182,109 @@ fn white_furnace_holds_where_coated_hits_choose() {
         let s = scene(roughness, 1.0, true, true);
         check(&format!("panel, roughness {roughness}"), &s, 1.0, 0.01);
     }
+}
+
+/// A closed box around the scene, its faces turned inward and emitting
+/// radiance 1: inside, every direction sees radiance 1, as under the
+/// uniform environment, but the light is now an area light, so the rough
+/// coat's light sampling and its MIS with the coat's lobe sampling carry
+/// the reflection. Their weights must sum to 1 for every direction (both
+/// strategies using the same pdf of the coat lobe), or the coat's
+/// reflection is off.
+#[test]
+fn the_rough_coat_under_an_enclosing_area_light_reflects_as_under_the_environment() {
+    let dir = tempfile::tempdir().unwrap();
+    // the 8 corners of [-h, h]³ and the 6 faces, each as two triangles
+    // wound so that their normal points to the centre
+    let h = 200.0f32;
+    let corner = |i: usize| {
+        [
+            if i & 1 == 0 { -h } else { h },
+            if i & 2 == 0 { -h } else { h },
+            if i & 4 == 0 { -h } else { h },
+        ]
+    };
+    let mut obj = String::new();
+    for i in 0..8 {
+        let c = corner(i);
+        obj += &format!("v {} {} {}\n", c[0], c[1], c[2]);
+    }
+    for (axis, side) in [(0, 0), (0, 1), (1, 0), (1, 1), (2, 0), (2, 1)] {
+        // the face's corners in cyclic order
+        let (a, b) = (
+            [1usize, 2, 4][(axis + 1) % 3],
+            [1usize, 2, 4][(axis + 2) % 3],
+        );
+        let base = side * [1usize, 2, 4][axis];
+        let mut q = [base, base + a, base + a + b, base + b];
+        // (q1 − q0) × (q3 − q0) has the sign of the axis for this order;
+        // inward is −sign at side 1, +sign at side 0
+        if side == 1 {
+            q.reverse();
+        }
+        obj += &format!(
+            "f {} {} {}\nf {} {} {}\n",
+            q[0] + 1,
+            q[1] + 1,
+            q[2] + 1,
+            q[0] + 1,
+            q[2] + 1,
+            q[3] + 1
+        );
+    }
+    std::fs::write(dir.path().join("dome.obj"), obj).unwrap();
+    let base = scene(0.5, 0.5, true, false);
+    let e = coat_albedo(&base);
+    let text = format!(
+        r#"
+units_per_mm = 1.0
+[camera]
+look_from = [0.0, {y}, {z}]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 1.0
+resolution = [24, 24]
+[render]
+spp = 256
+max_depth = 6
+seed = 3
+[materials.slab]
+type = "subsurface"
+albedo = [0.5, 0.5, 0.5]
+dmfp = [0.2, 0.2, 0.2]
+eta = {ETA}
+renormalize = true
+roughness = 0.5
+[materials.lamp]
+type = "diffuse"
+albedo = [0.0, 0.0, 0.0]
+[[shapes]]
+name = "slab"
+type = "box"
+material = "slab"
+scale = [50.0, 5.0, 50.0]
+translate = [0.0, -5.0, 0.0]
+[[shapes]]
+name = "dome"
+type = "obj"
+file = "dome.obj"
+material = "lamp"
+emission = [1.0, 1.0, 1.0]
+"#,
+        y = 10.0 * MU_O,
+        z = 10.0 * (1.0 - MU_O * MU_O).sqrt(),
+    );
+    let path = dir.path().join("dome.toml");
+    std::fs::write(&path, &text).unwrap();
+    let s = lucent::scene::load(&path).unwrap();
+    assert_eq!(
+        coat_albedo(&s),
+        e,
+        "the same coat as the environment's scene"
+    );
+    check(
+        "rough coat under an enclosing light",
+        &s,
+        e + (1.0 - e) * 0.5,
+        0.01,
+    );
 }
