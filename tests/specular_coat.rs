@@ -134,15 +134,25 @@ material = "coat"
 /// image centre with brightness F(cos θ)·Le and that nothing else is lit
 /// brighter than `dark` × F·Le (0: not at all).
 fn check_highlight(dir: &Path, text: &str, cos_i: f64, what: &str, dark: f32) {
+    check_highlight_with(dir, text, cos_i, what, dark, &RenderOptions::default());
+}
+
+/// [`check_highlight`] rendered with `opts` (another integrator).
+fn check_highlight_with(
+    dir: &Path,
+    text: &str,
+    cos_i: f64,
+    what: &str,
+    dark: f32,
+    opts: &RenderOptions,
+) {
     let path = dir.join("coat.toml");
     std::fs::write(&path, text).unwrap();
     let scene = load_str(text, &path).unwrap();
     let f = fresnel(cos_i, ETA) as f32;
     for backend in common::backends() {
         let a = accel::build(&scene.meshes, backend).unwrap();
-        let film = render(&scene, a.as_ref(), &RenderOptions::default())
-            .unwrap()
-            .0;
+        let film = render(&scene, a.as_ref(), opts).unwrap().0;
         assert_eq!((film.width as usize, film.height as usize), (RES, RES));
         let c = RES / 2;
         let px = |x: usize, y: usize| film.pixels[y * RES + x];
@@ -264,5 +274,34 @@ fn nearly_smooth_rough_coat_puts_the_highlight_where_the_mirror_does() {
         wo.dot(ns) as f64,
         "rough 0.05, tilted shading normals",
         0.05,
+    );
+}
+
+/// The random walk's diffuse boundary (`boundary = "diffuse"`) reflects
+/// light arriving from outside as a mirror with probability Fr, like the
+/// smooth coat: the same highlight, at the mirror direction about the
+/// surface's normal (the walk's boundary is the geometric surface), with
+/// nothing else lit above a tenth of it (A = 0: what the walk's medium and
+/// its exit light sampling return there is far below the highlight).
+#[test]
+fn the_random_walks_diffuse_boundary_reflects_in_the_mirror_direction() {
+    let dir = tempfile::tempdir().unwrap();
+    let slab = "type = \"box\"\nscale = [3, 0.5, 3]\ntranslate = [0, -0.5, 0]";
+    let text = scene_text(Vec3::new(0.0, 1.0, -1.0), slab, 0.0).replace(
+        "specular = true\n",
+        "specular = true\nboundary = \"diffuse\"\n",
+    );
+    assert!(text.contains("boundary"));
+    let opts = RenderOptions {
+        integrator: lucent::integrator::IntegratorKind::RandomWalk,
+        ..Default::default()
+    };
+    check_highlight_with(
+        dir.path(),
+        &text,
+        std::f64::consts::FRAC_1_SQRT_2,
+        "random walk, diffuse boundary",
+        0.1,
+        &opts,
     );
 }
