@@ -32,8 +32,10 @@
 //! let u = ProbeRandoms::from_rng(rng);
 //! let seg = sampler.sample_probe(xo, &frame, kappa, &u)?;
 //! accel.hits_on_segment(&seg.ray, seg.t_max, geom, u.seed, &mut probe_hits); // the integrator's query
-//! let hit = probe_hits.hits()[pick_hit(&u, probe_hits.hits().len())];
-//! let e = sampler.weigh(&seg, hit.t, mesh.face_normal(hit.prim), probe_hits.total())?;
+//! let kept = probe_hits.hits();
+//! // one hit: weigh it with the count; several: weigh each with a count of
+//! // 1, keep one in proportion to its channel sum (pick_by_score), scale
+//! let e = sampler.weigh(&seg, kept[0].t, mesh.face_normal(kept[0].prim), probe_hits.total())?;
 //! // e.weight = Rd / pdf × hit count (RGB); light arriving at e.point
 //! // through the lobe sw(cos, eta, c) contributes
 //! // Ft(xo, wo) · e.weight · ∫ Li sw cos dω.
@@ -56,7 +58,7 @@ pub mod radius;
 pub use fresnel_moment::{sw, sw_normalization, transmittance};
 pub use params::{AlbedoSource, Measured, Preset, SubsurfaceParams, PRESETS};
 pub use probe::{
-    pick_hit, ChannelStrategy, PlaneModel, ProbeAxes, ProbeEntry, ProbeOptions, ProbeRandoms,
+    pick_by_score, ChannelStrategy, PlaneModel, ProbeAxes, ProbeEntry, ProbeOptions, ProbeRandoms,
     ProbeSampler, ProbeSegment,
 };
 pub use profile::Fit;

@@ -7,10 +7,10 @@
 //! disk ⟂ V, and shoot a probe segment through the sphere of radius Rmax
 //! around xo, parallel to V, at that disk point. Every hit xi on the same
 //! object is a candidate; its surface-area density is
-//! p_disk(r)·|V·N(xi)|. One hit is picked uniformly among those the query
-//! kept and weighted by the number `total` the segment had:
-//! the kept ones are a uniform random subset, so every hit of the segment is
-//! picked with probability 1/total and the estimator stays unbiased.
+//! p_disk(r)·|V·N(xi)|. One hit is kept among those the query kept, in
+//! proportion to its weight ([`pick_by_score`]), and scaled so that the
+//! estimate is the sum over the segment's `total` hits: the kept ones are a
+//! uniform random subset, so the estimator stays unbiased.
 //!
 //! Options:
 //! - [`ProbeAxes::Normal`]: probe along N only (the seed). Grazing hits
@@ -317,13 +317,39 @@ pub struct ProbeEntry {
     pub weight: Vec3,
 }
 
-/// The index of the hit one probe keeps among the `kept` ≥ 1 hits the query
-/// returned: uniform, from the probe's `hit` random number. Each of the
-/// segment's `total` hits is then chosen with probability 1/total (the kept
-/// ones are a uniform subset), which [`ProbeSampler::weigh`] undoes.
-#[inline]
-pub fn pick_hit(u: &ProbeRandoms, kept: usize) -> usize {
-    uniform_index(u.hit, kept)
+/// The index of the hit one probe keeps among several, in proportion to
+/// `scores` (each kept hit's Rd/p summed over channels, from
+/// [`ProbeSampler::weigh`] with a count of 1), from the probe's `hit`
+/// random number, and the factor that makes the pick unbiased:
+///
+/// ```text
+/// P(k) = s_k / Σ_j s_j,   weight = Rd/p(x_k) × (total / kept) × Σ_j s_j / s_k,
+/// ```
+///
+/// so E[weight·L] = (total/kept) Σ_{kept} Rd/p·L, the uniform pick's mean
+/// (the kept hits are a uniform subset of the `total`). A segment that
+/// crosses the body twice — a thin tile's top and bottom, both walls of a
+/// sphere's far side — keeps the near, heavy hit nearly always instead of
+/// half the time (docs/accuracy.md, "Sharp edges and thin bodies"). Hits of score 0 are
+/// never picked; None when every score is 0 (nothing to scatter from).
+pub fn pick_by_score(u: &ProbeRandoms, scores: &[f32], total: usize) -> Option<(usize, f32)> {
+    let sum: f32 = scores.iter().sum();
+    if !(sum > 0.0 && sum.is_finite()) {
+        return None;
+    }
+    let goal = u.hit as f32 * sum;
+    let mut acc = 0.0;
+    // the last hit with a score > 0 absorbs rounding in the running sum
+    let mut pick = scores.iter().rposition(|&s| s > 0.0)?;
+    for (k, &s) in scores.iter().enumerate() {
+        acc += s;
+        if goal < acc && s > 0.0 {
+            pick = k;
+            break;
+        }
+    }
+    let factor = (total as f32 / scores.len() as f32) * (sum / scores[pick]);
+    Some((pick, factor))
 }
 
 /// ⌊u·n⌋ for u ∈ [0, 1), n ≥ 1, clamped to n − 1 against rounding.
@@ -603,9 +629,11 @@ impl ProbeSampler {
     }
 
     /// Weighs the hit at distance `t` along `seg` on a triangle with unit
-    /// normal `n_hit`, picked with [`pick_hit`] among `total` hits on the
+    /// normal `n_hit`, as if picked uniformly among `total` hits on the
     /// segment (pbrt-v4 `ProbeIntersectionToSample`; `docs/bssrdf.md` §5
-    /// step 4, where `total` is k):
+    /// step 4, where `total` is k). The integrator calls it with the count
+    /// for a segment's only hit, and with `total` = 1 for each of several,
+    /// whose pick [`pick_by_score`] then scales:
     ///
     ///   weight = Rd(|xo − xi|) / p(xi) × total,
     ///
@@ -908,6 +936,41 @@ mod tests {
             }
         }
         println!("f32 weights: worst relative error {worst:.3} of the bound");
+    }
+
+    #[test]
+    fn hits_are_kept_in_proportion_to_their_score_and_scaled_back() {
+        let u = |hit: f64| ProbeRandoms {
+            axis: 0.0,
+            channel: 0.0,
+            radius: 0.5,
+            angle: 0.0,
+            hit,
+            seed: 0,
+        };
+        // scores 1, 0, 3: the zero is never kept; P = ¼, ¾
+        let scores = [1.0f32, 0.0, 3.0];
+        let n = 10_000;
+        let mut kept = [0usize; 3];
+        let mut mean = 0.0f64;
+        for i in 0..n {
+            let (k, f) = pick_by_score(&u((i as f64 + 0.5) / n as f64), &scores, 3).unwrap();
+            kept[k] += 1;
+            // E[score × factor] = Σ scores × total/kept = 4 (all kept here)
+            mean += (scores[k] * f) as f64 / n as f64;
+            assert!(f > 0.0 && f.is_finite());
+        }
+        assert_eq!(kept, [2_500, 0, 7_500]);
+        assert!((mean - 4.0).abs() < 1e-4, "{mean}");
+        // the query kept 3 of 12 hits: × 12/3
+        let (k, f) = pick_by_score(&u(0.1), &scores, 12).unwrap();
+        assert_eq!((k, f), (0, 4.0 * 4.0));
+        // u at the top of [0, 1) still picks a hit with a score
+        assert_eq!(pick_by_score(&u(1.0 - 1e-12), &[2.0, 0.0], 2).unwrap().0, 0);
+        // nothing to scatter from, or a broken score: no pick
+        assert!(pick_by_score(&u(0.3), &[0.0, 0.0], 2).is_none());
+        assert!(pick_by_score(&u(0.3), &[1.0, f32::NAN], 2).is_none());
+        assert!(pick_by_score(&u(0.3), &[1.0, f32::INFINITY], 2).is_none());
     }
 
     #[test]

@@ -28,6 +28,8 @@ pub mod plan;
 pub mod probe;
 #[cfg(feature = "subsurface")]
 pub mod randomwalk;
+#[cfg(feature = "subsurface")]
+pub mod sharp_edges;
 
 use crate::accel::Accel;
 use crate::lights::LightSet;
@@ -85,12 +87,11 @@ impl<'a> Context<'a> {
             .meshes
             .iter()
             .zip(&scene.objects)
-            .map(|(m, o)| {
-                matches!(
-                    scene.materials[o.material],
-                    crate::materials::Material::Subsurface(_)
-                )
-                .then(|| probe::MeshCurvature::new(m))
+            .map(|(m, o)| match &scene.materials[o.material] {
+                crate::materials::Material::Subsurface(ss) => {
+                    Some(probe::MeshCurvature::new(m, ss.probe.rmax() as f32))
+                }
+                _ => None,
             })
             .collect();
         Context {
@@ -131,6 +132,19 @@ impl<'a> Context<'a> {
                     crate::bssrdf::curvature_correction::mean_curvature(m, prim),
                 )
             }
+        }
+    }
+
+    /// The curvature the probe axes read at exit point `xo` on triangle
+    /// `prim` of mesh `geom`: [`probe::MeshCurvature::axes`] (the
+    /// triangle's, or 1/s near a sharp edge at distance s), or
+    /// [`probe::exit_curvature`] for a mesh without the cache.
+    #[cfg(feature = "subsurface")]
+    #[inline]
+    pub fn axes_curvature(&self, geom: u32, prim: u32, xo: crate::geometry::Vec3) -> f32 {
+        match &self.curvature[geom as usize] {
+            Some(c) => c.axes(prim, xo),
+            None => probe::exit_curvature(&self.scene.meshes[geom as usize], prim),
         }
     }
 

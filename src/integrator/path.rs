@@ -911,6 +911,9 @@ fn entries<'s>(
             Ahead::default(),
         );
     }
+    // The probe axes also see sharp edges near xo (`sharp_edges`); level
+    // of detail above and the curvature correction read the triangle's.
+    let kappa = ctx.axes_curvature(si.geom, si.prim, si.p);
     let cv =
         ss.control_variate && control_variate::applies(ctx.cv_depth, ctx.plan.area_lights, depth);
     // The control variate's light samples, drawn before the probe's randoms.

@@ -2,17 +2,19 @@
 //! between `SubsurfaceMaterial`'s BSSRDF and the integrator): the BSSRDF
 //! samples a probe segment ([`ProbeSampler::sample_probe`]), the integrator
 //! asks the accel for every hit of the segment on the exit point's object
-//! ([`Accel::hits_on_segment`]), keeps one ([`pick_hit`]) and the BSSRDF
+//! ([`Accel::hits_on_segment`]), keeps one ([`pick_by_score`]) and the BSSRDF
 //! weighs it ([`ProbeSampler::weigh`]). The tests here check the whole
 //! estimator end to end on a brute-force accel: energy on planes for every
 //! option, hit counting, empty and degenerate geometry, and on curved
 //! geometry that entry points stay within Rmax of xo and are distributed
 //! with the density the weights divide by (a χ² test).
 
+use crate::accel::MAX_PROBE_HITS;
 use crate::accel::{Accel, Hit, ProbeHits};
 use crate::bssrdf::curvature_correction::mean_curvature;
-use crate::bssrdf::{pick_hit, ProbeRandoms, ProbeSampler, ProbeSegment};
+use crate::bssrdf::{pick_by_score, ProbeRandoms, ProbeSampler, ProbeSegment};
 use crate::geometry::{Frame, Mesh, Vec3};
+use crate::integrator::sharp_edges::SharpEdges;
 
 /// The curvature of `mesh` at triangle `prim`, from its shading normals:
 /// the largest |n_i − n_j| / |p_i − p_j| over its edges (1/scene units),
@@ -73,19 +75,29 @@ pub fn exit_curvature(mesh: &Mesh, prim: u32) -> f32 {
 /// ([`crate::integrator::Context`], for meshes with a subsurface
 /// material) instead of at every hit from the vertex normals: each is a
 /// deterministic function of the triangle, so the values, and the pixels,
-/// are the same bit for bit (tested). 8 bytes a triangle.
+/// are the same bit for bit (tested). 8 bytes a triangle. With them, the
+/// mesh's sharp edges ([`SharpEdges`]), which the probe axes also read
+/// ([`MeshCurvature::axes`]).
 #[derive(Clone, Debug, Default)]
 pub struct MeshCurvature {
     /// (exit, mean) per triangle.
     per_prim: Vec<[f32; 2]>,
+    /// The sharp edges, None when the mesh has none.
+    edges: Option<SharpEdges>,
+    /// How far a sharp edge is looked for: the material's Rmax.
+    reach: f32,
 }
 
 impl MeshCurvature {
-    pub fn new(mesh: &Mesh) -> Self {
+    /// The cache for `mesh`, its sharp edges looked for within `reach`
+    /// (the material's Rmax, scene units) of an exit point.
+    pub fn new(mesh: &Mesh, reach: f32) -> Self {
         MeshCurvature {
             per_prim: (0..mesh.triangle_count() as u32)
                 .map(|prim| [exit_curvature(mesh, prim), mean_curvature(mesh, prim)])
                 .collect(),
+            edges: SharpEdges::new(mesh),
+            reach,
         }
     }
 
@@ -99,6 +111,31 @@ impl MeshCurvature {
     #[inline]
     pub fn mean(&self, prim: u32) -> f32 {
         self.per_prim[prim as usize][1]
+    }
+
+    /// The curvature the probe axes read at exit point `xo` on triangle
+    /// `prim`: [`exit_curvature`], or 1/s where a sharp edge lies at a
+    /// distance s < reach and that is larger
+    /// ([`crate::integrator::sharp_edges`]).
+    #[inline]
+    pub fn axes(&self, prim: u32, xo: Vec3) -> f32 {
+        let k = self.exit(prim);
+        match &self.edges {
+            Some(e) => {
+                let s = e.distance(xo, self.reach);
+                if s < self.reach {
+                    k.max(1.0 / s)
+                } else {
+                    k
+                }
+            }
+            None => k,
+        }
+    }
+
+    /// How many sharp edges the mesh has.
+    pub fn sharp_edge_count(&self) -> usize {
+        self.edges.as_ref().map_or(0, SharpEdges::len)
     }
 }
 
@@ -161,12 +198,34 @@ pub fn entry_on_segment(
         .accel
         .hits_on_segment(&seg.ray, seg.t_max, target.geom, u.seed, hits);
     let kept = hits.hits();
-    if kept.is_empty() {
-        return None;
-    }
-    let hit = kept[pick_hit(u, kept.len())];
-    let normal = target.mesh.face_normal(hit.prim);
-    let entry = sampler.weigh(seg, hit.t, normal, hits.total())?;
+    let (hit, normal, entry) = match kept {
+        [] => return None,
+        // one hit: kept with probability 1, weight Rd/p × total
+        [hit] => {
+            let normal = target.mesh.face_normal(hit.prim);
+            (
+                *hit,
+                normal,
+                sampler.weigh(seg, hit.t, normal, hits.total())?,
+            )
+        }
+        // several: each weighed, one kept in proportion to its weight
+        _ => {
+            let mut scores = [0.0f32; MAX_PROBE_HITS];
+            for (s, hit) in scores.iter_mut().zip(kept) {
+                let normal = target.mesh.face_normal(hit.prim);
+                *s = sampler
+                    .weigh(seg, hit.t, normal, 1)
+                    .map_or(0.0, |e| e.weight.element_sum());
+            }
+            let (k, factor) = pick_by_score(u, &scores[..kept.len()], hits.total())?;
+            let hit = kept[k];
+            let normal = target.mesh.face_normal(hit.prim);
+            let mut entry = sampler.weigh(seg, hit.t, normal, 1)?;
+            entry.weight *= factor;
+            (hit, normal, entry)
+        }
+    };
     Some(ProbeSample {
         hit,
         point: entry.point,
@@ -978,6 +1037,78 @@ mod tests {
     }
 
     #[test]
+    fn light_across_a_sharp_edge_is_found_by_one_probe_in_a_few() {
+        // xo on a cube's side face, half a d below its top edge, lit only
+        // through the top face (X = the probe's weight when it lands there:
+        // the light that crosses the edge). The triangle's curvature is the
+        // cube's 1/R floor (κd ≈ 0.02, ε = ε_min): tangent probes, the only
+        // ones that reach the top face, are one in a hundred, so X's
+        // relative variance is in the hundreds. The sharp edge at s = d/2
+        // makes κ_axes = 1/s (ε = ¼): the same mean, a variance ~50× lower
+        // (16.7 against 796 here).
+        let opts = ProbeOptions::default();
+        assert_eq!(opts.axes, ProbeAxes::Curvature);
+        let params = params_for(&opts, 1.0);
+        let s = ProbeSampler::new(&params, &opts).unwrap();
+        let h = 30.0f32;
+        let mut cube = crate::scene::shapes::cuboid();
+        cube.transform(|p| p * h, |n| n);
+        let prim = (0..12).find(|&p| cube.face_normal(p) == Vec3::X).unwrap();
+        let cache = MeshCurvature::new(&cube, s.rmax() as f32);
+        assert_eq!(cache.sharp_edge_count(), 12);
+        let xo = Vec3::new(h, 0.3, h - 0.5);
+        let k_tri = cache.exit(prim);
+        let k_axes = cache.axes(prim, xo);
+        assert_eq!(k_tri, exit_curvature(&cube, prim));
+        assert!((k_tri * h * 3f32.sqrt() - 1.0).abs() < 1e-5);
+        assert!((k_axes - 2.0).abs() < 1e-5, "{k_axes}");
+        // the face's centre is h from every edge, beyond the reach: the
+        // triangle's own
+        let centre = Vec3::new(h, 0.0, 0.0);
+        assert!(h > s.rmax() as f32);
+        assert_eq!(cache.axes(prim, centre), k_tri);
+        let accel = Brute {
+            meshes: vec![cube.clone()],
+        };
+        let target = ProbeTarget {
+            accel: &accel,
+            geom: 0,
+            mesh: &cube,
+        };
+        let frame = Frame::from_normal(Vec3::X);
+        let across = |kappa: f32| {
+            let mut rng = Rng::from_key(11);
+            let mut hits = ProbeHits::new();
+            let n = 40_000;
+            let (mut s1, mut s2) = (0.0f64, 0.0f64);
+            for _ in 0..n {
+                let u = ProbeRandoms::from_rng(&mut rng);
+                if let Some(ps) = sample_entry(&s, xo, &frame, kappa, &u, &target, &mut hits) {
+                    if ps.normal.z > 0.99 {
+                        let w = ps.weight[0] as f64;
+                        s1 += w;
+                        s2 += w * w;
+                    }
+                }
+            }
+            let mean = s1 / n as f64;
+            let var = s2 / n as f64 - mean * mean;
+            (mean, (var / n as f64).sqrt(), var / (mean * mean))
+        };
+        let (m_edge, se_edge, rel_edge) = across(k_axes);
+        let (m_tri, se_tri, rel_tri) = across(k_tri);
+        println!("edge rule: {m_edge:.4} ± {se_edge:.4}, relative variance {rel_edge:.1}");
+        println!("triangle:  {m_tri:.4} ± {se_tri:.4}, relative variance {rel_tri:.1}");
+        assert!(m_edge > 0.02, "the top face holds a share of the profile");
+        assert!(
+            (m_edge - m_tri).abs() < 5.0 * (se_edge.powi(2) + se_tri.powi(2)).sqrt(),
+            "both unbiased"
+        );
+        assert!(rel_edge < 30.0, "{rel_edge}");
+        assert!(rel_tri > 200.0, "{rel_tri}");
+    }
+
+    #[test]
     fn the_curvature_cache_is_the_functions_bit_for_bit() {
         // A smooth sphere (both curvatures > 0), the same sphere turned
         // inside out (mean curvature 0: concave) and a flat quad.
@@ -986,7 +1117,7 @@ mod tests {
         inside.transform(|p| p, |n| -n);
         let flat = planes(3.0, &[0.5]);
         for (what, m) in [("sphere", &sphere), ("inside", &inside), ("flat", &flat)] {
-            let cache = MeshCurvature::new(m);
+            let cache = MeshCurvature::new(m, 1.0);
             for prim in 0..m.triangle_count() as u32 {
                 assert_eq!(
                     cache.exit(prim).to_bits(),
@@ -1568,15 +1699,18 @@ mod tests {
     }
 
     #[test]
-    fn a_chosen_entry_point_has_density_p_over_the_hits_on_its_segment() {
+    fn a_chosen_entry_point_has_density_p_times_its_share_of_the_segments_weight() {
         // Two concentric octant patches (`octant_patch`, radii 1.6 Rmax and
         // 1.3 Rmax, xo on the outer one): a probe segment can cross both, and
-        // the query then returns two hits of which one is picked uniformly.
-        // The density of the chosen xi is Σ_a p_a(xi) / k_a(xi), p_a the
-        // density of reaching xi along axis a (`pdf_area_axes_mean`) and k_a
-        // the hits on the segment through xi along a (1 or 2, counted here
-        // by intersecting that segment with the other patch); the weight
-        // must be Rd/p × k, p = Σ_a p_a. Pearson χ² as in
+        // the query then returns two hits of which one is kept in proportion
+        // to its score s = Σ_c Rd_c/p (`pick_by_score`). The density of the
+        // chosen xi is Σ_a p_a(xi) · s(xi) / Σ_j s(x_j), p_a the density of
+        // reaching xi along axis a (`pdf_area_axes_mean`) and the x_j the
+        // hits on the segment through xi along a (xi and, found here by
+        // intersecting that segment with the other patch, the other one);
+        // the weight must be Rd/p × Σ_j s(x_j) / s(xi), p = Σ_a p_a (× k
+        // for a segment's only hit, k = 1). A uniform pick (density
+        // p_a/k_a) fails the χ² here. Pearson χ² as in
         // `sampled_entry_points_follow_the_density_the_estimator_divides_by`,
         // the bins separating the two patches; triangles across which some
         // k_a changes are subdivided so the quadrature resolves the jump,
@@ -1654,9 +1788,9 @@ mod tests {
                 .collect()
             };
             let (near_outer, near_inner) = (near(0..n_outer), near(n_outer..n_tri));
-            // k_a(x) for x on triangle `prim`: 1 + the hits of the
-            // other patch on the segment along axis a through x
-            let count = |x: DVec3, prim: u32, a: usize| -> usize {
+            // the hits of the other patch on the segment along axis a
+            // through x on triangle `prim`, as (point, normal)
+            let others = |x: DVec3, prim: u32, a: usize| -> Vec<(DVec3, DVec3)> {
                 let v = axes_v[a];
                 let d = x - xo64;
                 let along = d.dot(v);
@@ -1669,10 +1803,21 @@ mod tests {
                 } else {
                     &near_outer
                 };
-                1 + others
+                others
                     .iter()
-                    .filter(|&&q| tri_hit(&ray, mesh.triangle(q), 0.0, (2.0 * h) as f32).is_some())
-                    .count()
+                    .filter_map(|&q| {
+                        let (t, _, _) = tri_hit(&ray, mesh.triangle(q), 0.0, (2.0 * h) as f32)?;
+                        let at = ray.o.as_dvec3() + ray.d.as_dvec3() * t as f64;
+                        Some((at, mesh.face_normal(q).as_dvec3()))
+                    })
+                    .collect()
+            };
+            // k_a(x): the hits on that segment
+            let count = |x: DVec3, prim: u32, a: usize| 1 + others(x, prim, a).len();
+            // s(x): Rd/p summed over channels, as `pick_by_score` reads it
+            let score = |x: DVec3, n: DVec3| -> f64 {
+                let p = s.pdf_area(x - xo64, &frame, kappa, n);
+                s.rd((x - xo64).length()).iter().sum::<f64>() / p
             };
             let bin_of = |prim: u32| {
                 let [a, b, c] = mesh.triangle(prim);
@@ -1712,7 +1857,12 @@ mod tests {
                     let pa = s.pdf_area_axes_mean(x - xo64, &frame, kappa, n_hit);
                     (0..3)
                         .filter(|&a| pa[a] > 0.0)
-                        .map(|a| pa[a] / count(x, prim, a) as f64)
+                        .map(|a| {
+                            let own = score(x, n_hit);
+                            let rest: f64 =
+                                others(x, prim, a).iter().map(|&(y, m)| score(y, m)).sum();
+                            pa[a] * own / (own + rest)
+                        })
                         .sum::<f64>()
                 };
                 // k_a changes inside where it differs at the corners
@@ -1762,12 +1912,28 @@ mod tests {
                     let p = s.pdf_area(d, &frame, kappa, ps.normal.as_dvec3());
                     assert!(p > 0.0, "{what}: an entry point where p = 0, at {d}");
                     let rd = s.rd(d.length());
+                    // Σ_j s(x_j) / s(xi) over the segment's hits (k for one)
+                    let scale = if k == 1 {
+                        1.0
+                    } else {
+                        let at = |h: &Hit| {
+                            let [a, b, c] = mesh.triangle(h.prim).map(|p| p.as_dvec3());
+                            let (u, v) = (h.u as f64, h.v as f64);
+                            a * (1.0 - u - v) + b * u + c * v
+                        };
+                        let total: f64 = hits
+                            .hits()
+                            .iter()
+                            .map(|h| score(at(h), mesh.face_normal(h.prim).as_dvec3()))
+                            .sum();
+                        total / score(ps.point.as_dvec3(), ps.normal.as_dvec3())
+                    };
                     for c in 0..3 {
-                        let want = rd[c] / p * k as f64;
+                        let want = rd[c] / p * scale;
                         let got = ps.weight[c] as f64;
                         assert!(
                             (got - want).abs() <= 2e-3 * want,
-                            "{what} ch{c}: weight {got}, Rd/p × {k} = {want} at {d}"
+                            "{what} ch{c}: weight {got}, Rd/p × {scale} = {want} at {d}"
                         );
                     }
                 }
