@@ -41,6 +41,14 @@
 //! surface for any probe to find. A smooth-shaded mesh has no sharp edge
 //! unless its normals split at a crease, and its rule is unchanged.
 //!
+//! **The bound of s.** For xo on one face and an edge's other face meeting
+//! it at an interior angle of 90° or more (any convex edge, a concave one
+//! opening at least square), the nearest point of the other face is on the
+//! edge, so s is the distance to the face itself. A concave fold sharper
+//! than 90° leans its face over xo, nearer than its edge; the rule then
+//! reads that face as farther than it is (ε lower than the geometry
+//! warrants, never below ε_min, so the weight bound still holds).
+//!
 //! **The query.** A bounding-volume tree over the sharp edges' segments
 //! (leaves of up to [`LEAF`]); a query descends only into boxes nearer
 //! than the best distance so far, starting at the reach, so an exit point
