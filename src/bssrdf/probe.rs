@@ -334,16 +334,19 @@ pub struct ProbeEntry {
 /// never picked; None when every score is 0 (nothing to scatter from).
 pub fn pick_by_score(u: &ProbeRandoms, scores: &[f32], total: usize) -> Option<(usize, f32)> {
     let sum: f32 = scores.iter().sum();
-    if !(sum > 0.0 && sum.is_finite()) {
+    if !sum.is_finite() {
         return None;
     }
     let goal = u.hit as f32 * sum;
     let mut acc = 0.0;
-    // the last hit with a score > 0 absorbs rounding in the running sum
+    // the last hit with a score > 0 absorbs rounding in the running sum;
+    // none (every score 0): nothing to pick
     let mut pick = scores.iter().rposition(|&s| s > 0.0)?;
+    // goal ≥ 0, so a hit of score 0 never ends the scan: the running sum
+    // it leaves unchanged was not above goal before it either
     for (k, &s) in scores.iter().enumerate() {
         acc += s;
-        if goal < acc && s > 0.0 {
+        if goal < acc {
             pick = k;
             break;
         }
