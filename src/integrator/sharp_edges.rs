@@ -286,6 +286,37 @@ mod tests {
         }
         // the same without vertex normals (face normals: the same jumps)
         assert_eq!(sharp_edges(&without_normals(&shapes::cuboid())).len(), 12);
+        // a tile off the origin: corners that share two coordinates and
+        // the sign of the third are still told apart
+        let mut tile = shapes::cuboid();
+        tile.transform(|p| p * Vec3::new(1.0, 0.2, 1.0) + Vec3::splat(5.0), |n| n);
+        assert_eq!(sharp_edges(&tile).len(), 12);
+    }
+
+    #[test]
+    fn minus_zero_and_zero_are_one_position() {
+        // a fold at 90° along x = 0 whose two faces do not share vertices,
+        // one written with −0.0: the faces still meet at one sharp edge
+        // (and the same turned so that the −0.0 is each coordinate in turn)
+        let p = [
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(-0.0, 0.0, 0.0),
+            Vec3::new(-0.0, 0.0, 1.0),
+            Vec3::new(-0.0, 1.0, 0.0),
+        ];
+        for turn in 0..3 {
+            let q: Vec<Vec3> = p
+                .iter()
+                .map(|v| Vec3::from_array(std::array::from_fn(|i| v[(i + 3 - turn) % 3])))
+                .collect();
+            let m = Mesh::new(q, vec![[0, 1, 2], [3, 4, 5]], None);
+            let e = sharp_edges(&m);
+            assert_eq!(e.len(), 1, "turn {turn}: {e:?}");
+            let mid = (e[0][0] + e[0][1]) / 2.0;
+            assert_eq!(mid.to_array()[(1 + turn) % 3], 0.5);
+        }
     }
 
     #[test]
