@@ -135,7 +135,7 @@ impl MeshCurvature {
 
     /// How many sharp edges the mesh has.
     pub fn sharp_edge_count(&self) -> usize {
-        self.edges.as_ref().map_or(0, SharpEdges::len)
+        self.edges.as_ref().map_or(0, SharpEdges::count)
     }
 }
 

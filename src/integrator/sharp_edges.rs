@@ -178,14 +178,10 @@ impl SharpEdges {
         Some(SharpEdges { segments, nodes })
     }
 
-    /// How many sharp edges the tree holds.
-    pub fn len(&self) -> usize {
+    /// How many sharp edges the tree holds (at least 1: an empty set has
+    /// no tree, [`SharpEdges::new`]).
+    pub fn count(&self) -> usize {
         self.segments.len()
-    }
-
-    /// Always false: an empty set has no tree ([`SharpEdges::new`]).
-    pub fn is_empty(&self) -> bool {
-        self.segments.is_empty()
     }
 
     /// The distance from `p` to the nearest sharp edge, or `reach` if none
@@ -375,7 +371,7 @@ mod tests {
         for n in [1usize, 3, 4, 5, 17, 300] {
             let segs: Vec<[Vec3; 2]> = (0..n).map(|_| [v(), v()]).collect();
             let tree = SharpEdges::from_segments(segs.clone()).unwrap();
-            assert_eq!(tree.len(), n);
+            assert_eq!(tree.count(), n);
             for _ in 0..500 {
                 let p = v() * 1.5;
                 let brute = segs
