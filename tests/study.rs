@@ -33,6 +33,14 @@ fn row<'a>(rows: &'a [Row], config: &str, spp: u32) -> &'a Row {
         .unwrap_or_else(|| panic!("no row {config} @ {spp}"))
 }
 
+/// Fireflies of configuration `config` summed over the ladder's rungs.
+fn fireflies(rows: &[Row], config: &str) -> u64 {
+    rows.iter()
+        .filter(|r| r.config == config)
+        .map(|r| r.fireflies)
+        .sum()
+}
+
 fn assert_png(path: &Path) {
     let img = image::open(path)
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -199,13 +207,7 @@ fn grazing_sphere_curvature_and_mis3_have_fewer_fireflies_than_normal() {
         base.overrides.axes,
         Some(lucent::bssrdf::ProbeAxes::Curvature)
     );
-    let total = |name: &str| -> u64 {
-        out.rows
-            .iter()
-            .filter(|r| r.config == name)
-            .map(|r| r.fireflies)
-            .sum()
-    };
+    let total = |name: &str| fireflies(&out.rows, name);
     let normal = total("axes=normal");
     assert!(normal >= 8, "normal-only probes: only {normal} fireflies");
     for name in ["baseline", "axes=mis3"] {
@@ -249,13 +251,6 @@ fn marble_tile_default_sees_across_its_edges() {
     s.only = vec![Axis::Axes];
     let out = study::run(&s).unwrap();
     let at16 = |name: &str| row(&out.rows, name, 16).clone();
-    let fireflies = |name: &str| -> u64 {
-        out.rows
-            .iter()
-            .filter(|r| r.config == name)
-            .map(|r| r.fireflies)
-            .sum()
-    };
     let (base, mis3, normal) = (at16("baseline"), at16("axes=mis3"), at16("axes=normal"));
     assert!(
         base.rel_mse < 0.9 * mis3.rel_mse,
@@ -263,7 +258,8 @@ fn marble_tile_default_sees_across_its_edges() {
         base.rel_mse,
         mis3.rel_mse
     );
-    assert!(fireflies("baseline") <= 4, "{}", fireflies("baseline"));
+    let base_fireflies = fireflies(&out.rows, "baseline");
+    assert!(base_fireflies <= 4, "{base_fireflies}");
     // unbiased against its own reference; normal-only loses the light
     // that crosses the edges
     assert!(base.bias.abs() < 3.0 * base.bias_stderr + 0.005, "{base:?}");
