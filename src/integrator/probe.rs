@@ -9,8 +9,7 @@
 //! geometry that entry points stay within Rmax of xo and are distributed
 //! with the density the weights divide by (a χ² test).
 
-use crate::accel::MAX_PROBE_HITS;
-use crate::accel::{Accel, Hit, ProbeHits};
+use crate::accel::{Accel, Hit, ProbeHits, MAX_PROBE_HITS};
 use crate::bssrdf::curvature_correction::mean_curvature;
 use crate::bssrdf::{pick_by_score, ProbeRandoms, ProbeSampler, ProbeSegment};
 use crate::geometry::{Frame, Mesh, Vec3};
@@ -120,16 +119,14 @@ impl MeshCurvature {
     #[inline]
     pub fn axes(&self, prim: u32, xo: Vec3) -> f32 {
         let k = self.exit(prim);
-        match &self.edges {
-            Some(e) => {
-                let s = e.distance(xo, self.reach);
-                if s < self.reach {
-                    k.max(1.0 / s)
-                } else {
-                    k
-                }
-            }
-            None => k,
+        let s = self
+            .edges
+            .as_ref()
+            .map_or(self.reach, |e| e.distance(xo, self.reach));
+        if s < self.reach {
+            k.max(1.0 / s)
+        } else {
+            k
         }
     }
 
@@ -211,19 +208,17 @@ pub fn entry_on_segment(
         }
         // several: each weighed, one kept in proportion to its weight
         _ => {
+            let mut entries = [None; MAX_PROBE_HITS];
             let mut scores = [0.0f32; MAX_PROBE_HITS];
-            for (s, hit) in scores.iter_mut().zip(kept) {
-                let normal = target.mesh.face_normal(hit.prim);
-                *s = sampler
-                    .weigh(seg, hit.t, normal, 1)
-                    .map_or(0.0, |e| e.weight.element_sum());
+            for ((e, s), hit) in entries.iter_mut().zip(&mut scores).zip(kept) {
+                *e = sampler.weigh(seg, hit.t, target.mesh.face_normal(hit.prim), 1);
+                *s = e.map_or(0.0, |e| e.weight.element_sum());
             }
             let (k, factor) = pick_by_score(u, &scores[..kept.len()], hits.total())?;
-            let hit = kept[k];
-            let normal = target.mesh.face_normal(hit.prim);
-            let mut entry = sampler.weigh(seg, hit.t, normal, 1)?;
+            // a picked hit has a score > 0, so it was weighed
+            let mut entry = entries[k]?;
             entry.weight *= factor;
-            (hit, normal, entry)
+            (kept[k], target.mesh.face_normal(kept[k].prim), entry)
         }
     };
     Some(ProbeSample {
