@@ -89,7 +89,15 @@ impl<'a> Context<'a> {
             .zip(&scene.objects)
             .map(|(m, o)| match &scene.materials[o.material] {
                 crate::materials::Material::Subsurface(ss) => {
-                    Some(probe::MeshCurvature::new(m, ss.probe.rmax() as f32))
+                    // only the `curvature` axis rule reads sharp edges
+                    let reads_edges =
+                        ss.probe.options().axes == crate::bssrdf::ProbeAxes::Curvature;
+                    let reach = if reads_edges {
+                        ss.probe.rmax() as f32
+                    } else {
+                        0.0
+                    };
+                    Some(probe::MeshCurvature::new(m, reach))
                 }
                 _ => None,
             })

@@ -89,13 +89,18 @@ pub struct MeshCurvature {
 
 impl MeshCurvature {
     /// The cache for `mesh`, its sharp edges looked for within `reach`
-    /// (the material's Rmax, scene units) of an exit point.
+    /// (the material's Rmax, scene units) of an exit point; `reach` = 0
+    /// (a material whose axis rule reads no curvature) skips finding them.
     pub fn new(mesh: &Mesh, reach: f32) -> Self {
         MeshCurvature {
             per_prim: (0..mesh.triangle_count() as u32)
                 .map(|prim| [exit_curvature(mesh, prim), mean_curvature(mesh, prim)])
                 .collect(),
-            edges: SharpEdges::new(mesh),
+            edges: if reach > 0.0 {
+                SharpEdges::new(mesh)
+            } else {
+                None
+            },
             reach,
         }
     }
