@@ -30,7 +30,9 @@
 # someone edits. Each outcome is appended to mutants/sampled-seed-S.txt
 # (outcome, seconds, name); mutants already there are skipped, so running
 # again with a larger N continues the same sample. --stop-at HH:MM (UTC)
-# starts no mutant after that time.
+# starts no mutant after that time (the next such time: a time earlier than
+# now is tomorrow's, so a run started at 23:10 with --stop-at 01:30 stops
+# after midnight, not at once).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -186,6 +188,17 @@ fi
 
 if [ -n "$sample" ]; then
     [ -n "$seed" ] || { echo "mutants.sh: --sample needs --seed" >&2; exit 2; }
+    deadline=""
+    if [ -n "$stop_at" ]; then
+        if ! [[ "$stop_at" =~ ^([01][0-9]|2[0-3]):[0-5][0-9]$ ]]; then
+            echo "mutants.sh: --stop-at wants HH:MM (UTC), got '$stop_at'" >&2
+            exit 2
+        fi
+        deadline=$(date -u -d "today $stop_at" +%s)
+        if [ "$deadline" -le "$(date -u +%s)" ]; then
+            deadline=$(( deadline + 86400 ))
+        fi
+    fi
     if [ -n "$(git status --porcelain --untracked-files=no -- src tests)" ]; then
         echo "mutants.sh: --sample mutates the tree in place; run it in a clean clone" >&2
         exit 2
@@ -207,7 +220,7 @@ if [ -n "$sample" ]; then
     # (not `| head`: with pipefail, the writer's SIGPIPE would end the script)
     sed -n "1,${sample}p" mutants.out.order >mutants.out.sample
     while IFS= read -r m; do
-        if [ -n "$stop_at" ] && [ "$(date -u +%H:%M)" \> "$stop_at" ]; then
+        if [ -n "$deadline" ] && [ "$(date -u +%s)" -gt "$deadline" ]; then
             echo "mutants.sh: past $stop_at, stopping"
             break
         fi
