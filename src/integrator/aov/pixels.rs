@@ -292,16 +292,14 @@ impl Nearest {
         material: 0,
     };
 
-    /// The order key: Z in f32's total order, then the sample index.
-    fn key(&self) -> (u32, u32) {
-        let b = self.z.to_bits();
-        let z = if b >> 31 == 1 { !b } else { b | 1 << 31 };
-        (z, self.sample)
+    /// The order: Z in f32's total order, then the sample index.
+    fn order(&self, o: &Nearest) -> std::cmp::Ordering {
+        self.z.total_cmp(&o.z).then(self.sample.cmp(&o.sample))
     }
 
     /// The nearer of the two.
     pub fn nearer(self, o: Nearest) -> Nearest {
-        if self.object == 0 || (o.object != 0 && o.key() < self.key()) {
+        if self.object == 0 || (o.object != 0 && o.order(&self).is_lt()) {
             o
         } else {
             self
