@@ -134,9 +134,13 @@ pub(crate) const COAT_SPLIT_DEPTH: u32 = 1;
 /// camera vertex (the default of [`Context::pair_depth`]).
 pub const PAIR_DEPTH: u32 = 1;
 
-/// Paths waiting to be traced after the current one ends; more than this
-/// many at once never happens with [`COAT_SPLIT_DEPTH`] ≤ 4.
+/// Paths waiting to be traced after the current one ends. A path pushes
+/// at most one branch per depth below [`COAT_SPLIT_DEPTH`], and a branch
+/// starts one depth below the vertex that pushed it, so at most
+/// `COAT_SPLIT_DEPTH` wait at once: the stack is never full.
 const MAX_BRANCHES: usize = 4;
+#[cfg(feature = "subsurface")]
+const _: () = assert!(COAT_SPLIT_DEPTH as usize <= MAX_BRANCHES);
 
 /// Per-thread buffers the integrator reuses so the hot path never allocates.
 #[derive(Default)]
@@ -330,15 +334,11 @@ struct Branches {
 }
 
 impl Branches {
-    /// false when full.
+    /// Never full (see [`MAX_BRANCHES`]).
     #[cfg(feature = "subsurface")]
-    fn push(&mut self, b: Branch) -> bool {
-        if self.len == MAX_BRANCHES {
-            return false;
-        }
+    fn push(&mut self, b: Branch) {
         self.items[self.len] = Some(b);
         self.len += 1;
-        true
     }
     fn pop(&mut self) -> Option<Branch> {
         if self.len == 0 {
@@ -601,36 +601,21 @@ fn follow<'s, R: Recorder, T: Clock>(
                     l += c;
                     rec.light(c, aov::sampled(coat_event, depth), Source::Light(light));
                 }
-                // What the entry's throughput was multiplied by here (2 when
-                // it alone goes on for both, 0 when the reflection does);
-                // its pair's and the control variate's the same.
-                let mut entry_mul = 1.0;
                 let (next, follow_reflected) = match (&c.entry, c.reflected) {
                     (Some(v), Some((r, mut b, p))) => {
                         // Both: this path enters the medium, the reflection
-                        // waits. The stack holds one branch per split depth;
-                        // were it full, one of the two would be followed,
-                        // each with probability ½ and twice the weight.
-                        let branch = roulette(depth, &mut b, rng).then_some(Branch {
-                            ray: r,
-                            beta: b,
-                            prev: p,
-                            depth: depth + 1,
-                            event: coat_event,
-                            cone: cone_specular,
-                        });
-                        match branch.map(|br| stack.push(br)) {
-                            Some(false) if rng.uniform() < 0.5 => {
-                                entry_mul = 0.0;
-                                (None, Some((r, 2.0 * b, p)))
-                            }
-                            Some(false) => {
-                                beta *= 2.0;
-                                entry_mul = 2.0;
-                                (Some(v), None)
-                            }
-                            _ => (Some(v), None),
+                        // waits on the stack (one branch per split depth).
+                        if roulette(depth, &mut b, rng) {
+                            stack.push(Branch {
+                                ray: r,
+                                beta: b,
+                                prev: p,
+                                depth: depth + 1,
+                                event: coat_event,
+                                cone: cone_specular,
+                            });
                         }
+                        (Some(v), None)
                     }
                     (Some(v), None) => (Some(v), None),
                     (None, reflected) => (None, reflected),
@@ -638,11 +623,10 @@ fn follow<'s, R: Recorder, T: Clock>(
                 // The control variate's terms, which count whether or not
                 // the probes found an entry point.
                 let lights = c.ahead.lights;
-                if lights.is_some() && entry_mul > 0.0 {
+                if lights.is_some() {
                     let ev = if first { Event::Subsurface } else { event };
                     for (t, light) in c.ahead.terms {
                         if light != aov::NO_LIGHT {
-                            let t = entry_mul * t;
                             l += t;
                             rec.light(t, aov::sampled(ev, depth), Source::Light(light));
                         }
@@ -661,7 +645,7 @@ fn follow<'s, R: Recorder, T: Clock>(
                                 let (d, light) =
                                     direct_lighting_ahead(ctx, pv, ahead, rng, counters);
                                 T::lap(counters, Effect::Direct, t0);
-                                let c = (entry_mul * *b) * d;
+                                let c = *b * d;
                                 l += c;
                                 rec.light(c, aov::sampled(event, depth), Source::Light(light));
                             }
