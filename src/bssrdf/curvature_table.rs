@@ -61,7 +61,10 @@ fn cell(v: &[f64], t: f64) -> (usize, f64) {
     if t >= v[n - 1] {
         return (n - 2, 1.0);
     }
-    let i = v.partition_point(|&x| x <= t).clamp(1, n - 1) - 1;
+    // v[0] < t < v[n − 1] here, so the partition point lies in 1..n − 1; a
+    // NaN t matches no node (point 0) and lands in the first cell, NaN
+    // weight.
+    let i = v.partition_point(|&x| x <= t).max(1) - 1;
     (i, (t - v[i]) / (v[i + 1] - v[i]))
 }
 
@@ -193,6 +196,19 @@ impl CurvatureTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cells_hold_their_point_and_a_nan_lands_in_the_first() {
+        let v = [1.0, 2.0, 4.0, 8.0];
+        assert_eq!(cell(&v, 0.5), (0, 0.0));
+        assert_eq!(cell(&v, 9.0), (2, 1.0));
+        assert_eq!(cell(&v, 1.5), (0, 0.5));
+        assert_eq!(cell(&v, 2.0), (1, 0.0));
+        assert_eq!(cell(&v, 7.0), (2, 0.75));
+        let (i, w) = cell(&v, f64::NAN);
+        assert_eq!(i, 0);
+        assert!(w.is_nan());
+    }
 
     #[test]
     fn embedded_table_parses_and_is_physical() {
