@@ -12,7 +12,7 @@ use lucent::bssrdf::params::{dipole_reflectance, invert_dipole_reflectance, Medi
 use lucent::bssrdf::{Fit, Measured, ProbeOptions, SubsurfaceParams, PRESETS};
 use lucent::film::Film;
 use lucent::geometry::{Mesh, Vec3};
-use lucent::integrator::{Counters, IntegratorKind};
+use lucent::integrator::{Counters, Effect, IntegratorKind};
 use lucent::materials::{Material, Subsurface, WalkBoundary};
 use lucent::render::{render, RenderOptions};
 use lucent::scene::{shapes, Camera, Object, RenderSettings, Scene};
@@ -504,6 +504,31 @@ fn closed_sphere_with_fresnel_boundary_is_invisible_in_a_furnace() {
             e[k]
         );
     }
+}
+
+/// A black medium (σs = 0) ends every walk at its first scattering, and a
+/// walk with nothing left to carry makes no further query: one flight query
+/// per walk, whether it scattered (throughput 0) or crossed to the far
+/// face. Every camera ray meets the slab and enters (η = 1, no coat), so
+/// the walks are the camera rays.
+#[test]
+fn a_black_medium_costs_one_query_per_walk() {
+    let mat = subsurface(medium([0.0; 3], [2.0, 3.0, 5.0], 0.0, 1.0));
+    let s = scene(
+        vec![slab(1.0, mat)],
+        Some(Vec3::ONE),
+        camera_above(8),
+        16,
+        8,
+    );
+    let (film, c, _) = run(&s, IntegratorKind::RandomWalk, Some(1));
+    let walks = c.effect_rays[Effect::Camera as usize];
+    assert_eq!(walks, 8 * 8 * 16);
+    assert_eq!(c.effect_rays[Effect::Walk as usize], walks);
+    // What crosses the slab (e^{−σa·t} along the way) sees the sky below.
+    let (m, _) = mean_and_error(&film);
+    assert!(m.max_element() < 0.2, "{m}");
+    assert_eq!((c.walks_capped, c.walks_escaped, c.nonfinite), (0, 0, 0));
 }
 
 /// Closed icospheres never lose a walk (`walks_escaped == 0`), on every

@@ -255,6 +255,12 @@ pub fn walk(
     let sigma_t = m.sigma_t();
     let mut beta = [1.0f64; 3];
     for event in 0..MAX_WALK_EVENTS {
+        // A walk with nothing left to carry (a black medium's first
+        // scattering) ends before its next query.
+        let total: f64 = beta.iter().sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
         counters.ray(Effect::Walk);
         // Inside a closed mesh every direction meets the boundary. No hit
         // means the walk is in the open (through a hole of an open mesh, or
@@ -267,10 +273,6 @@ pub fn walk(
         let t_max = hit.t as f64;
 
         // Hero channel by throughput; q sums to 1 over live channels.
-        let total: f64 = beta.iter().sum();
-        if !(total > 0.0 && total.is_finite()) {
-            return None;
-        }
         let q = beta.map(|b| b / total);
         let c = pick_channel(&q, rng.uniform_f64());
         let t = free_flight(sigma_t[c], rng.uniform_f64());
