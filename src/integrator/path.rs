@@ -831,16 +831,21 @@ fn subsurface_probe<'s>(
 /// would reflect below the surface the geometric normal is used instead.
 #[cfg(feature = "subsurface")]
 fn mirror(ctx: &Context, si: &Interaction, wo: Vec3, n_out: Vec3) -> Ray {
-    let ns_out = if si.ns.dot(n_out) >= 0.0 {
-        si.ns
+    si.spawn(mirror_direction(wo, si.ns, n_out), ctx.ray_epsilon)
+}
+
+/// `wo` reflected about the shading normal `ns` (either orientation),
+/// or about the geometric normal `n_out` (the side `wo` is on) where the
+/// former would go below the surface.
+#[cfg(feature = "subsurface")]
+fn mirror_direction(wo: Vec3, ns: Vec3, n_out: Vec3) -> Vec3 {
+    let ns_out = if ns.dot(n_out) >= 0.0 { ns } else { -ns };
+    let wi = (2.0 * wo.dot(ns_out)) * ns_out - wo;
+    if wi.dot(n_out) > 0.0 {
+        wi
     } else {
-        -si.ns
-    };
-    let mut wi = (2.0 * wo.dot(ns_out)) * ns_out - wo;
-    if wi.dot(n_out) <= 0.0 {
-        wi = (2.0 * wo.dot(n_out)) * n_out - wo;
+        (2.0 * wo.dot(n_out)) * n_out - wo
     }
-    si.spawn(wi, ctx.ray_epsilon)
 }
 
 /// A ray sampled from the rough coat's lobe at `v`, with its throughput
@@ -1332,4 +1337,48 @@ fn subsurface_probe<'s>(
     _: f32,
 ) -> Scatter<'s> {
     match *ss {}
+}
+
+#[cfg(all(test, feature = "subsurface"))]
+mod tests {
+    use super::*;
+
+    /// Angle of reflection equals angle of incidence, in the plane of `wo`
+    /// and `n`: `wi + wo` is along `n` and `wi·n = wo·n`.
+    fn assert_mirror(wi: Vec3, wo: Vec3, n: Vec3) {
+        assert!((wi.length() - 1.0).abs() < 1e-5, "{wi}");
+        assert!((wi.dot(n) - wo.dot(n)).abs() < 1e-5, "{wi} {wo} {n}");
+        assert!((wi + wo).cross(n).length() < 1e-5, "{wi} {wo} {n}");
+    }
+
+    #[test]
+    fn the_coat_mirrors_about_the_shading_normal_or_the_geometric_one_below_it() {
+        let ng = Vec3::Z;
+        // A shading normal tilted 40° towards +x, given either way round.
+        let ns = Vec3::new(40f32.to_radians().sin(), 0.0, 40f32.to_radians().cos());
+        for ns in [ns, -ns] {
+            // Steep incidence: the shading mirror stays above the surface.
+            let wo = Vec3::new(0.2, 0.1, 1.0).normalize();
+            let wi = mirror_direction(wo, ns, ng);
+            assert!(wi.dot(ng) > 0.0);
+            assert_mirror(wi, wo, ns);
+            // Grazing from −x: about ns the reflection would point below
+            // the surface, so it is the mirror about ng.
+            let wo = Vec3::new(-0.95, 0.1, 0.2).normalize();
+            let ns_up = if ns.dot(ng) >= 0.0 { ns } else { -ns };
+            let below = (2.0 * wo.dot(ns_up)) * ns_up - wo;
+            assert!(
+                below.dot(ng) <= 0.0,
+                "the case is not the fallback: {below}"
+            );
+            let wi = mirror_direction(wo, ns, ng);
+            assert!(wi.dot(ng) > 0.0);
+            assert_mirror(wi, wo, ng);
+        }
+        // Seen from below (n_out = −ng) the same holds on that side.
+        let wo = Vec3::new(0.95, -0.1, -0.2).normalize();
+        let wi = mirror_direction(wo, ns, -ng);
+        assert!(wi.dot(-ng) > 0.0);
+        assert_mirror(wi, wo, -ng);
+    }
 }
