@@ -430,26 +430,42 @@ mod tests {
         // around random points: a tree split by position opens a few dozen
         // of its ~1,000 nodes per query; a split that ignores position
         // (wrong axis, wrong centroid, wrong median) leaves boxes that
-        // overlap everywhere and opens hundreds.
-        let mut rng = Rng::from_key(3);
-        let mut v = || Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
-        // a flat box of three different extents: a split along the wrong
-        // axis is as bad as one that ignores position
-        let size = Vec3::new(1.0, 0.05, 0.3);
-        let segs: Vec<[Vec3; 2]> = (0..2000)
-            .map(|_| {
-                let a = (v() * 2.0 - 1.0) * size;
-                [a, a + (v() - 0.5) * 0.02]
-            })
-            .collect();
-        let tree = SharpEdges::from_segments(segs).unwrap();
-        let queries = 1000;
-        let opened: usize = (0..queries)
-            .map(|_| tree.nearest((v() * 2.0 - 1.0) * size, 0.02).1)
-            .sum();
-        let mean = opened as f64 / queries as f64;
-        println!("nodes opened per query: {mean:.1} of {}", tree.nodes.len());
-        assert!(mean < 40.0, "{mean}"); // 24.4; mutants of the split 56–152
+        // overlap everywhere and opens hundreds. Flat boxes of three
+        // different extents, the widest along each axis in turn (a split
+        // along the wrong axis is as bad as one that ignores position),
+        // at the origin and far from it along their thinnest axis (where a
+        // centroid that is not the endpoints' mean, e.g. their product,
+        // ranks the axes by the offset instead of the extent).
+        for (size, offset) in [
+            (Vec3::new(1.0, 0.05, 0.3), Vec3::ZERO),
+            (Vec3::new(0.3, 1.0, 0.05), Vec3::ZERO),
+            (Vec3::new(0.05, 0.3, 1.0), Vec3::ZERO),
+            (Vec3::new(0.3, 1.0, 0.05), Vec3::new(0.0, 0.0, 200.0)),
+            (Vec3::new(1.0, 0.05, 0.3), Vec3::new(0.0, -200.0, 0.0)),
+            // a rod's edges: long in y, the query's reach across in x,
+            // flat in z
+            (Vec3::new(0.02, 1.0, 0.002), Vec3::ZERO),
+        ] {
+            let mut rng = Rng::from_key(3);
+            let mut v = || Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
+            let segs: Vec<[Vec3; 2]> = (0..2000)
+                .map(|_| {
+                    let a = (v() * 2.0 - 1.0) * size + offset;
+                    [a, a + (v() - 0.5) * 0.02]
+                })
+                .collect();
+            let tree = SharpEdges::from_segments(segs).unwrap();
+            let queries = 1000;
+            let opened: usize = (0..queries)
+                .map(|_| tree.nearest((v() * 2.0 - 1.0) * size + offset, 0.02).1)
+                .sum();
+            let mean = opened as f64 / queries as f64;
+            println!(
+                "box {size} at {offset}: nodes opened per query {mean:.1} of {}",
+                tree.nodes.len()
+            );
+            assert!(mean < 40.0, "box {size} at {offset}: {mean}");
+        }
     }
 
     #[test]
