@@ -90,7 +90,10 @@ use crate::lights::LightSample;
 use crate::materials::lod::Cone;
 use crate::materials::{dielectric, diffuse, Material};
 #[cfg(feature = "subsurface")]
-use crate::materials::{microfacet::RoughCoat, Subsurface};
+use crate::materials::{
+    microfacet::{reflect, RoughCoat},
+    Subsurface,
+};
 use crate::sampling::{power, Draw, SampleRng};
 #[cfg(feature = "subsurface")]
 use crate::{
@@ -840,11 +843,11 @@ fn mirror(ctx: &Context, si: &Interaction, wo: Vec3, n_out: Vec3) -> Ray {
 #[cfg(feature = "subsurface")]
 fn mirror_direction(wo: Vec3, ns: Vec3, n_out: Vec3) -> Vec3 {
     let ns_out = if ns.dot(n_out) >= 0.0 { ns } else { -ns };
-    let wi = (2.0 * wo.dot(ns_out)) * ns_out - wo;
+    let wi = reflect(wo, ns_out);
     if wi.dot(n_out) > 0.0 {
         wi
     } else {
-        (2.0 * wo.dot(n_out)) * n_out - wo
+        reflect(wo, n_out)
     }
 }
 
@@ -1366,7 +1369,7 @@ mod tests {
             // the surface, so it is the mirror about ng.
             let wo = Vec3::new(-0.95, 0.1, 0.2).normalize();
             let ns_up = if ns.dot(ng) >= 0.0 { ns } else { -ns };
-            let below = (2.0 * wo.dot(ns_up)) * ns_up - wo;
+            let below = reflect(wo, ns_up);
             assert!(
                 below.dot(ng) <= 0.0,
                 "the case is not the fallback: {below}"

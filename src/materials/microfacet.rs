@@ -146,7 +146,7 @@ impl Ggx {
 }
 
 /// The mirror direction of `wo` about the unit normal `m`.
-fn reflect(wo: Vec3, m: Vec3) -> Vec3 {
+pub(crate) fn reflect(wo: Vec3, m: Vec3) -> Vec3 {
     2.0 * wo.dot(m) * m - wo
 }
 
