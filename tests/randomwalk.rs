@@ -531,6 +531,60 @@ fn a_black_medium_costs_one_query_per_walk() {
     assert_eq!((c.walks_capped, c.walks_escaped, c.nonfinite), (0, 0, 0));
 }
 
+/// A walk that cannot end within [`MAX_WALK_EVENTS`] events is stopped
+/// there and counted as capped: started at the centre of a sphere of
+/// optical radius 10⁴ of a medium that absorbs nothing, a walk needs ~10⁸
+/// events to reach the boundary (its distance grows like √N mean free
+/// paths), so every one of them stops at the cap, after exactly that many
+/// flight queries, and is neither escaped nor lost uncounted.
+///
+/// [`MAX_WALK_EVENTS`]: lucent::integrator::randomwalk::MAX_WALK_EVENTS
+#[test]
+fn walks_that_cannot_end_stop_at_the_cap_and_are_counted() {
+    use lucent::integrator::randomwalk::{walk, Boundary, MAX_WALK_EVENTS};
+    use lucent::integrator::Context;
+    use lucent::sampling::{Draw, SampleRng};
+    let m = Medium {
+        sigma_s: [1e4; 3],
+        sigma_a: [0.0; 3],
+        g: 0.0,
+    };
+    let s = scene(
+        vec![Part {
+            mesh: shapes::sphere(2),
+            material: Material::Diffuse { albedo: Vec3::ONE },
+            emission: None,
+        }],
+        None,
+        camera_above(4),
+        1,
+        1,
+    );
+    let a = accel::build(&s.meshes, Backend::Bvh).unwrap();
+    let ctx = Context::new(&s, a.as_ref());
+    let mut c = Counters::default();
+    let walks = 12u64;
+    for i in 0..walks {
+        let mut rng = SampleRng::new(3, i, 0);
+        let [u, v] = rng.uniform2();
+        let z = 1.0 - 2.0 * u;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let phi = std::f32::consts::TAU * v;
+        let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+        let ray = lucent::geometry::Ray::new(Vec3::ZERO, d);
+        let end = walk(&ctx, &m, Boundary::Dielectric(1.0), ray, &mut rng, &mut c);
+        assert!(end.is_none(), "walk {i} ended at the boundary");
+    }
+    assert_eq!(
+        (c.walks_capped, c.walks_escaped, c.nonfinite),
+        (walks, 0, 0)
+    );
+    assert_eq!(
+        c.effect_rays[Effect::Walk as usize],
+        walks * MAX_WALK_EVENTS as u64
+    );
+}
+
 /// Closed icospheres never lose a walk (`walks_escaped == 0`), on every
 /// backend, at several tessellations and at scales from 10⁻³ to 10³ scene
 /// units. The medium is dense (mean free path 10⁻⁴ of the radius), so walks
