@@ -289,4 +289,44 @@ mod tests {
         assert_eq!((e.line, e.field.as_str()), (4, "row"));
         assert!(e.to_string().starts_with("f.csv:4: row:"));
     }
+
+    /// The rows of a full grid over the given axis values, sorted by η,
+    /// x, ρ as the generator writes them.
+    fn grid(etas: &[f64], xs: &[f64], rhos: &[f64]) -> String {
+        let mut t = String::from("eta,x,rho,h,se_h,a_sphere,a_slab\n");
+        for e in etas {
+            for x in xs {
+                for r in rhos {
+                    t += &format!("{e},{x},{r},0.5,0,0.5,0.4\n");
+                }
+            }
+        }
+        t
+    }
+
+    /// The smallest table interpolation can use, two values on each axis,
+    /// parses; a table with one value on any axis (nothing to interpolate
+    /// between: its cells would have zero width) or with rows missing from
+    /// or added to its grid is refused on its last line, even when every
+    /// other check would pass.
+    #[test]
+    fn only_a_full_grid_of_two_or_more_values_per_axis_parses() {
+        let t =
+            CurvatureTable::parse(&grid(&[1.0, 1.5], &[0.5, 1.0], &[1.0, 2.0]), "f.csv").unwrap();
+        assert_eq!((t.etas.len(), t.xs.len(), t.rhos.len()), (2, 2, 2));
+        for (etas, xs, rhos) in [
+            (&[1.0][..], &[0.5, 1.0][..], &[1.0, 2.0][..]),
+            (&[1.0, 1.5], &[0.5], &[1.0, 2.0]),
+            (&[1.0, 1.5], &[0.5, 1.0], &[1.0]),
+        ] {
+            let text = grid(etas, xs, rhos);
+            let e = CurvatureTable::parse(&text, "f.csv").unwrap_err();
+            let rows = text.lines().count() - 1;
+            assert_eq!((e.line, e.field.as_str()), (rows + 1, "row"), "{e}");
+        }
+        // a 2×2×2 grid with a ninth row repeating an axis value
+        let text = grid(&[1.0, 1.5], &[0.5, 1.0], &[1.0, 2.0]) + "1.5,1.0,2.0,0.5,0,0.5,0.4\n";
+        let e = CurvatureTable::parse(&text, "f.csv").unwrap_err();
+        assert_eq!((e.line, e.field.as_str()), (10, "row"), "{e}");
+    }
 }
