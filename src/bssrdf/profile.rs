@@ -245,6 +245,18 @@ mod tests {
         }
     }
 
+    /// An inactive channel (d = 0) and d no medium can have (negative,
+    /// infinite, NaN) reflect nothing: R = 0 at every r, never the NaN
+    /// that r/d with d = 0 would give.
+    #[test]
+    fn a_channel_without_a_length_has_no_profile() {
+        for d in [0.0, -0.0, -1.0, f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            for r in [0.0, 1e-12, 0.5, 3.0] {
+                assert_eq!(profile(r, d), 0.0, "R({r}) with d = {d}");
+            }
+        }
+    }
+
     #[test]
     fn cdf_matches_numerical_integral() {
         let d = 2.5;
