@@ -20,39 +20,79 @@ pub(super) fn with_huge_pages<T>(n: usize) -> Vec<T> {
     v
 }
 
-#[cfg(all(
-    target_os = "linux",
-    any(target_arch = "x86_64", target_arch = "aarch64")
-))]
-fn advise(start: usize, len: usize) {
-    use std::ffi::{c_int, c_void};
-    extern "C" {
-        fn madvise(addr: *mut c_void, len: usize, advice: c_int) -> c_int;
-    }
-    const MADV_HUGEPAGE: c_int = 14;
-    const HUGE: usize = 2 << 20;
-    // Only whole, aligned 2 MiB pages inside the buffer can be huge.
-    let a = start.next_multiple_of(HUGE);
-    let b = (start + len) & !(HUGE - 1);
-    if b > a {
-        // SAFETY: madvise only attaches a hint to pages of our own
-        // allocation [start, start + len); it reads and writes no memory.
-        // Failure (e.g. THP disabled) changes nothing, so it is ignored.
-        unsafe {
-            madvise(a as *mut c_void, b - a, MADV_HUGEPAGE);
-        }
-    }
+/// Size of a transparent huge page on x86_64 and aarch64 (4 KiB base
+/// pages).
+const HUGE: usize = 2 << 20;
+
+/// The whole, aligned huge pages inside the buffer `[start, start + len)`:
+/// the range that may be advised without touching memory that is not ours.
+/// None when the buffer holds no whole huge page.
+fn huge_pages_within(start: usize, len: usize) -> Option<(usize, usize)> {
+    let a = start.checked_next_multiple_of(HUGE)?;
+    let b = start.checked_add(len)? & !(HUGE - 1);
+    (b > a).then_some((a, b - a))
 }
 
-#[cfg(not(all(
-    target_os = "linux",
-    any(target_arch = "x86_64", target_arch = "aarch64")
-)))]
-fn advise(_start: usize, _len: usize) {}
+/// Asks the kernel to back the whole huge pages of `[start, start + len)`
+/// with huge pages (Linux on x86_64 and aarch64; elsewhere nothing).
+fn advise(start: usize, len: usize) {
+    let Some((a, n)) = huge_pages_within(start, len) else {
+        return;
+    };
+    #[cfg(all(
+        target_os = "linux",
+        any(target_arch = "x86_64", target_arch = "aarch64")
+    ))]
+    {
+        use std::ffi::{c_int, c_void};
+        extern "C" {
+            fn madvise(addr: *mut c_void, len: usize, advice: c_int) -> c_int;
+        }
+        const MADV_HUGEPAGE: c_int = 14;
+        // SAFETY: madvise only attaches a hint to pages of our own
+        // allocation (whole pages inside [start, start + len)); it reads
+        // and writes no memory. Failure (e.g. THP disabled) changes
+        // nothing, so it is ignored.
+        unsafe {
+            madvise(a as *mut c_void, n, MADV_HUGEPAGE);
+        }
+    }
+    #[cfg(not(all(
+        target_os = "linux",
+        any(target_arch = "x86_64", target_arch = "aarch64")
+    )))]
+    let _ = (a, n);
+}
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The advised range starts and ends on huge-page boundaries and lies
+    /// inside the buffer, and is the largest such range.
+    #[test]
+    fn only_whole_huge_pages_inside_the_buffer_are_advised() {
+        const K: usize = 4096;
+        assert_eq!(huge_pages_within(0, HUGE), Some((0, HUGE)));
+        assert_eq!(
+            huge_pages_within(HUGE, 3 * HUGE + K),
+            Some((HUGE, 3 * HUGE))
+        );
+        assert_eq!(
+            huge_pages_within(HUGE - K, 2 * HUGE + 2 * K),
+            Some((HUGE, 2 * HUGE))
+        );
+        assert_eq!(huge_pages_within(K, 2 * HUGE), Some((HUGE, HUGE)));
+        assert_eq!(huge_pages_within(K, HUGE), None);
+        assert_eq!(huge_pages_within(0, HUGE - 1), None);
+        assert_eq!(huge_pages_within(usize::MAX - K, K), None);
+        for (start, len) in [(12_345 * K + 17, 9 * HUGE + 5), (7 * HUGE - 1, 5 * HUGE)] {
+            let (a, n) = huge_pages_within(start, len).unwrap();
+            assert!(a % HUGE == 0 && n % HUGE == 0 && n > 0);
+            assert!(a >= start && a + n <= start + len);
+            assert!(a - start < HUGE && start + len - (a + n) < HUGE);
+        }
+    }
 
     #[test]
     fn advised_vectors_are_ordinary_vectors() {
