@@ -223,3 +223,40 @@ fn the_pair_keeps_the_mean_where_its_twin_often_misses() {
         }
     }
 }
+
+/// The curvature the probe axes read on a smooth sphere of radius ρ is
+/// 1/ρ on every triangle, whether the mesh has the render's cache (a
+/// subsurface material: `MeshCurvature::axes`) or not (the per-hit
+/// `exit_curvature`): the axis probabilities are chosen for the surface's
+/// real bending, not a fixed scale.
+#[test]
+fn probe_axes_read_the_curvature_of_the_surface() {
+    let text = SCENE.replace("MARBLE_OPTIONS", "").replace(
+        "subdivisions = 4\n",
+        "subdivisions = 3\nscale = [3.0, 3.0, 3.0]\n\n[[shapes]]\nname = \"plaster\"\n\
+         type = \"sphere\"\nmaterial = \"lamp\"\nsubdivisions = 3\nscale = [0.5, 0.5, 0.5]\n\
+         translate = [0.0, 5.0, 0.0]\n",
+    );
+    let scene = lucent::scene::load_str(&text, Path::new("curvature.toml")).unwrap();
+    let accel = accel::build(&scene.meshes, Backend::Bvh).unwrap();
+    let ctx = Context::new(&scene, accel.as_ref());
+    let mut checked = [0; 2];
+    for (geom, (mesh, object)) in scene.meshes.iter().zip(&scene.objects).enumerate() {
+        let (radius, cached) = match (&scene.materials[object.material], object.name.as_str()) {
+            (Material::Subsurface(_), "ball") => (3.0, 0),
+            (_, "plaster") => (0.5, 1),
+            _ => continue,
+        };
+        assert_eq!(ctx.curvature[geom].is_some(), cached == 0);
+        for prim in 0..mesh.triangle_count() as u32 {
+            let [a, b, c] = mesh.triangle(prim);
+            let k = ctx.axes_curvature(geom as u32, prim, (a + b + c) / 3.0);
+            assert!(
+                (k * radius - 1.0).abs() < 0.1,
+                "sphere of radius {radius}, triangle {prim}: κ = {k}"
+            );
+            checked[cached] += 1;
+        }
+    }
+    assert!(checked[0] > 0 && checked[1] > 0, "{checked:?}");
+}

@@ -289,6 +289,19 @@ impl CameraSpread {
 mod tests {
     use super::*;
 
+    /// The names the EXR header records (`sampling_description`) are the
+    /// values the scene format (auto, off) and the command line
+    /// (`--lod force`) take: a scene's `lod` read back gives its mode.
+    #[test]
+    fn mode_names_are_the_values_a_scene_and_the_command_line_take() {
+        for m in [LodMode::Auto, LodMode::Off] {
+            assert_eq!(LodMode::parse_scene(m.name()), Some(m));
+            assert_eq!(LodMode::parse_scene(&m.name().to_uppercase()), Some(m));
+        }
+        assert_eq!(LodMode::Force.name(), "force");
+        assert_eq!(LodMode::parse_scene("force"), None);
+    }
+
     #[test]
     fn primary_footprint_is_the_pixel_cone_width() {
         // 90° fov, 100 px high: one pixel at distance 1 is 2/100 wide; a

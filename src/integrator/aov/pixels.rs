@@ -748,6 +748,49 @@ pub fn layers<'b>(
 mod tests {
     use super::*;
 
+    /// A render pays per pixel only for the stores its passes read: the
+    /// nearest hit for P, Z and the IDs, the coverage lists for the
+    /// Cryptomatte passes, the sums for the summed layers; a beauty-only
+    /// render keeps none of them.
+    #[test]
+    fn each_pixel_store_exists_only_for_the_passes_that_read_it() {
+        use crate::film::passes::ALL;
+        let names = [String::from("a")];
+        let pixels = 16;
+        let sums = |passes: PassSet| {
+            let layout = Layout::new(passes, &names, &names, &names);
+            AovSums::new(&layout, pixels).unwrap()
+        };
+        let none = sums(PassSet::EMPTY);
+        assert_eq!(
+            (none.sums.len(), none.nearest.len(), none.objects.len()),
+            (0, 0, 0)
+        );
+        assert!(none.materials.is_empty());
+        for p in ALL {
+            let one = sums([p].into_iter().collect());
+            let nearest = matches!(
+                p,
+                Pass::Position | Pass::Depth | Pass::ObjectId | Pass::MaterialId
+            );
+            assert_eq!(one.nearest.len(), if nearest { pixels } else { 0 }, "{p:?}");
+            let objects = p == Pass::CryptoObject;
+            assert_eq!(one.objects.len(), if objects { pixels } else { 0 }, "{p:?}");
+            let materials = p == Pass::CryptoMaterial;
+            assert_eq!(
+                one.materials.len(),
+                if materials { pixels } else { 0 },
+                "{p:?}"
+            );
+            let summed = LIGHT_PATHS.contains(&p)
+                || matches!(
+                    p,
+                    Pass::LightGroups | Pass::Albedo | Pass::Normal | Pass::Variance
+                );
+            assert_eq!(one.sums.is_empty(), !summed, "{p:?}");
+        }
+    }
+
     #[test]
     fn squares_and_the_variance_numerator_are_exact() {
         let m = u64::MAX as i128;
