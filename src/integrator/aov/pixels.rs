@@ -683,11 +683,12 @@ pub fn layers<'b>(
     let pixels = width as usize * height as usize;
     let mut layers = Vec::with_capacity(layout.slots.len());
     for slot in &layout.slots {
-        let len = pixels * slot.channels.len();
+        let len = pixels.saturating_mul(slot.channels.len());
         let mut values = Vec::new();
-        values
-            .try_reserve_exact(len)
-            .map_err(|_| out_of_memory(&format!("the {} pass", slot.name), len * 4))?;
+        values.try_reserve_exact(len).map_err(|_| {
+            let bytes = len.saturating_mul(std::mem::size_of::<f32>());
+            out_of_memory(&format!("the {} pass", slot.name), bytes)
+        })?;
         layers.push(Layer {
             name: slot.name.clone(),
             channels: slot.channels.iter().map(|c| c.to_string()).collect(),
@@ -789,6 +790,23 @@ mod tests {
                 );
             assert_eq!(one.sums.is_empty(), !summed, "{p:?}");
         }
+    }
+
+    /// A pass too large for memory is an error naming the pass and the
+    /// size it needed (3 channels of 4 bytes for 2⁶⁰ pixels: 3·2⁴² MB),
+    /// however large the image: no overflow, no abort.
+    #[test]
+    fn a_pass_too_large_for_memory_names_its_size() {
+        let names = [String::from("a")];
+        let layout = Layout::new([Pass::Albedo].into_iter().collect(), &names, &names, &names);
+        let aov = AovSums::new(&layout, 0).unwrap();
+        let at = |_: u32, _: u32| -> (usize, &[i128]) { unreachable!("no pixel is read") };
+        let e = layers(&layout, &aov, 1 << 30, 1 << 30, 1, at).unwrap_err();
+        let text = e.to_string();
+        assert!(text.contains(&format!("{} MB", 3u64 << 42)), "{text}");
+        assert!(text.contains(Pass::Albedo.name()), "{text}");
+        let e = layers(&layout, &aov, u32::MAX, u32::MAX, 1, at).unwrap_err();
+        assert!(e.to_string().contains("out of memory"), "{e}");
     }
 
     #[test]
