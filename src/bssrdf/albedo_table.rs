@@ -393,6 +393,15 @@ mod tests {
         assert!((ok.reflectance(0.75, 1.5).unwrap() - want).abs() < 1e-12);
         let e = AlbedoTable::parse(&format!("{head}{rows}2.0,1,0,0,0,0\n"), "t.csv").unwrap_err();
         assert_eq!(e.field, "row");
+        // one η (nothing to interpolate between), one x per η: refused on
+        // the last row, although each is a full grid of its rows
+        for rows in [
+            "1.0,0,1,0,1,0\n1.0,1,0,0,0,0\n",
+            "1.0,0,1,0,1,0\n2.0,0,1,0,1,0\n",
+        ] {
+            let e = AlbedoTable::parse(&format!("{head}{rows}"), "t.csv").unwrap_err();
+            assert_eq!((e.line, e.field.as_str()), (4, "row"), "{e}");
+        }
         // η out of order: the error names the first line of the η block
         // that does not increase (line 5, the third row)
         let rows = "2.0,0,1,0,1,0\n2.0,1,0,0,0,0\n1.0,0,1,0,1,0\n1.0,1,0,0,0,0\n";
