@@ -30,7 +30,8 @@ const HUGE: usize = 2 << 20;
 fn huge_pages_within(start: usize, len: usize) -> Option<(usize, usize)> {
     let a = start.checked_next_multiple_of(HUGE)?;
     let b = start.checked_add(len)? & !(HUGE - 1);
-    (b > a).then_some((a, b - a))
+    // `then`, not `then_some`: b − a is only taken where it is positive
+    (b > a).then(|| (a, b - a))
 }
 
 /// Asks the kernel to back the whole huge pages of `[start, start + len)`
