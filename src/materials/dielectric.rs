@@ -32,25 +32,23 @@ pub fn refract(wo: Vec3, eta: f32) -> Option<(Vec3, f32)> {
 }
 
 pub fn sample(eta: f32, wo: Vec3, u: f32) -> SpecularSample {
-    let fr = fresnel::dielectric(wo.z, eta);
-    if u < fr {
-        return SpecularSample {
-            wi: Vec3::new(-wo.x, -wo.y, wo.z),
-            weight: 1.0,
-            transmitted: false,
-        };
+    let mirror = SpecularSample {
+        wi: Vec3::new(-wo.x, -wo.y, wo.z),
+        weight: 1.0,
+        transmitted: false,
+    };
+    if u < fresnel::dielectric(wo.z, eta) {
+        return mirror;
     }
+    // Fr = 1 wherever refract finds total internal reflection (the same
+    // sin²θt), so its None is a guard here, not a branch light takes.
     match refract(wo, eta) {
         Some((wi, etap)) => SpecularSample {
             wi,
             weight: 1.0 / (etap * etap),
             transmitted: true,
         },
-        None => SpecularSample {
-            wi: Vec3::new(-wo.x, -wo.y, wo.z),
-            weight: 1.0,
-            transmitted: false,
-        },
+        None => mirror,
     }
 }
 
