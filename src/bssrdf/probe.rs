@@ -355,7 +355,10 @@ pub fn pick_by_score(u: &ProbeRandoms, scores: &[f32], total: usize) -> Option<(
     Some((pick, factor))
 }
 
-/// ⌊u·n⌋ for u ∈ [0, 1), n ≥ 1, clamped to n − 1 against rounding.
+/// ⌊u·n⌋ for u ∈ [0, 1], n ≥ 1, clamped to n − 1. For u < 1 the product
+/// never rounds up to n (below 2⁵³, n·(1 − 2⁻⁵³) is at least half an ulp
+/// under n, or exact below a power of two); the clamp keeps the closed
+/// end u = 1 in range.
 #[inline]
 fn uniform_index(u: f64, n: usize) -> usize {
     ((u * n as f64) as usize).min(n - 1)
@@ -974,6 +977,20 @@ mod tests {
         assert!(pick_by_score(&u(0.3), &[0.0, 0.0], 2).is_none());
         assert!(pick_by_score(&u(0.3), &[1.0, f32::NAN], 2).is_none());
         assert!(pick_by_score(&u(0.3), &[1.0, f32::INFINITY], 2).is_none());
+    }
+
+    #[test]
+    fn uniform_indices_cover_every_slot_and_stay_in_range_at_both_ends() {
+        let below_one = 1.0 - f64::EPSILON / 2.0;
+        for n in [1usize, 2, 3, 5, 7, 1 << 20, (1 << 20) + 3] {
+            assert_eq!(uniform_index(0.0, n), 0);
+            assert_eq!(uniform_index(below_one, n), n - 1, "n = {n}");
+            assert_eq!(uniform_index(1.0, n), n - 1, "n = {n}");
+            for k in 0..n.min(64) {
+                // the middle of slot k maps to k
+                assert_eq!(uniform_index((k as f64 + 0.5) / n as f64, n), k);
+            }
+        }
     }
 
     #[test]
