@@ -560,6 +560,28 @@ impl SubsurfaceParams {
 mod tests {
     use super::*;
 
+    /// An albedo the dipole reaches only without absorption (A = 1, or
+    /// above its value at α' = 1) inverts to the cap 1 − 10⁻⁶, not to 1:
+    /// the medium keeps σa ≥ 10⁻⁶·σt' like the diffusion side; below the
+    /// cap the inversion is exact.
+    #[test]
+    fn inverting_an_albedo_without_absorption_stops_at_the_cap() {
+        let cap = 1.0 - MIN_ABSORPTION_FRACTION;
+        for eta in [1.0, 1.3, 1.5] {
+            for a in [
+                1.0,
+                dipole_reflectance(1.0, eta),
+                0.9999 + 0.0001 * dipole_reflectance(1.0, eta),
+            ] {
+                let alpha = invert_dipole_reflectance(a, eta);
+                assert!(alpha <= cap, "η {eta}, A {a}: α' = {alpha}");
+                assert!(alpha > cap - 1e-6, "η {eta}, A {a}: α' = {alpha}");
+            }
+            let below = dipole_reflectance(0.999, eta);
+            assert!((invert_dipole_reflectance(below, eta) - 0.999).abs() < 1e-9);
+        }
+    }
+
     /// Lengths carry the scene's unit, so scaling every given length by k
     /// scales every coefficient by 1/k — the zero-length channel's
     /// optically thick stand-in included (it is tied to the shortest given
