@@ -854,3 +854,72 @@ fn study_matrix_has_the_other_boundary() {
         .iter()
         .any(|c| c.axis == Axis::Boundary));
 }
+
+/// Inside the diffuse boundary a walk reflects in the mirror direction
+/// about the surface normal. In a cube of a clear medium (no scattering on
+/// the way) a mirror path is a straight line folded at the faces: from a
+/// start that meets a face at total internal reflection first (cosine
+/// 0.30 < 0.75 at η = 1.5), every walk must leave at one of the face hits
+/// of the folded line, through that face. A reflection off the mirror
+/// direction (2μ → 2 + μ in the walk was a mutation no test caught) leaves
+/// elsewhere.
+#[test]
+fn the_walk_reflects_inside_the_diffuse_boundary_in_the_mirror_direction() {
+    use lucent::integrator::diffuse_boundary::DiffuseBoundary;
+    use lucent::integrator::randomwalk::{walk, Boundary, WalkEnd};
+    use lucent::integrator::Context;
+    use lucent::sampling::SampleRng;
+    let m = Medium {
+        sigma_s: [0.0; 3],
+        sigma_a: [1e-9; 3],
+        g: 0.0,
+    };
+    let s = scene(
+        vec![Part {
+            mesh: shapes::cuboid(),
+            material: Material::Diffuse { albedo: Vec3::ONE },
+            emission: None,
+        }],
+        None,
+        camera_above(4),
+        1,
+        1,
+    );
+    let a = accel::build(&s.meshes, Backend::Bvh).unwrap();
+    let ctx = Context::new(&s, a.as_ref());
+    let b = DiffuseBoundary::new(1.5);
+    let p0 = Vec3::new(0.8, 0.0, -0.5);
+    let d0 = Vec3::new(0.3, 0.5, 0.8).normalize();
+    // the folded line's face hits: (point, outward normal)
+    let mut hits = Vec::new();
+    let (mut p, mut d) = (p0, d0);
+    for _ in 0..400 {
+        let t = |k: usize| (d[k].signum() - p[k]) / d[k];
+        let k = (0..3).min_by(|&i, &j| t(i).total_cmp(&t(j))).unwrap();
+        p += d * t(k);
+        let mut n = Vec3::ZERO;
+        n[k] = d[k].signum();
+        hits.push((p, n));
+        d[k] = -d[k];
+    }
+    assert_eq!(hits[0].1, Vec3::X, "the first face met is x = 1");
+    let mut c = Counters::default();
+    let mut reflected = 0;
+    for i in 0..64u64 {
+        let mut rng = SampleRng::new(11, i, 0);
+        let ray = lucent::geometry::Ray::new(p0, d0);
+        let Some((WalkEnd::Exit { p, n_out }, _)) =
+            walk(&ctx, &m, Boundary::Diffuse(&b), ray, &mut rng, &mut c)
+        else {
+            panic!("walk {i} did not leave through the boundary");
+        };
+        let at = hits.iter().position(|(h, _)| (*h - p).length() < 1e-4);
+        let Some(k) = at else {
+            panic!("walk {i} left at {p}, off the mirror path");
+        };
+        assert_eq!(n_out, hits[k].1, "walk {i}: normal at hit {k}");
+        reflected += k;
+    }
+    // every walk reflected at least once (x = 1 first); several more often
+    assert!(reflected > 64, "{reflected} reflections in 64 walks");
+}

@@ -63,6 +63,7 @@ use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
 use crate::geometry::{Frame, Ray, Vec3};
+use crate::materials::microfacet::reflect;
 use crate::materials::{dielectric, WalkBoundary};
 use crate::sampling::{Draw, SampleRng};
 
@@ -330,7 +331,7 @@ pub fn walk(
                 if rng.uniform() >= b.reflect_in(mu_in) {
                     return Some((WalkEnd::Exit { p: si.p, n_out }, w()));
                 }
-                let wi = (ray.d - (2.0 * mu_in) * n_out).normalize();
+                let wi = reflect(-ray.d, n_out).normalize();
                 ray = si.spawn(wi, ctx.ray_epsilon);
             }
         }
