@@ -260,3 +260,56 @@ fn probe_axes_read_the_curvature_of_the_surface() {
     }
     assert!(checked[0] > 0 && checked[1] > 0, "{checked:?}");
 }
+
+/// The control variate is drawn only where it can act (module docs of
+/// `integrator::control_variate`): at the camera vertex, under an area
+/// light. Where it cannot — no area light, or a vertex at or below the
+/// context's `cv_depth` — switching it on changes not one sample: the same
+/// randoms, rays and radiance as with it off. Where it can, it does change
+/// the samples (else this test would prove nothing).
+#[test]
+fn the_control_variate_is_drawn_only_at_the_camera_vertex_under_an_area_light() {
+    let pixels = [(20u32, 14u32), (24, 18), (16, 16)];
+    let samples = |scene: &lucent::scene::Scene, cv_depth: Option<u32>| {
+        let accel = accel::build(&scene.meshes, Backend::Bvh).unwrap();
+        let mut ctx = Context::new(scene, accel.as_ref());
+        if let Some(d) = cv_depth {
+            ctx.cv_depth = d;
+        }
+        pixels.map(|(x, y)| pixel_stats(&ctx, x, y, 64))
+    };
+    let lit_on = scene("");
+    let lit_off = scene("control_variate = false");
+    assert_ne!(
+        samples(&lit_on, None),
+        samples(&lit_off, None),
+        "the control variate changed nothing where it applies"
+    );
+    assert_eq!(
+        samples(&lit_on, Some(0)),
+        samples(&lit_off, Some(0)),
+        "drawn at a vertex at cv_depth"
+    );
+    let dark = |options: &str| {
+        let text = SCENE
+            .replace("MARBLE_OPTIONS", options)
+            .replace("emission = [50.0, 50.0, 50.0]\n", "");
+        lucent::scene::load_str(&text, Path::new("no_area_light.toml")).unwrap()
+    };
+    let (dark_on, dark_off) = (dark(""), dark("control_variate = false"));
+    assert!(
+        !Context::new(
+            &dark_on,
+            accel::build(&dark_on.meshes, Backend::Bvh)
+                .unwrap()
+                .as_ref()
+        )
+        .plan
+        .area_lights
+    );
+    assert_eq!(
+        samples(&dark_on, None),
+        samples(&dark_off, None),
+        "drawn without an area light"
+    );
+}
