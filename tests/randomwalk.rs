@@ -862,7 +862,9 @@ fn study_matrix_has_the_other_boundary() {
 /// 0.30 < 0.75 at η = 1.5), every walk must leave at one of the face hits
 /// of the folded line, through that face. A reflection off the mirror
 /// direction (2μ → 2 + μ in the walk was a mutation no test caught) leaves
-/// elsewhere.
+/// elsewhere. The cube is walked twice, wound outwards and inwards: the
+/// exit normal faces the way the walk leaves, whichever way the mesh's
+/// triangles face.
 #[test]
 fn the_walk_reflects_inside_the_diffuse_boundary_in_the_mirror_direction() {
     use lucent::integrator::diffuse_boundary::DiffuseBoundary;
@@ -874,19 +876,12 @@ fn the_walk_reflects_inside_the_diffuse_boundary_in_the_mirror_direction() {
         sigma_a: [1e-9; 3],
         g: 0.0,
     };
-    let s = scene(
-        vec![Part {
-            mesh: shapes::cuboid(),
-            material: Material::Diffuse { albedo: Vec3::ONE },
-            emission: None,
-        }],
+    let outward = shapes::cuboid();
+    let inward = Mesh::new(
+        outward.positions().to_vec(),
+        outward.indices.iter().map(|&[i, j, k]| [i, k, j]).collect(),
         None,
-        camera_above(4),
-        1,
-        1,
     );
-    let a = accel::build(&s.meshes, Backend::Bvh).unwrap();
-    let ctx = Context::new(&s, a.as_ref());
     let b = DiffuseBoundary::new(1.5);
     let p0 = Vec3::new(0.8, 0.0, -0.5);
     let d0 = Vec3::new(0.3, 0.5, 0.8).normalize();
@@ -903,23 +898,38 @@ fn the_walk_reflects_inside_the_diffuse_boundary_in_the_mirror_direction() {
         d[k] = -d[k];
     }
     assert_eq!(hits[0].1, Vec3::X, "the first face met is x = 1");
-    let mut c = Counters::default();
-    let mut reflected = 0;
-    for i in 0..64u64 {
-        let mut rng = SampleRng::new(11, i, 0);
-        let ray = lucent::geometry::Ray::new(p0, d0);
-        let Some((WalkEnd::Exit { p, n_out }, _)) =
-            walk(&ctx, &m, Boundary::Diffuse(&b), ray, &mut rng, &mut c)
-        else {
-            panic!("walk {i} did not leave through the boundary");
-        };
-        let at = hits.iter().position(|(h, _)| (*h - p).length() < 1e-4);
-        let Some(k) = at else {
-            panic!("walk {i} left at {p}, off the mirror path");
-        };
-        assert_eq!(n_out, hits[k].1, "walk {i}: normal at hit {k}");
-        reflected += k;
+    for mesh in [outward, inward] {
+        let s = scene(
+            vec![Part {
+                mesh,
+                material: Material::Diffuse { albedo: Vec3::ONE },
+                emission: None,
+            }],
+            None,
+            camera_above(4),
+            1,
+            1,
+        );
+        let a = accel::build(&s.meshes, Backend::Bvh).unwrap();
+        let ctx = Context::new(&s, a.as_ref());
+        let mut c = Counters::default();
+        let mut reflected = 0;
+        for i in 0..64u64 {
+            let mut rng = SampleRng::new(11, i, 0);
+            let ray = lucent::geometry::Ray::new(p0, d0);
+            let Some((WalkEnd::Exit { p, n_out }, _)) =
+                walk(&ctx, &m, Boundary::Diffuse(&b), ray, &mut rng, &mut c)
+            else {
+                panic!("walk {i} did not leave through the boundary");
+            };
+            let at = hits.iter().position(|(h, _)| (*h - p).length() < 1e-4);
+            let Some(k) = at else {
+                panic!("walk {i} left at {p}, off the mirror path");
+            };
+            assert_eq!(n_out, hits[k].1, "walk {i}: normal at hit {k}");
+            reflected += k;
+        }
+        // every walk reflected at least once (x = 1 first); several more often
+        assert!(reflected > 64, "{reflected} reflections in 64 walks");
     }
-    // every walk reflected at least once (x = 1 first); several more often
-    assert!(reflected > 64, "{reflected} reflections in 64 walks");
 }
