@@ -531,6 +531,18 @@ fn a_black_medium_costs_one_query_per_walk() {
     assert_eq!((c.walks_capped, c.walks_escaped, c.nonfinite), (0, 0, 0));
 }
 
+/// A scene of `mesh` alone (a diffuse material, no light): what tests
+/// that call [`walk`](lucent::integrator::randomwalk::walk) directly build
+/// their context from.
+fn walk_scene(mesh: Mesh) -> Scene {
+    let part = Part {
+        mesh,
+        material: Material::Diffuse { albedo: Vec3::ONE },
+        emission: None,
+    };
+    scene(vec![part], None, camera_above(4), 1, 1)
+}
+
 /// A walk that cannot end within [`MAX_WALK_EVENTS`] events is stopped
 /// there and counted as capped: started at the centre of a sphere of
 /// optical radius 10⁴ of a medium that absorbs nothing, a walk needs ~10⁸
@@ -549,28 +561,14 @@ fn walks_that_cannot_end_stop_at_the_cap_and_are_counted() {
         sigma_a: [0.0; 3],
         g: 0.0,
     };
-    let s = scene(
-        vec![Part {
-            mesh: shapes::sphere(2),
-            material: Material::Diffuse { albedo: Vec3::ONE },
-            emission: None,
-        }],
-        None,
-        camera_above(4),
-        1,
-        1,
-    );
+    let s = walk_scene(shapes::sphere(2));
     let a = accel::build(&s.meshes, Backend::Bvh).unwrap();
     let ctx = Context::new(&s, a.as_ref());
     let mut c = Counters::default();
     let walks = 12u64;
     for i in 0..walks {
         let mut rng = SampleRng::new(3, i, 0);
-        let [u, v] = rng.uniform2();
-        let z = 1.0 - 2.0 * u;
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        let phi = std::f32::consts::TAU * v;
-        let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+        let d = lucent::sampling::uniform_sphere(rng.uniform2());
         let ray = lucent::geometry::Ray::new(Vec3::ZERO, d);
         let end = walk(&ctx, &m, Boundary::Dielectric(1.0), ray, &mut rng, &mut c);
         assert!(end.is_none(), "walk {i} ended at the boundary");
@@ -612,17 +610,7 @@ fn closed_icospheres_lose_no_walk_at_any_scale() {
                 sigma_a: [0.01 * k; 3],
                 g: 0.0,
             };
-            let s = scene(
-                vec![Part {
-                    mesh: mesh.clone(),
-                    material: Material::Diffuse { albedo: Vec3::ONE },
-                    emission: None,
-                }],
-                None,
-                camera_above(4),
-                1,
-                1,
-            );
+            let s = walk_scene(mesh.clone());
             let a = accel::build(&s.meshes, backend).unwrap();
             let ctx = Context::new(&s, a.as_ref());
             let mut c = Counters::default();
@@ -899,17 +887,7 @@ fn the_walk_reflects_inside_the_diffuse_boundary_in_the_mirror_direction() {
     }
     assert_eq!(hits[0].1, Vec3::X, "the first face met is x = 1");
     for mesh in [outward, inward] {
-        let s = scene(
-            vec![Part {
-                mesh,
-                material: Material::Diffuse { albedo: Vec3::ONE },
-                emission: None,
-            }],
-            None,
-            camera_above(4),
-            1,
-            1,
-        );
+        let s = walk_scene(mesh);
         let a = accel::build(&s.meshes, Backend::Bvh).unwrap();
         let ctx = Context::new(&s, a.as_ref());
         let mut c = Counters::default();
