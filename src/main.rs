@@ -697,7 +697,9 @@ fn run_render(
         None => None,
     };
     stop_if_interrupted()?;
-    let accel = accel::build(&scene.meshes, backend)?;
+    let traversal =
+        accel::Traversal::for_render(scene.settings.traversal, random_walk(opts.integrator));
+    let accel = accel::build_with(&scene.meshes, backend, traversal)?;
     stop_if_interrupted()?;
     out.preview = Some(preview);
     let keep = checkpoint_path(output);
@@ -782,6 +784,16 @@ fn run_explain(
         ExplainArg::Json => println!("{}", plan.to_json_pretty()),
     }
     Ok(())
+}
+
+/// Whether `integrator` is the random walk (which needs a watertight
+/// traversal, `accel::Traversal`).
+fn random_walk(integrator: IntegratorKind) -> bool {
+    match integrator {
+        IntegratorKind::Path => false,
+        #[cfg(feature = "subsurface")]
+        IntegratorKind::RandomWalk => true,
+    }
 }
 
 /// The plan a render of `scene` with `integrator` and `passes` follows.

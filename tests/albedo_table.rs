@@ -56,6 +56,7 @@ fn slab_scene(material: Material, side: f32, thickness: f32, theta_deg: f32, spp
             spp,
             max_depth: 8,
             seed: 5,
+            ..RenderSettings::default()
         },
         meshes: Arc::new(vec![mesh]),
         objects: vec![Object {

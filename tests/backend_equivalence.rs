@@ -19,7 +19,7 @@ mod embree_vs_bvh {
     use std::path::Path;
     use std::sync::Arc;
 
-    use lucent::accel::{self, Accel, Backend, Hit, ProbeHits, MAX_PROBE_HITS};
+    use lucent::accel::{self, Accel, Backend, Hit, ProbeHits, Traversal, MAX_PROBE_HITS};
     use lucent::geometry::{Mesh, Ray, Vec3};
     use lucent::sampling::Rng;
     use lucent::scene::shapes;
@@ -924,6 +924,25 @@ mod embree_vs_bvh {
         assert!(err.to_string().contains("vertex index 4"), "{err}");
     }
 
+    /// Embree's scene is committed with the traversal asked for (read back
+    /// from its flags), `build` is watertight, and a fast scene still
+    /// answers every ray that is not a knife edge as the reference does.
+    fn each_traversal_is_what_embree_was_given(which: Backend) {
+        let meshes = Arc::new(vec![shapes::sphere(5)]);
+        assert_eq!(embree(&meshes, which).traversal(), Traversal::Watertight);
+        for t in [Traversal::Watertight, Traversal::Fast] {
+            let e = accel::build_with(&meshes, which, t).expect("Embree build");
+            assert_eq!(e.traversal(), t);
+            let mut qs = random_queries(1500, 1.5, 1, 7);
+            qs.extend(inside_queries(1000, Vec3::ZERO, 0.9, 0, 8));
+            let st = compare(&*e, None, &meshes, &qs, 1e-5);
+            assert!(st.hits > 1000, "{t:?}: {st:?}");
+        }
+        // our BVH ignores the choice: it is watertight
+        let b = accel::build_with(&meshes, Backend::Bvh, Traversal::Fast).unwrap();
+        assert_eq!(b.traversal(), Traversal::Watertight);
+    }
+
     /// Each check above as one test per Embree this build has: Embree 3
     /// (the `embree` feature; these tests need it) and Embree 4 (the
     /// `embree4` feature and a library: see [`embree4`]).
@@ -949,6 +968,7 @@ mod embree_vs_bvh {
         integer_grid_vertices_embree_watertight,
         overflowing_probe_keeps_the_same_subset,
         embree_rejects_out_of_range_indices,
+        each_traversal_is_what_embree_was_given,
     );
 
     /// Embree 4 if this process can load it; else `None` (the test is

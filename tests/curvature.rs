@@ -49,6 +49,7 @@ fn scene(material: Material, mesh: Mesh, eye: Vec3, up: Vec3, fov: f32, spp: u32
             spp,
             max_depth: 4,
             seed: 1,
+            ..RenderSettings::default()
         },
         meshes: Arc::new(vec![mesh]),
         objects: vec![Object {

@@ -28,6 +28,7 @@ fn scene_with(
             spp,
             max_depth,
             seed: 7,
+            ..RenderSettings::default()
         },
         meshes: Arc::new(vec![mesh]),
         objects: vec![Object {

@@ -98,6 +98,7 @@ fn scene(
             spp,
             max_depth,
             seed: 11,
+            ..RenderSettings::default()
         },
         meshes: Arc::new(meshes),
         objects: (0..n)

@@ -76,6 +76,7 @@ fn top(direct: &str, env: &str, specular: (&str, Vec<&str>), probes: &str) -> Va
         "indirect": {"method": "lobe sampling", "max_depth": 5, "roulette_from": 3},
         "specular_chains": {"method": specular.0, "materials": specular.1},
         "probe_queries": {"method": probes},
+        "traversal": {"method": "fast"},
         "aovs": {"method": "none", "passes": []},
     })
 }
@@ -307,6 +308,7 @@ fn random_walk_replaces_probes_with_the_walk() {
         ]),
     );
     want["integrator"] = json!("randomwalk");
+    want["traversal"] = json!({"method": "watertight"});
     check(
         &plan_of(&s, IntegratorKind::RandomWalk, PassSet::EMPTY),
         want,
@@ -406,6 +408,20 @@ fn a_plan_with_subsurface_makes_probe_queries_and_the_walk_none() {
 }
 
 #[test]
+fn the_plan_traverses_fast_unless_the_scene_asks_or_the_walk_needs_watertight() {
+    let method = |s: &Scene, i| plan_of(s, i, PassSet::EMPTY).traversal.method;
+    let s = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
+    assert_eq!(method(&s, IntegratorKind::Path), "fast");
+    assert_eq!(method(&s, IntegratorKind::RandomWalk), "watertight");
+    // CAMERA ends in [render]
+    let w = load(&format!(
+        "traversal = \"watertight\"\n{LAMP}{KETCHUP}{BALL_SAUCE}"
+    ));
+    assert_eq!(method(&w, IntegratorKind::Path), "watertight");
+    assert_eq!(method(&w, IntegratorKind::RandomWalk), "watertight");
+}
+
+#[test]
 fn time_is_measured_only_with_stats() {
     let s = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
     let off = counters(&s, IntegratorKind::Path, false);
@@ -494,6 +510,7 @@ fn explain_prints_the_plan_and_writes_nothing() {
             "indirect",
             "specular_chains",
             "probe_queries",
+            "traversal",
             "aovs",
             "materials"
         ]

@@ -70,6 +70,7 @@ fn scene(parts: Vec<Part>, env: Option<Vec3>, camera: Camera, spp: u32, max_dept
             spp,
             max_depth,
             seed: 11,
+            ..RenderSettings::default()
         },
         meshes: Arc::new(meshes),
         objects,

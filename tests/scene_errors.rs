@@ -236,6 +236,8 @@ fn cases() -> Vec<Case> {
         ),
         case("spp zero", format!("{CAM}[render]\nspp = 0\n"), "at least 1 sample", Some("spp"), Some("render.spp")),
         case("max_depth zero", format!("{CAM}[render]\nmax_depth = 0\n"), "at least 1", Some("max_depth"), Some("render.max_depth")),
+        case("traversal unknown", format!("{CAM}[render]\ntraversal = \"robust\"\n"), "expected \"fast\" or \"watertight\", found \"robust\"", Some("traversal"), Some("render.traversal")),
+        case("traversal not a string", format!("{CAM}[render]\ntraversal = true\n"), "expected a string", Some("traversal"), Some("render.traversal")),
         case("seed negative", format!("{CAM}[render]\nseed = -3\n"), "expected u64", Some("seed"), Some("render.seed")),
         case("units_per_mm zero", format!("units_per_mm = 0\n{CAM}"), "expected a number > 0", Some("units_per_mm"), Some("units_per_mm")),
         case("units_per_mm inf", format!("units_per_mm = inf\n{CAM}"), "finite", Some("units_per_mm"), Some("units_per_mm")),

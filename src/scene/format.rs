@@ -102,6 +102,8 @@ pub struct RenderDef {
     pub spp: Option<Spanned<u32>>,
     pub max_depth: Option<Spanned<u32>>,
     pub seed: Option<u64>,
+    /// `"fast"` or `"watertight"` (`crate::accel::Traversal`).
+    pub traversal: Option<Spanned<String>>,
 }
 
 /// `[output]`: the passes and how the frame is stored; every key is

@@ -21,6 +21,7 @@ use super::output::output;
 pub use super::regular_file::read_regular_file;
 use super::regular_file::{read_regular_bytes, utf8_text};
 use super::{show_point, Camera, RenderSettings, Scene, MAX_COORDINATE};
+use crate::accel::Traversal;
 use crate::error::InputError;
 use crate::geometry::Vec3;
 
@@ -291,6 +292,16 @@ fn settings(cx: &Cx, r: &RenderDef) -> Res<RenderSettings> {
     if let Some(seed) = r.seed {
         s.seed = seed;
     }
+    if let Some(t) = &r.traversal {
+        let name = t.get_ref().as_str();
+        s.traversal = Traversal::parse(name).ok_or_else(|| {
+            cx.err(
+                t.span(),
+                "render.traversal",
+                format!("expected \"fast\" or \"watertight\", found \"{name}\""),
+            )
+        })?;
+    }
     Ok(s)
 }
 
@@ -323,6 +334,15 @@ mod tests {
     }
 
     #[test]
+    fn traversal_is_fast_unless_the_scene_asks_for_watertight() {
+        assert_eq!(scene("").settings.traversal, Traversal::Fast);
+        for t in [Traversal::Fast, Traversal::Watertight] {
+            let s = scene(&format!("[render]\ntraversal = \"{}\"\n", t.name()));
+            assert_eq!(s.settings.traversal, t);
+        }
+    }
+
+    #[test]
     fn defaults_fill_everything_optional() {
         let s = scene("");
         assert_eq!(s.settings, RenderSettings::default());
@@ -351,7 +371,8 @@ mod tests {
             RenderSettings {
                 spp: 4,
                 max_depth: 3,
-                seed: 99
+                seed: 99,
+                traversal: Traversal::Fast,
             }
         );
         // Field by field: the derived members (tan of the fov) can differ in

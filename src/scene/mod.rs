@@ -54,12 +54,16 @@ pub(crate) fn show_point(p: [f32; 3]) -> String {
     format!("[{}, {}, {}]", one(p[0]), one(p[1]), one(p[2]))
 }
 
-/// Sample count, path depth and seed.
+/// Sample count, path depth, seed, and how rays treat shared edges.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     pub spp: u32,
     pub max_depth: u32,
     pub seed: u64,
+    /// `[render] traversal`: what `lucent render` asks of Embree
+    /// ([`crate::accel::Traversal`]; the random walk is watertight
+    /// whatever this says). `Fast` unless the scene says `"watertight"`.
+    pub traversal: crate::accel::Traversal,
 }
 
 impl Default for RenderSettings {
@@ -68,6 +72,7 @@ impl Default for RenderSettings {
             spp: 16,
             max_depth: 8,
             seed: 0,
+            traversal: crate::accel::Traversal::Fast,
         }
     }
 }

@@ -197,6 +197,7 @@ extern "C" {
     pub fn rtcNewScene(device: RTCDevice) -> RTCScene;
     pub fn rtcReleaseScene(scene: RTCScene);
     pub fn rtcSetSceneFlags(scene: RTCScene, flags: RTCSceneFlags);
+    pub fn rtcGetSceneFlags(scene: RTCScene) -> RTCSceneFlags;
     pub fn rtcSetSceneBuildQuality(scene: RTCScene, quality: RTCBuildQuality);
     pub fn rtcAttachGeometryByID(scene: RTCScene, geometry: RTCGeometry, geom_id: c_uint);
     pub fn rtcCommitScene(scene: RTCScene);

@@ -5,7 +5,8 @@
 //! them (hence the padding vertex in [`Mesh`]); geometry ids are the mesh
 //! indices, so hits need no translation. The scene is built `ROBUST` (a
 //! watertight triangle test, so probe rays do not slip through shared edges)
-//! with `CONTEXT_FILTER_FUNCTION`, which lets [`Accel::hits_on_segment`]
+//! unless asked for [`Traversal::Fast`], and always with
+//! `CONTEXT_FILTER_FUNCTION`, which lets [`Accel::hits_on_segment`]
 //! gather every hit of a segment in one traversal: a filter records each
 //! candidate and rejects it, so the ray's interval never shrinks.
 
@@ -21,7 +22,7 @@ use std::sync::{Arc, OnceLock};
 use super::embree_shared::{
     check_shareable, error_name, on_device_error, record_and_reject, ErrorSink,
 };
-use super::{valid_query, Accel, Hit, ProbeHits, RejectedRays};
+use super::{valid_query, Accel, Hit, ProbeHits, RejectedRays, Traversal};
 use crate::error::Error;
 use crate::geometry::{Mesh, Ray, Vec3};
 
@@ -168,12 +169,26 @@ unsafe impl Send for EmbreeAccel {}
 // SAFETY: see `Send` above.
 unsafe impl Sync for EmbreeAccel {}
 
+/// `RTC_SCENE_FLAG_ROBUST` for a watertight traversal, else no flag.
+fn robust_flag(traversal: Traversal) -> ffi::RTCSceneFlags {
+    match traversal {
+        Traversal::Watertight => ffi::RTC_SCENE_FLAG_ROBUST,
+        Traversal::Fast => ffi::RTC_SCENE_FLAG_NONE,
+    }
+}
+
 impl EmbreeAccel {
     /// Builds and commits an Embree scene over `meshes`, sharing their
     /// buffers; called inside a rayon pool, the build uses that many
     /// threads. Fails (without leaking) if Embree reports any error or if a
     /// mesh cannot be shared safely (index out of range, too many elements).
     pub fn build(meshes: &Arc<Vec<Mesh>>) -> Result<EmbreeAccel, Error> {
+        Self::build_with(meshes, Traversal::Watertight)
+    }
+
+    /// [`build`](Self::build) with the given [`Traversal`]: `ROBUST` for
+    /// `Watertight`, Embree's default arithmetic for `Fast`.
+    pub fn build_with(meshes: &Arc<Vec<Mesh>>, traversal: Traversal) -> Result<EmbreeAccel, Error> {
         check_shareable(meshes)?;
 
         // Inside a rayon pool, build with as many threads as it has (so a
@@ -208,7 +223,7 @@ impl EmbreeAccel {
         unsafe {
             ffi::rtcSetSceneFlags(
                 scene.raw,
-                ffi::RTC_SCENE_FLAG_ROBUST | ffi::RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION,
+                robust_flag(traversal) | ffi::RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION,
             );
             ffi::rtcSetSceneBuildQuality(scene.raw, ffi::RTC_BUILD_QUALITY_MEDIUM);
         }
@@ -427,5 +442,14 @@ impl Accel for EmbreeAccel {
 
     fn rejected_rays(&self) -> u64 {
         self.rejected.get()
+    }
+    fn traversal(&self) -> Traversal {
+        // SAFETY: `self.scene.raw` is a live, committed scene.
+        let flags = unsafe { ffi::rtcGetSceneFlags(self.scene.raw) };
+        if flags & ffi::RTC_SCENE_FLAG_ROBUST != 0 {
+            Traversal::Watertight
+        } else {
+            Traversal::Fast
+        }
     }
 }

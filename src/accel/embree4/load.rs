@@ -53,6 +53,7 @@ pub struct Api {
     pub new_scene: unsafe extern "C" fn(device: RTCDevice) -> RTCScene,
     pub release_scene: unsafe extern "C" fn(scene: RTCScene),
     pub set_scene_flags: unsafe extern "C" fn(scene: RTCScene, flags: RTCSceneFlags),
+    pub get_scene_flags: unsafe extern "C" fn(scene: RTCScene) -> RTCSceneFlags,
     pub set_scene_build_quality: unsafe extern "C" fn(scene: RTCScene, q: RTCBuildQuality),
     pub attach_geometry_by_id:
         unsafe extern "C" fn(scene: RTCScene, geometry: RTCGeometry, id: c_uint),
@@ -181,6 +182,7 @@ fn bind(lib: libloading::Library, path: String) -> Result<Api, String> {
         new_scene: sym!("rtcNewScene"),
         release_scene: sym!("rtcReleaseScene"),
         set_scene_flags: sym!("rtcSetSceneFlags"),
+        get_scene_flags: sym!("rtcGetSceneFlags"),
         set_scene_build_quality: sym!("rtcSetSceneBuildQuality"),
         attach_geometry_by_id: sym!("rtcAttachGeometryByID"),
         commit_scene: sym!("rtcCommitScene"),

@@ -4,7 +4,8 @@
 //!
 //! It does what the Embree 3 backend ([`super::embree`]) does, in Embree 4's
 //! API: the meshes' buffers are shared, geometry ids are mesh indices, the
-//! scene is `ROBUST` (watertight triangle test) and MEDIUM quality (binned
+//! scene is `ROBUST` (watertight triangle test) unless asked for
+//! [`Traversal::Fast`], and MEDIUM quality (binned
 //! SAH, no spatial splits, so a filter sees each triangle once per ray).
 //! Embree 4 has no intersect context: [`Accel::hits_on_segment`] passes its
 //! filter in the query's `RTCIntersectArguments`, with
@@ -26,7 +27,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use super::embree_shared::{check_shareable, on_device_error, record_and_reject, ErrorSink};
-use super::{valid_query, Accel, Hit, ProbeHits, RejectedRays};
+use super::{valid_query, Accel, Hit, ProbeHits, RejectedRays, Traversal};
 use crate::error::Error;
 use crate::geometry::{Mesh, Ray, Vec3};
 use load::Api;
@@ -150,6 +151,14 @@ unsafe impl Send for Embree4Accel {}
 // SAFETY: see `Send` above.
 unsafe impl Sync for Embree4Accel {}
 
+/// `RTC_SCENE_FLAG_ROBUST` for a watertight traversal, else no flag.
+fn robust_flag(traversal: Traversal) -> ffi::RTCSceneFlags {
+    match traversal {
+        Traversal::Watertight => ffi::RTC_SCENE_FLAG_ROBUST,
+        Traversal::Fast => 0,
+    }
+}
+
 impl Embree4Accel {
     /// Builds and commits an Embree 4 scene over `meshes`, sharing their
     /// buffers (inside a rayon pool, with that many build threads). Fails
@@ -157,6 +166,15 @@ impl Embree4Accel {
     /// without leaking if Embree reports an error or a mesh cannot be
     /// shared safely.
     pub fn build(meshes: &Arc<Vec<Mesh>>) -> Result<Embree4Accel, Error> {
+        Self::build_with(meshes, Traversal::Watertight)
+    }
+
+    /// [`build`](Self::build) with the given [`Traversal`]: `ROBUST` for
+    /// `Watertight`, Embree's default arithmetic for `Fast`.
+    pub fn build_with(
+        meshes: &Arc<Vec<Mesh>>,
+        traversal: Traversal,
+    ) -> Result<Embree4Accel, Error> {
         let api = load::api()?;
         check_shareable(meshes)?;
         let threads = rayon::current_thread_index().map(|_| rayon::current_num_threads());
@@ -177,7 +195,7 @@ impl Embree4Accel {
         unsafe {
             (api.set_scene_flags)(
                 scene.raw,
-                ffi::RTC_SCENE_FLAG_ROBUST | ffi::RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS,
+                robust_flag(traversal) | ffi::RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS,
             );
             (api.set_scene_build_quality)(scene.raw, ffi::RTC_BUILD_QUALITY_MEDIUM);
         }
@@ -398,5 +416,14 @@ impl Accel for Embree4Accel {
 
     fn rejected_rays(&self) -> u64 {
         self.rejected.get()
+    }
+    fn traversal(&self) -> Traversal {
+        // SAFETY: `self.scene.raw` is a live, committed scene of `api`.
+        let flags = unsafe { (self.scene.api.get_scene_flags)(self.scene.raw) };
+        if flags & ffi::RTC_SCENE_FLAG_ROBUST != 0 {
+            Traversal::Watertight
+        } else {
+            Traversal::Fast
+        }
     }
 }

@@ -33,6 +33,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{emits, Plan};
+use crate::accel::Traversal;
 use crate::film::passes::PassSet;
 #[cfg(feature = "subsurface")]
 use crate::integrator::path::COAT_SPLIT_DEPTH;
@@ -77,7 +78,7 @@ impl Default for PlanOptions {
 }
 
 /// An effect's method and the reason for it.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Choice {
     pub method: String,
     pub reason: String,
@@ -198,6 +199,10 @@ pub struct Explanation {
     pub indirect: Indirect,
     pub specular_chains: Specular,
     pub probe_queries: Choice,
+    /// How Embree treats rays through shared edges
+    /// ([`crate::accel::Traversal`]); absent in plans written before it.
+    #[serde(default)]
+    pub traversal: Choice,
     pub aovs: Aovs,
     pub materials: Vec<MaterialPlan>,
 }
@@ -370,6 +375,29 @@ impl Explanation {
                 ),
             )
         };
+        #[cfg(feature = "subsurface")]
+        let random_walk = walk;
+        #[cfg(not(feature = "subsurface"))]
+        let random_walk = false;
+        let traversal = match Traversal::for_render(scene.settings.traversal, random_walk) {
+            Traversal::Watertight if random_walk => choice(
+                "watertight",
+                "random-walk integrator: no walk may slip out of a closed medium through \
+                 an edge that triangles share",
+            ),
+            Traversal::Watertight => choice(
+                "watertight",
+                "asked for ([render] traversal): no ray slips through an edge that \
+                 triangles share",
+            ),
+            Traversal::Fast => choice(
+                "fast",
+                "Embree's default arithmetic: a ray exactly through an edge that \
+                 triangles share can slip through (about 1 in 10⁶ from inside a dense \
+                 mesh); [render] traversal = \"watertight\" forbids it; lucent's own BVH \
+                 is watertight either way",
+            ),
+        };
         let passes: Vec<String> = opts.passes.iter().map(|p| p.name().to_string()).collect();
         let aovs = Aovs {
             method: if passes.is_empty() {
@@ -397,6 +425,7 @@ impl Explanation {
             indirect,
             specular_chains,
             probe_queries,
+            traversal,
             aovs,
             materials,
         }

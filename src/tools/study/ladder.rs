@@ -10,7 +10,6 @@
 //! rung j + 1), so load drift on a shared machine spreads over all
 //! configurations instead of penalizing whichever ran in a busy minute.
 
-use std::collections::HashMap;
 use std::fs;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -21,7 +20,6 @@ use super::results::{Results, Row};
 use super::resume::{slug, state_path, Job};
 use super::settings::Settings;
 use super::{render_opts, runtime};
-use crate::accel::Accel;
 use crate::film::{Film, ToneMap};
 use crate::geometry::Vec3;
 use crate::render;
@@ -70,7 +68,7 @@ pub(super) struct Ladder<'a> {
     /// The sample counts, [`ladder`]`(max_spp)`.
     pub(super) spps: &'a [u32],
     /// The acceleration structure of each backend, by name.
-    pub(super) accels: &'a HashMap<&'static str, Box<dyn Accel>>,
+    pub(super) accels: &'a super::Accels,
     pub(super) reference: &'a Film,
     /// The base seed: rung j renders with `seed + j`.
     pub(super) seed: u64,
@@ -114,7 +112,7 @@ impl Ladder<'_> {
         bar.set_message(format!("{} @ {n} spp", c.name));
         let (film, stats) = render::render(
             &job.scene,
-            self.accels[c.backend.name()].as_ref(),
+            self.accels[&(c.backend.name(), super::config_traversal(&job.scene, c))].as_ref(),
             &render_opts(
                 s,
                 n - prev_n,

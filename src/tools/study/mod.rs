@@ -48,7 +48,7 @@ use std::fs;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use crate::accel::{self, Accel, Backend};
+use crate::accel::{self, Accel, Backend, Traversal};
 use crate::integrator::IntegratorKind;
 use crate::render::RenderOptions;
 use crate::scene::{self, Camera, Scene};
@@ -104,22 +104,35 @@ fn runtime<E: std::fmt::Display>(e: E) -> Error {
     Error::Runtime(e.to_string())
 }
 
-/// Every backend the matrix uses (and the first, which renders the
-/// reference), built once and shared by its configurations (a
-/// configuration rebuilds materials, never meshes).
-fn build_accels(
-    scene: &Scene,
-    backends: &[Backend],
-    configs: &[Config],
-) -> Result<HashMap<&'static str, Box<dyn Accel>>, Error> {
-    let mut accels: HashMap<&'static str, Box<dyn Accel>> = HashMap::new();
-    for b in backends
+/// The accels the matrix uses, by backend name and traversal, built once
+/// and shared by its configurations (a configuration rebuilds materials,
+/// never meshes): each configuration's backend with the traversal `lucent
+/// render` would use for it ([`Traversal::for_render`]), so its time is a
+/// render's, and the first backend watertight, which renders the
+/// reference.
+pub(super) type Accels = HashMap<(&'static str, Traversal), Box<dyn Accel>>;
+
+fn build_accels(scene: &Scene, backends: &[Backend], configs: &[Config]) -> Result<Accels, Error> {
+    let mut accels = Accels::new();
+    let wanted = configs
         .iter()
-        .filter(|b| configs.iter().any(|c| c.backend == **b) || **b == backends[0])
-    {
-        accels.insert(b.name(), accel::build(&scene.meshes, *b)?);
+        .map(|c| (c.backend, config_traversal(scene, c)))
+        .chain([(backends[0], Traversal::Watertight)]);
+    for (b, t) in wanted {
+        if let std::collections::hash_map::Entry::Vacant(e) = accels.entry((b.name(), t)) {
+            e.insert(accel::build_with(&scene.meshes, b, t)?);
+        }
     }
     Ok(accels)
+}
+
+/// The traversal `lucent render` uses for configuration `c` of `scene`.
+pub(super) fn config_traversal(scene: &Scene, c: &Config) -> Traversal {
+    #[cfg(feature = "subsurface")]
+    let walk = c.integrator == IntegratorKind::RandomWalk;
+    #[cfg(not(feature = "subsurface"))]
+    let walk = false;
+    Traversal::for_render(scene.settings.traversal, walk)
 }
 
 /// Runs (or resumes) a study; see the module docs.
@@ -152,7 +165,7 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
         s,
         &scene,
         &scene_text,
-        accels[backends[0].name()].as_ref(),
+        accels[&(backends[0].name(), Traversal::Watertight)].as_ref(),
         seed,
     )?;
 
