@@ -697,8 +697,7 @@ fn run_render(
         None => None,
     };
     stop_if_interrupted()?;
-    let traversal =
-        accel::Traversal::for_render(scene.settings.traversal, random_walk(opts.integrator));
+    let traversal = opts.integrator.traversal(scene.settings.traversal);
     let accel = accel::build_with(&scene.meshes, backend, traversal)?;
     stop_if_interrupted()?;
     out.preview = Some(preview);
@@ -784,16 +783,6 @@ fn run_explain(
         ExplainArg::Json => println!("{}", plan.to_json_pretty()),
     }
     Ok(())
-}
-
-/// Whether `integrator` is the random walk (which needs a watertight
-/// traversal, `accel::Traversal`).
-fn random_walk(integrator: IntegratorKind) -> bool {
-    match integrator {
-        IntegratorKind::Path => false,
-        #[cfg(feature = "subsurface")]
-        IntegratorKind::RandomWalk => true,
-    }
 }
 
 /// The plan a render of `scene` with `integrator` and `passes` follows.

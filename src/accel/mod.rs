@@ -403,7 +403,7 @@ pub fn embree_report() -> Vec<String> {
 /// Our BVH is watertight in either mode ([`bvh`]); the choice is Embree's.
 /// `lucent render` renders `Fast` unless the scene asks for `watertight`
 /// (`[render] traversal`) or the integrator is the random walk
-/// ([`Traversal::for_render`]); everything else, tests and `lucent bench`
+/// (`IntegratorKind::traversal`); everything else, tests and `lucent bench`
 /// included, builds `Watertight` through [`build`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Traversal {
@@ -426,16 +426,6 @@ impl Traversal {
         [Traversal::Watertight, Traversal::Fast]
             .into_iter()
             .find(|t| t.name() == s)
-    }
-
-    /// What a render uses: what the scene asks for (`asked`), except that
-    /// the random walk (`random_walk`) is always watertight.
-    pub fn for_render(asked: Traversal, random_walk: bool) -> Traversal {
-        if random_walk {
-            Traversal::Watertight
-        } else {
-            asked
-        }
     }
 }
 
@@ -485,10 +475,8 @@ mod tests {
     use crate::scene::shapes;
 
     #[test]
-    fn a_render_traverses_as_the_scene_asks_except_the_random_walk_always_watertight() {
+    fn traversal_names_round_trip_and_nothing_else_parses() {
         for t in [Traversal::Watertight, Traversal::Fast] {
-            assert_eq!(Traversal::for_render(t, false), t);
-            assert_eq!(Traversal::for_render(t, true), Traversal::Watertight);
             assert_eq!(Traversal::parse(t.name()), Some(t));
         }
         assert_eq!(Traversal::parse("robust"), None);

@@ -31,7 +31,7 @@ pub mod randomwalk;
 #[cfg(feature = "subsurface")]
 pub mod sharp_edges;
 
-use crate::accel::Accel;
+use crate::accel::{Accel, Traversal};
 use crate::lights::LightSet;
 use crate::scene::Scene;
 
@@ -192,6 +192,18 @@ pub enum IntegratorKind {
 }
 
 impl IntegratorKind {
+    /// The traversal a render with this estimator uses when the scene asks
+    /// for `asked` ([`Traversal`]): the random walk is always watertight (a
+    /// walk that slipped out of a closed medium through a crack would leave
+    /// it at the wrong place); the path integrator takes what is asked.
+    pub fn traversal(self, asked: Traversal) -> Traversal {
+        match self {
+            IntegratorKind::Path => asked,
+            #[cfg(feature = "subsurface")]
+            IntegratorKind::RandomWalk => Traversal::Watertight,
+        }
+    }
+
     /// One sample of the radiance along `ray` with this estimator; its
     /// parts go to `rec` ([`aov`]), its effects' time to `T` ([`effects`]).
     pub fn radiance<R: aov::Recorder, T: Clock>(
@@ -272,5 +284,22 @@ impl std::ops::AddAssign for Counters {
             self.effect_ticks[e] += o.effect_ticks[e];
         }
         self.sample_ticks += o.sample_ticks;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_render_traverses_as_the_scene_asks_except_the_random_walk_always_watertight() {
+        for t in [Traversal::Watertight, Traversal::Fast] {
+            assert_eq!(IntegratorKind::Path.traversal(t), t);
+            #[cfg(feature = "subsurface")]
+            assert_eq!(
+                IntegratorKind::RandomWalk.traversal(t),
+                Traversal::Watertight
+            );
+        }
     }
 }

@@ -375,22 +375,19 @@ impl Explanation {
                 ),
             )
         };
-        #[cfg(feature = "subsurface")]
-        let random_walk = walk;
-        #[cfg(not(feature = "subsurface"))]
-        let random_walk = false;
-        let traversal = match Traversal::for_render(scene.settings.traversal, random_walk) {
-            Traversal::Watertight if random_walk => choice(
+        let asked = scene.settings.traversal;
+        let traversal = match (asked, opts.integrator.traversal(asked)) {
+            (Traversal::Fast, Traversal::Watertight) => choice(
                 "watertight",
                 "random-walk integrator: no walk may slip out of a closed medium through \
                  an edge that triangles share",
             ),
-            Traversal::Watertight => choice(
+            (_, Traversal::Watertight) => choice(
                 "watertight",
                 "asked for ([render] traversal): no ray slips through an edge that \
                  triangles share",
             ),
-            Traversal::Fast => choice(
+            (_, Traversal::Fast) => choice(
                 "fast",
                 "Embree's default arithmetic: a ray exactly through an edge that \
                  triangles share can slip through (about 1 in 10⁶ from inside a dense \

@@ -112,7 +112,11 @@ impl Ladder<'_> {
         bar.set_message(format!("{} @ {n} spp", c.name));
         let (film, stats) = render::render(
             &job.scene,
-            self.accels[&(c.backend.name(), super::config_traversal(&job.scene, c))].as_ref(),
+            self.accels[&(
+                c.backend.name(),
+                c.integrator.traversal(job.scene.settings.traversal),
+            )]
+                .as_ref(),
             &render_opts(
                 s,
                 n - prev_n,

@@ -107,7 +107,7 @@ fn runtime<E: std::fmt::Display>(e: E) -> Error {
 /// The accels the matrix uses, by backend name and traversal, built once
 /// and shared by its configurations (a configuration rebuilds materials,
 /// never meshes): each configuration's backend with the traversal `lucent
-/// render` would use for it ([`Traversal::for_render`]), so its time is a
+/// render` would use for it (`IntegratorKind::traversal`), so its time is a
 /// render's, and the first backend watertight, which renders the
 /// reference.
 pub(super) type Accels = HashMap<(&'static str, Traversal), Box<dyn Accel>>;
@@ -116,7 +116,7 @@ fn build_accels(scene: &Scene, backends: &[Backend], configs: &[Config]) -> Resu
     let mut accels = Accels::new();
     let wanted = configs
         .iter()
-        .map(|c| (c.backend, config_traversal(scene, c)))
+        .map(|c| (c.backend, c.integrator.traversal(scene.settings.traversal)))
         .chain([(backends[0], Traversal::Watertight)]);
     for (b, t) in wanted {
         if let std::collections::hash_map::Entry::Vacant(e) = accels.entry((b.name(), t)) {
@@ -124,15 +124,6 @@ fn build_accels(scene: &Scene, backends: &[Backend], configs: &[Config]) -> Resu
         }
     }
     Ok(accels)
-}
-
-/// The traversal `lucent render` uses for configuration `c` of `scene`.
-pub(super) fn config_traversal(scene: &Scene, c: &Config) -> Traversal {
-    #[cfg(feature = "subsurface")]
-    let walk = c.integrator == IntegratorKind::RandomWalk;
-    #[cfg(not(feature = "subsurface"))]
-    let walk = false;
-    Traversal::for_render(scene.settings.traversal, walk)
 }
 
 /// Runs (or resumes) a study; see the module docs.
