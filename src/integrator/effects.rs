@@ -165,6 +165,14 @@ pub fn summary(c: &Counters) -> String {
         }
         out.push('\n');
     }
+    if c.culled > 0 {
+        out.push_str(&format!(
+            "  {:<width$}  {:>12} rays ({:5.1} %) of those, proven to meet nothing, no query made\n",
+            "answered by bounds",
+            c.culled,
+            pct(c.culled, c.rays)
+        ));
+    }
     if timed {
         let sections: u64 = c.effect_ticks.iter().sum();
         out.push_str(&format!(

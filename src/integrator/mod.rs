@@ -18,6 +18,8 @@
 pub mod aov;
 #[cfg(feature = "subsurface")]
 pub mod control_variate;
+pub mod convex;
+pub mod culling;
 #[cfg(feature = "subsurface")]
 pub mod diffuse_boundary;
 pub mod effects;
@@ -62,6 +64,10 @@ pub struct Context<'a> {
     /// The camera's pixel angle, for the footprint cone of subsurface
     /// level of detail ([`crate::materials::lod`]).
     pub camera_spread: crate::materials::lod::CameraSpread,
+    /// Rays proven to meet nothing ([`culling`]); None for scenes of more
+    /// than [`culling::MAX_OBJECTS`] objects, and where a caller turns it
+    /// off to compare (the pixels are the same either way).
+    pub culling: Option<culling::Culling>,
     /// Per mesh with a subsurface material, its triangles' curvatures
     /// ([`probe::MeshCurvature`]); None for the others.
     #[cfg(feature = "subsurface")]
@@ -102,12 +108,14 @@ impl<'a> Context<'a> {
                 _ => None,
             })
             .collect();
+        let ray_epsilon = extent * 1e-6;
         Context {
             scene,
             accel,
+            culling: culling::Culling::new(&scene.meshes, extent, ray_epsilon),
             lights: LightSet::new(scene),
             plan: Plan::new(scene),
-            ray_epsilon: extent * 1e-6,
+            ray_epsilon,
             shading,
             pair_depth: path::PAIR_DEPTH,
             #[cfg(feature = "subsurface")]
@@ -154,6 +162,55 @@ impl<'a> Context<'a> {
             Some(c) => c.axes(prim, xo),
             None => probe::exit_curvature(&self.scene.meshes[geom as usize], prim),
         }
+    }
+
+    /// The nearest hit of `ray` (t from 0 to ∞), or None — without asking
+    /// the accelerator where [`culling`] proves the ray meets nothing;
+    /// `from`: the object the ray leaves, [`Context::leaving`].
+    #[inline(always)]
+    pub fn intersect(
+        &self,
+        ray: &crate::geometry::Ray,
+        from: Option<u32>,
+        counters: &mut Counters,
+    ) -> Option<crate::accel::Hit> {
+        if let Some(c) = &self.culling {
+            if c.misses(ray, f32::INFINITY, [from, None]) {
+                counters.culled += 1;
+                return None;
+            }
+        }
+        self.accel.intersect(ray, 0.0, f32::INFINITY)
+    }
+
+    /// Whether something blocks `ray` for t in [0, `t_max`] — without
+    /// asking the accelerator where [`culling`] proves nothing does;
+    /// `ends`: the objects the segment leaves and arrives on
+    /// ([`Context::leaving`]).
+    #[inline(always)]
+    pub fn occluded(
+        &self,
+        ray: &crate::geometry::Ray,
+        t_max: f32,
+        ends: [Option<u32>; 2],
+        counters: &mut Counters,
+    ) -> bool {
+        if let Some(c) = &self.culling {
+            if c.misses(ray, t_max, ends) {
+                counters.culled += 1;
+                return false;
+            }
+        }
+        self.accel.occluded(ray, 0.0, t_max)
+    }
+
+    /// `geom`, when a ray leaving it towards (or arriving on) the side of
+    /// its triangles' front faces (`front`) or back faces cannot meet it:
+    /// that side is the outside of a convex object ([`convex`]). None
+    /// otherwise, or without culling.
+    #[inline(always)]
+    pub fn leaving(&self, geom: u32, front: bool) -> Option<u32> {
+        self.culling.as_ref().and_then(|c| c.outside(geom, front))
     }
 
     /// The surface geometry at `hit` on the ray `ray`. Forced inline (a
@@ -240,6 +297,9 @@ pub struct Counters {
     pub walks_capped: u64,
     /// Random walks that left an open mesh through a hole (no boundary hit).
     pub walks_escaped: u64,
+    /// Of `rays`, those answered without the accelerator: proven to meet
+    /// nothing ([`culling`]).
+    pub culled: u64,
     /// Ray queries by [`Effect`]: they sum to `rays`.
     pub effect_rays: [u64; EFFECTS],
     /// Clock ticks by [`Effect`] (0 unless timed, [`effects`]).
@@ -279,6 +339,7 @@ impl std::ops::AddAssign for Counters {
         self.clamped += o.clamped;
         self.walks_capped += o.walks_capped;
         self.walks_escaped += o.walks_escaped;
+        self.culled += o.culled;
         for e in 0..EFFECTS {
             self.effect_rays[e] += o.effect_rays[e];
             self.effect_ticks[e] += o.effect_ticks[e];

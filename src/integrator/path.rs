@@ -247,6 +247,10 @@ pub(crate) struct Vertex<'a> {
     pub(crate) frame: Frame,
     pub(crate) wo_local: Vec3,
     pub(crate) lobe: Lobe<'a>,
+    /// The object the vertex lies on, when rays leaving it on the side of
+    /// `ng` cannot meet that object again ([`Context::leaving`]); None
+    /// where that is not known.
+    pub(crate) outside_of: Option<u32>,
 }
 
 /// What a subsurface hit turns into: a vertex that scatters light with a
@@ -322,6 +326,8 @@ pub(crate) type Reflected = (Ray, Vec3, Option<(Vec3, f32)>);
 #[derive(Clone, Copy)]
 struct Branch {
     ray: Ray,
+    /// The object `ray` leaves, if it cannot meet it ([`Context::leaving`]).
+    from: Option<u32>,
     beta: Vec3,
     prev: Option<(Vec3, f32)>,
     depth: u32,
@@ -432,6 +438,7 @@ fn trace_at<'s, R: Recorder, T: Clock>(
     let mut stack = Branches::default();
     let mut first = Some(Branch {
         ray: camera_ray,
+        from: None,
         beta: Vec3::ONE,
         prev: None,
         depth: 0,
@@ -475,6 +482,8 @@ fn follow<'s, R: Recorder, T: Clock>(
     // Path throughput: the product of f |cos| / pdf (and BSSRDF weights).
     let mut beta = start.beta;
     let mut ray = start.ray;
+    // The object the ray leaves, which it cannot meet (culling).
+    let mut from = start.from;
     // The last non-specular vertex and the solid-angle pdf with which its
     // lobe sampled the current ray; None after the camera or a specular
     // bounce, where no light sample competed for this direction.
@@ -489,7 +498,7 @@ fn follow<'s, R: Recorder, T: Clock>(
         // camera rays too: the tile loop moves one a sample to Effect::Camera
         counters.ray(Effect::Indirect);
         let t0 = T::now();
-        let found = ctx.accel.intersect(&ray, 0.0, f32::INFINITY);
+        let found = ctx.intersect(&ray, from, counters);
         let effect = if depth == 0 {
             Effect::Camera
         } else {
@@ -523,21 +532,26 @@ fn follow<'s, R: Recorder, T: Clock>(
             break;
         }
 
+        // The object a ray the material continues with leaves, where known.
+        let mut continue_from = None;
         let scatter = match &scene.materials[object.material] {
             Material::Diffuse { albedo } => {
                 let frame = si.shading_frame_facing(wo);
                 rec.surface(*albedo, frame.n);
-                let ng = if wo.dot(si.ng) >= 0.0 { si.ng } else { -si.ng };
+                let front = wo.dot(si.ng) >= 0.0;
+                let ng = if front { si.ng } else { -si.ng };
                 Scatter::Vertex(Vertex {
                     p: si.p,
                     ng,
                     wo_local: frame.to_local(wo),
                     frame,
                     lobe: Lobe::Diffuse(*albedo),
+                    outside_of: ctx.leaving(si.geom, front),
                 })
             }
             Material::Dielectric { eta } => {
                 let (next, e) = dielectric_bounce(ctx, *eta, &si, wo, &mut beta, rng);
+                continue_from = ctx.leaving(si.geom, next.d.dot(si.ng) >= 0.0);
                 Scatter::Continue(next, e)
             }
             #[cfg(feature = "subsurface")]
@@ -586,6 +600,7 @@ fn follow<'s, R: Recorder, T: Clock>(
                 }
                 prev = None;
                 ray = *next;
+                from = continue_from;
                 cone = cone_specular;
                 if !roulette(depth, &mut beta, rng) {
                     break;
@@ -611,6 +626,7 @@ fn follow<'s, R: Recorder, T: Clock>(
                         if roulette(depth, &mut b, rng) {
                             stack.push(Branch {
                                 ray: r,
+                                from: ctx.leaving(si.geom, r.d.dot(si.ng) >= 0.0),
                                 beta: b,
                                 prev: p,
                                 depth: depth + 1,
@@ -658,6 +674,7 @@ fn follow<'s, R: Recorder, T: Clock>(
                     }
                     (None, Some((r, b, p))) => {
                         (ray, beta, prev, event) = (r, b, p, coat_event);
+                        from = ctx.leaving(si.geom, r.d.dot(si.ng) >= 0.0);
                         cone = cone_specular;
                         if !roulette(depth, &mut beta, rng) {
                             break;
@@ -695,6 +712,7 @@ fn follow<'s, R: Recorder, T: Clock>(
         beta *= weight;
         prev = Some((vertex.p, pdf));
         ray = Ray::new(offset_along(vertex.p, vertex.ng, ctx.ray_epsilon), wi);
+        from = vertex.outside_of;
         cone = cone_rough;
         if !roulette(depth, &mut beta, rng) {
             break;
@@ -806,6 +824,7 @@ fn subsurface_probe<'s>(
             coat: rc,
             select: e,
         },
+        outside_of: ctx.leaving(si.geom, si.front),
     };
     // Choose: the reflection with probability E (its weight divided by E
     // in the lobe's sample), else the medium (weight (1 − E)/(1 − E) = 1).
@@ -1051,6 +1070,7 @@ impl<'s> CvModel<'s> {
             frame: Frame::from_normal(n),
             wo_local: Vec3::Z,
             lobe: Lobe::SubsurfaceEntry(self.ss),
+            outside_of: None,
         };
         unshadowed(
             &v,
@@ -1101,6 +1121,7 @@ fn lod_entry<'s>(
         frame: frame_o,
         wo_local: Vec3::Z,
         lobe: Lobe::SubsurfaceEntry(ss),
+        outside_of: ctx.leaving(si.geom, si.front),
     }
 }
 
@@ -1162,6 +1183,8 @@ fn probe_entry<'s>(
             frame: Frame::from_normal(n_in),
             wo_local: Vec3::Z,
             lobe: Lobe::SubsurfaceEntry(ss),
+            // n_in faces the side xo was seen from, as ng does at xo.
+            outside_of: ctx.leaving(si.geom, si.front),
         },
         weight,
     ))
@@ -1284,10 +1307,14 @@ fn light_sample(
     let origin = offset_along(v.p, v.ng, ctx.ray_epsilon);
     // t is in units of |d| = the distance to the light point; stop just short
     // of it so the light's own triangle does not shadow itself.
-    if ctx
-        .accel
-        .occluded(&Ray::new(origin, ls.point - origin), 0.0, 1.0 - 1e-4)
-    {
+    // The segment arrives at the light's front face (cos_l > 0 above).
+    let light = ctx.leaving(ctx.lights.geom_of(source), true);
+    if ctx.occluded(
+        &Ray::new(origin, ls.point - origin),
+        1.0 - 1e-4,
+        [v.outside_of, light],
+        counters,
+    ) {
         return (Vec3::ZERO, source);
     }
     (c, source)

@@ -201,6 +201,9 @@ fn diffuse_hit<'s>(
             frame,
             wo_local: Vec3::Z,
             lobe: Lobe::WalkExit(lobe),
+            // The walk's exit is not culled from (the reference stays as
+            // it was).
+            outside_of: None,
         });
     }
     match lobe.sample(rng.uniform2_packed()) {
