@@ -103,7 +103,11 @@ impl<'a> Context<'a> {
                     } else {
                         0.0
                     };
-                    Some(probe::MeshCurvature::new(m, reach))
+                    let c = probe::MeshCurvature::new(m, reach);
+                    Some(match ss.curvature_correction() {
+                        Some(cc) => c.with_factors(cc),
+                        None => c,
+                    })
                 }
                 _ => None,
             })
@@ -149,6 +153,16 @@ impl<'a> Context<'a> {
                 )
             }
         }
+    }
+
+    /// f(κ) of triangle `prim` of mesh `geom` under its material's
+    /// curvature correction, when the cache has it.
+    #[cfg(feature = "subsurface")]
+    #[inline]
+    pub fn curvature_factor(&self, geom: u32, prim: u32) -> Option<[f32; 3]> {
+        self.curvature[geom as usize]
+            .as_ref()
+            .and_then(|c| c.factor(prim))
     }
 
     /// The curvature the probe axes read at exit point `xo` on triangle

@@ -931,7 +931,13 @@ fn entries<'s>(
     let lights = cv.then(|| [draw_light(ctx, rng), None]);
     let u = ProbeRandoms::from_rng(rng);
     // The curvature correction's exit half, once for both probes of a pair.
-    let exit = ss.curvature_correction().map(|cc| (cc, cc.at_exit(k_mean)));
+    let exit = ss.curvature_correction().map(|cc| {
+        let e = match ctx.curvature_factor(si.geom, si.prim) {
+            Some(f) => cc.at_exit_with(k_mean, f),
+            None => cc.at_exit(k_mean),
+        };
+        (cc, e)
+    });
     let beta_in = *beta;
     if !(ss.probe_pair && depth < ctx.pair_depth) {
         let (seg, plane) = if cv {
@@ -1064,21 +1070,27 @@ impl<'s> CvModel<'s> {
     /// estimation weighs it, without a shadow ray.
     fn g(&self, d: Vec3, ls: &LightSample) -> Vec3 {
         let (p, n) = control_variate::model_point(self.xo, self.n, self.kappa, d);
-        let v = Vertex {
-            p,
-            ng: n,
-            frame: Frame::from_normal(n),
-            wo_local: Vec3::Z,
-            lobe: Lobe::SubsurfaceEntry(self.ss),
-            outside_of: None,
-        };
-        unshadowed(
-            &v,
-            ls,
-            |wo, wi| v.lobe.eval(wo, wi),
-            |wo, wi| v.lobe.pdf(wo, wi),
-        )
-        .unwrap_or(Vec3::ZERO)
+        // `unshadowed` at a vertex with the entry lobe, written out: that
+        // lobe reads only cos θ = ωi·n, so no frame is built (the same
+        // arithmetic, bit for bit).
+        let to_light = ls.point - p;
+        let dist2 = to_light.length_squared();
+        if dist2 <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let wi = to_light / dist2.sqrt();
+        let cos_l = -wi.dot(ls.normal);
+        let cos = wi.dot(n);
+        if cos_l <= 0.0 || cos <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let f = self.ss.lobe(cos);
+        if f == 0.0 {
+            return Vec3::ZERO;
+        }
+        let pdf_light = ls.pdf_area * dist2 / cos_l;
+        let w = power(pdf_light, cosine_hemisphere_pdf(cos));
+        Vec3::splat(f) * ls.radiance * (cos.abs() * w / pdf_light)
     }
 
     /// C of one probe along N with plane model `pm` and light sample `ls`.
@@ -1171,7 +1183,11 @@ fn probe_entry<'s>(
     let mut weight = ps.weight;
     if let Some((cc, exit)) = &exit {
         let (_, k_i) = ctx.curvatures(si.geom, ps.hit.prim);
-        if let Some(f) = cc.weight_from(exit, k_i) {
+        let f_i = || {
+            ctx.curvature_factor(si.geom, ps.hit.prim)
+                .unwrap_or_else(|| cc.factor(k_i))
+        };
+        if let Some(f) = cc.weight_from_factor(exit, k_i, f_i) {
             weight *= f;
         }
     }

@@ -85,6 +85,9 @@ pub struct MeshCurvature {
     edges: Option<SharpEdges>,
     /// How far a sharp edge is looked for: the material's Rmax.
     reach: f32,
+    /// Per triangle, the material's curvature correction f(κ) of its mean
+    /// curvature (`CurvatureCorrection::factor`), empty without one.
+    factor: Vec<[f32; 3]>,
 }
 
 impl MeshCurvature {
@@ -102,7 +105,23 @@ impl MeshCurvature {
                 None
             },
             reach,
+            factor: Vec::new(),
         }
+    }
+
+    /// With each triangle's f(κ) under `cc` cached ([`MeshCurvature::factor`]).
+    pub fn with_factors(
+        mut self,
+        cc: &crate::bssrdf::curvature_correction::CurvatureCorrection,
+    ) -> Self {
+        self.factor = self.per_prim.iter().map(|k| cc.factor(k[1])).collect();
+        self
+    }
+
+    /// f(κ) of triangle `prim`'s mean curvature, when cached.
+    #[inline]
+    pub fn factor(&self, prim: u32) -> Option<[f32; 3]> {
+        self.factor.get(prim as usize).copied()
     }
 
     /// [`exit_curvature`] of triangle `prim`.

@@ -29,7 +29,9 @@ fn record(scene: &Scene, accel: &dyn Accel, threads: usize) -> (Vec<Vec<Record>>
     let (_, stats) = render::render(scene, &rec, &opts).unwrap();
     let (logs, d, dropped) = rec.finish();
     assert_eq!(dropped, 0);
-    (logs, d, stats.counters.rays)
+    // Rays answered by bounds (integrator::culling) never reach the
+    // accelerator, so they are not recorded.
+    (logs, d, stats.counters.rays - stats.counters.culled)
 }
 
 #[test]
@@ -42,12 +44,15 @@ fn recording_counts_every_ray_and_replay_reproduces_the_answers() {
             let (logs, recorded, rays) = record(&scene, accel, threads);
             assert_eq!(logs.len(), threads);
             let n: u64 = logs.iter().map(|l| l.len() as u64).sum();
-            assert_eq!(n, rays, "one record per ray the renderer counts");
+            assert_eq!(n, rays, "one record per query the renderer makes");
             // Every kind occurs, and the camera rays are one per sample.
             for k in Kind::ALL {
                 assert!(recorded[k.index()].queries > 0, "{}", k.name());
             }
-            assert_eq!(recorded[Kind::Camera.index()].queries, 24 * 16 * 2);
+            // At most one per sample: camera rays beside the scene's
+            // objects are answered by bounds.
+            let camera = recorded[Kind::Camera.index()].queries;
+            assert!(camera > 0 && camera <= 24 * 16 * 2, "{camera}");
             let mut replayed = Digests::default();
             for l in &logs {
                 sum_digests(&mut replayed, &replay_digest(accel, l));
@@ -126,5 +131,5 @@ fn the_recorder_stops_logging_at_its_cap() {
     let (_, stats) = render::render(&scene, &rec, &opts).unwrap();
     let (logs, _, dropped) = rec.finish();
     assert_eq!(logs[0].len(), 100);
-    assert_eq!(dropped + 100, stats.counters.rays);
+    assert_eq!(dropped + 100, stats.counters.rays - stats.counters.culled);
 }
