@@ -292,7 +292,8 @@ fn scene_bench_replays_the_renders_queries() {
         // anything on a shared machine (that is the bench's job, at size).
         let ratio = num(r, "ratio");
         assert!(ratio > 0.0 && ratio.is_finite(), "ratio {ratio}: {r:?}");
-        // Every ray the renderer counts is one recorded query.
+        // Every query the renderer makes (rays less those answered by
+        // bounds) is one recorded query.
         let rays = num(r, "render_rays");
         assert!(rays > 0.0);
         assert_eq!(num(r, "records"), rays, "{r:?}");
@@ -300,7 +301,10 @@ fn scene_bench_replays_the_renders_queries() {
         // the other kinds all occur in this scene.
         let sum: f64 = kinds.iter().map(|k| num(r, &format!("{k}_queries"))).sum();
         assert_eq!(sum, rays);
-        assert_eq!(num(r, "camera_queries"), 24.0 * 16.0);
+        // At most one camera query a pixel: those beside the scene's
+        // objects are answered by bounds (integrator::culling).
+        let camera = num(r, "camera_queries");
+        assert!(camera > 0.0 && camera <= 24.0 * 16.0, "{r:?}");
         for k in kinds {
             assert!(num(r, &format!("{k}_queries")) > 0.0, "{k}: {r:?}");
             let m = num(r, &format!("{k}_mrays_per_s"));

@@ -113,7 +113,9 @@ fn record(
             s.max_records * RECORD_BYTES / 1_000_000
         )));
     }
-    let render_rays = rec_stats.counters.rays;
+    // The queries that reached the accelerator: rays answered by bounds
+    // (`integrator::culling`) are not asked of it and not recorded.
+    let render_rays = rec_stats.counters.rays - rec_stats.counters.culled;
     let records: u64 = logs.iter().map(|l| l.len() as u64).sum();
     if records != render_rays {
         notes.push(format!(
@@ -157,10 +159,11 @@ fn time_renders_and_replays(
             let c0 = process_cpu_seconds();
             let (_, stats) = render::render(scene, accel, opts).map_err(runtime)?;
             let cpu = c0.zip(process_cpu_seconds()).map(|(a, b)| b - a);
-            if stats.counters.rays != rec.render_rays {
+            let queries = stats.counters.rays - stats.counters.culled;
+            if queries != rec.render_rays {
                 return Err(runtime(format!(
-                    "{label}: two renders of the same scene counted {} and {} rays",
-                    rec.render_rays, stats.counters.rays
+                    "{label}: two renders of the same scene made {} and {queries} queries",
+                    rec.render_rays
                 )));
             }
             render_t.add(stats.seconds.max(1e-9), cpu, 1.0);
