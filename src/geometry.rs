@@ -173,15 +173,20 @@ impl Mesh {
     /// computed once, on the first call.
     pub fn bounding_radius(&self) -> f32 {
         *self.bounding_radius.get_or_init(|| {
-            let p = self.positions();
-            if p.is_empty() {
-                return 0.0;
-            }
-            let (lo, hi) = p
-                .iter()
-                .fold((p[0], p[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-            0.5 * (hi - lo).length()
+            self.bounds()
+                .map_or(0.0, |(lo, hi)| 0.5 * (hi - lo).length())
         })
+    }
+
+    /// The vertices' axis-aligned bounding box (lo, hi); None without
+    /// vertices.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let p = self.positions();
+        let first = *p.first()?;
+        Some(
+            p.iter()
+                .fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v))),
+        )
     }
 
     /// [`face_normal`](Self::face_normal) of every triangle, in order;

@@ -269,7 +269,7 @@ impl CurvatureCorrection {
     /// [`weight`](Self::weight) from the exit point's [`at_exit`](Self::at_exit):
     /// the same value, bit for bit.
     pub fn weight_from(&self, exit: &ExitFactor, kappa_i: f32) -> Option<Vec3> {
-        self.weight_from_factor(exit, kappa_i, || self.factor(kappa_i))
+        self.weight_from_factor(exit, kappa_i, self.factor(kappa_i))
     }
 
     /// [`at_exit`](Self::at_exit) with f(κo) already known (a cache of
@@ -281,20 +281,19 @@ impl CurvatureCorrection {
         }
     }
 
-    /// [`weight_from`](Self::weight_from) with f(κi) from `f_i` (a cache
-    /// of [`factor`](Self::factor), read only when needed): the same
-    /// value, bit for bit.
+    /// [`weight_from`](Self::weight_from) with f(κi) already known (`f_i`,
+    /// a cache of [`factor`](Self::factor)): the same value, bit for bit.
     #[inline]
     pub fn weight_from_factor(
         &self,
         exit: &ExitFactor,
         kappa_i: f32,
-        f_i: impl FnOnce() -> [f32; 3],
+        f_i: [f32; 3],
     ) -> Option<Vec3> {
         if !(exit.kappa > 0.0 || kappa_i > 0.0) {
             return None;
         }
-        let (fo, fi) = (exit.f, f_i());
+        let (fo, fi) = (exit.f, f_i);
         Some(Vec3::new(
             (fo[0] * fi[0]).sqrt(),
             (fo[1] * fi[1]).sqrt(),
@@ -488,7 +487,7 @@ mod tests {
                 assert_eq!(got, cc.weight(ko, ki));
                 // and from cached factors (integrator::probe::MeshCurvature)
                 let cached = cc.at_exit_with(ko, cc.factor(ko));
-                let from_cache = cc.weight_from_factor(&cached, ki, || cc.factor(ki));
+                let from_cache = cc.weight_from_factor(&cached, ki, cc.factor(ki));
                 assert_eq!(
                     from_cache.map(|v| v.to_array().map(f32::to_bits)),
                     got.map(|v| v.to_array().map(f32::to_bits))

@@ -67,12 +67,10 @@ impl Culling {
         Some(Culling {
             boxes: meshes
                 .iter()
-                .map(|m| {
-                    let (lo, hi) = m.positions().iter().fold(
-                        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-                    );
-                    [lo - pad, hi + pad]
+                .map(|m| match m.bounds() {
+                    Some((lo, hi)) => [lo - pad, hi + pad],
+                    // no vertices: an empty box, which every ray misses
+                    None => [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)],
                 })
                 .collect(),
             outside: meshes

@@ -155,14 +155,24 @@ impl<'a> Context<'a> {
         }
     }
 
-    /// f(κ) of triangle `prim` of mesh `geom` under its material's
-    /// curvature correction, when the cache has it.
+    /// f(κ) per channel of triangle `prim` of mesh `geom` under `cc`, its
+    /// material's curvature correction, for its mean curvature: from the
+    /// cache where the mesh has one ([`probe::MeshCurvature::factor`]).
     #[cfg(feature = "subsurface")]
     #[inline]
-    pub fn curvature_factor(&self, geom: u32, prim: u32) -> Option<[f32; 3]> {
-        self.curvature[geom as usize]
+    pub fn curvature_factor(
+        &self,
+        geom: u32,
+        prim: u32,
+        cc: &crate::bssrdf::curvature_correction::CurvatureCorrection,
+    ) -> [f32; 3] {
+        match self.curvature[geom as usize]
             .as_ref()
             .and_then(|c| c.factor(prim))
+        {
+            Some(f) => f,
+            None => cc.factor(self.curvatures(geom, prim).1),
+        }
     }
 
     /// The curvature the probe axes read at exit point `xo` on triangle
@@ -227,6 +237,13 @@ impl<'a> Context<'a> {
         self.culling.as_ref().and_then(|c| c.outside(geom, front))
     }
 
+    /// [`Context::leaving`] for a ray spawned at `si` in direction `dir`
+    /// ([`Interaction::spawn`]: offset to the side `dir` points to).
+    #[inline(always)]
+    pub fn leaving_towards(&self, si: &Interaction, dir: crate::geometry::Vec3) -> Option<u32> {
+        self.leaving(si.geom, dir.dot(si.ng) >= 0.0)
+    }
+
     /// The surface geometry at `hit` on the ray `ray`. Forced inline (a
     /// measured gain, see [`crate::kernels`]): the bounce loop is large
     /// enough that LLVM kept this out of line, and the call returned the
@@ -240,11 +257,9 @@ impl<'a> Context<'a> {
 fn scene_bounds(scene: &Scene) -> (glam::Vec3, glam::Vec3) {
     let mut lo = glam::Vec3::splat(f32::INFINITY);
     let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
-    for m in scene.meshes.iter() {
-        for &p in m.positions() {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
+    for (a, b) in scene.meshes.iter().filter_map(|m| m.bounds()) {
+        lo = lo.min(a);
+        hi = hi.max(b);
     }
     (lo, hi)
 }

@@ -551,7 +551,7 @@ fn follow<'s, R: Recorder, T: Clock>(
             }
             Material::Dielectric { eta } => {
                 let (next, e) = dielectric_bounce(ctx, *eta, &si, wo, &mut beta, rng);
-                continue_from = ctx.leaving(si.geom, next.d.dot(si.ng) >= 0.0);
+                continue_from = ctx.leaving_towards(&si, next.d);
                 Scatter::Continue(next, e)
             }
             #[cfg(feature = "subsurface")]
@@ -626,7 +626,7 @@ fn follow<'s, R: Recorder, T: Clock>(
                         if roulette(depth, &mut b, rng) {
                             stack.push(Branch {
                                 ray: r,
-                                from: ctx.leaving(si.geom, r.d.dot(si.ng) >= 0.0),
+                                from: ctx.leaving_towards(&si, r.d),
                                 beta: b,
                                 prev: p,
                                 depth: depth + 1,
@@ -674,7 +674,7 @@ fn follow<'s, R: Recorder, T: Clock>(
                     }
                     (None, Some((r, b, p))) => {
                         (ray, beta, prev, event) = (r, b, p, coat_event);
-                        from = ctx.leaving(si.geom, r.d.dot(si.ng) >= 0.0);
+                        from = ctx.leaving_towards(&si, r.d);
                         cone = cone_specular;
                         if !roulette(depth, &mut beta, rng) {
                             break;
@@ -932,11 +932,10 @@ fn entries<'s>(
     let u = ProbeRandoms::from_rng(rng);
     // The curvature correction's exit half, once for both probes of a pair.
     let exit = ss.curvature_correction().map(|cc| {
-        let e = match ctx.curvature_factor(si.geom, si.prim) {
-            Some(f) => cc.at_exit_with(k_mean, f),
-            None => cc.at_exit(k_mean),
-        };
-        (cc, e)
+        (
+            cc,
+            cc.at_exit_with(k_mean, ctx.curvature_factor(si.geom, si.prim, cc)),
+        )
     });
     let beta_in = *beta;
     if !(ss.probe_pair && depth < ctx.pair_depth) {
@@ -1070,27 +1069,16 @@ impl<'s> CvModel<'s> {
     /// estimation weighs it, without a shadow ray.
     fn g(&self, d: Vec3, ls: &LightSample) -> Vec3 {
         let (p, n) = control_variate::model_point(self.xo, self.n, self.kappa, d);
-        // `unshadowed` at a vertex with the entry lobe, written out: that
-        // lobe reads only cos θ = ωi·n, so no frame is built (the same
-        // arithmetic, bit for bit).
-        let to_light = ls.point - p;
-        let dist2 = to_light.length_squared();
-        if dist2 <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let wi = to_light / dist2.sqrt();
-        let cos_l = -wi.dot(ls.normal);
-        let cos = wi.dot(n);
-        if cos_l <= 0.0 || cos <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let f = self.ss.lobe(cos);
-        if f == 0.0 {
-            return Vec3::ZERO;
-        }
-        let pdf_light = ls.pdf_area * dist2 / cos_l;
-        let w = power(pdf_light, cosine_hemisphere_pdf(cos));
-        Vec3::splat(f) * ls.radiance * (cos.abs() * w / pdf_light)
+        // The entry lobe reads only cos θ = ωi·n: no frame is built.
+        unshadowed_at(
+            p,
+            n,
+            ls,
+            |wi| Vec3::new(0.0, 0.0, wi.dot(n)),
+            |wi_local| Vec3::splat(self.ss.lobe(wi_local.z)),
+            |wi_local| cosine_hemisphere_pdf(wi_local.z),
+        )
+        .unwrap_or(Vec3::ZERO)
     }
 
     /// C of one probe along N with plane model `pm` and light sample `ls`.
@@ -1183,10 +1171,7 @@ fn probe_entry<'s>(
     let mut weight = ps.weight;
     if let Some((cc, exit)) = &exit {
         let (_, k_i) = ctx.curvatures(si.geom, ps.hit.prim);
-        let f_i = || {
-            ctx.curvature_factor(si.geom, ps.hit.prim)
-                .unwrap_or_else(|| cc.factor(k_i))
-        };
+        let f_i = ctx.curvature_factor(si.geom, ps.hit.prim, cc);
         if let Some(f) = cc.weight_from_factor(exit, k_i, f_i) {
             weight *= f;
         }
@@ -1347,23 +1332,45 @@ fn unshadowed(
     eval: impl Fn(Vec3, Vec3) -> Vec3,
     pdf: impl Fn(Vec3, Vec3) -> f32,
 ) -> Option<Vec3> {
-    let to_light = ls.point - v.p;
+    unshadowed_at(
+        v.p,
+        v.ng,
+        ls,
+        |wi| v.frame.to_local(wi),
+        |wi_local| eval(v.wo_local, wi_local),
+        |wi_local| pdf(v.wo_local, wi_local),
+    )
+}
+
+/// [`unshadowed`] at the point `p` with geometric normal `ng` (facing the
+/// lit side), for a lobe that reads ωi through `to_local` (whose z is
+/// cos θ): `eval` and `pdf` of the local direction.
+#[inline(always)]
+fn unshadowed_at(
+    p: Vec3,
+    ng: Vec3,
+    ls: &LightSample,
+    to_local: impl Fn(Vec3) -> Vec3,
+    eval: impl Fn(Vec3) -> Vec3,
+    pdf: impl Fn(Vec3) -> f32,
+) -> Option<Vec3> {
+    let to_light = ls.point - p;
     let dist2 = to_light.length_squared();
     if dist2 <= 0.0 {
         return None;
     }
     let wi = to_light / dist2.sqrt();
     let cos_l = -wi.dot(ls.normal);
-    if cos_l <= 0.0 || wi.dot(v.ng) <= 0.0 {
+    if cos_l <= 0.0 || wi.dot(ng) <= 0.0 {
         return None;
     }
-    let wi_local = v.frame.to_local(wi);
-    let f = eval(v.wo_local, wi_local);
+    let wi_local = to_local(wi);
+    let f = eval(wi_local);
     if f == Vec3::ZERO {
         return None;
     }
     let pdf_light = ls.pdf_area * dist2 / cos_l;
-    let w = power(pdf_light, pdf(v.wo_local, wi_local));
+    let w = power(pdf_light, pdf(wi_local));
     Some(f * ls.radiance * (wi_local.z.abs() * w / pdf_light))
 }
 
