@@ -1,61 +1,17 @@
 //! Speed kernels: the places where lucent computes something less directly
 //! than the equation it implements, because a measurement showed it pays.
-//! Each entry names the plain form it replaces, why the result is the same
-//! (or how close), and its measured gain. The rest of the renderer is
-//! written as its equations; a trick that cannot show a gain here goes.
+//! Each is written beside the plain form it replaces and why the result is
+//! the same (or how close); the rest of the renderer is written as its
+//! equations, and a trick that cannot show a gain here goes.
 //!
-//! Figures are callgrind instruction counts of `lucent render` on the marble
-//! bunny at 160×120, 8 spp, 1 thread (`scripts/profile.sh`), counts being
-//! repeatable where wall time on a shared machine is not.
+//! - [`exp4`]: e^x on four f32 lanes, for the probe density
+//!   ([`crate::bssrdf::density`]);
+//! - code placement (`#[inline(never)]`, `#[inline(always)]`) in the bounce
+//!   loop of [`crate::integrator::path`];
+//! - the antithetic probe pair's shared sampling and exit half.
 //!
-//! - [`exp4`]: e^x on four f32 lanes (Cody–Waite reduction, Cephes
-//!   polynomial, 2^n from the exponent bits with SSE2 integer lanes). The
-//!   probe density ([`crate::bssrdf::density`]) evaluates the profile at four
-//!   radii per channel with one call, where the f64 evaluation made 12 libm
-//!   `exp` calls per probe hit: with the f64 density instead the tile loop
-//!   costs 769.0M instead of 718.5M instructions (+7.0 %; BVH build, as
-//!   every figure here unless noted).
-//!
-//! - Code placement in the bounce loop of [`crate::integrator::path`]:
-//!   `#[inline(never)]` on `dielectric_bounce`, `emission_weight` and
-//!   `subsurface_probe`. Inlined, their locals join the values the loop
-//!   keeps live across every ray-query call (which preserves no xmm
-//!   register) and the loop spills more: without the attributes the tile
-//!   loop costs 718.5M instead of 711.2M instructions (+1.0 %).
-//! - `#[inline(always)]` on `Context::interaction` and `Interaction::new`:
-//!   LLVM kept them out of line despite `#[inline]`, returning the 48-byte
-//!   Interaction through memory; 3.2M instructions (0.6 %) when measured
-//!   (Embree build, commit a4c453a).
-//!
-//! - The antithetic probe pair's shared work (`integrator::path`, at the
-//!   camera vertex of a subsurface hit): its two probes differ only in the
-//!   angle (φ and φ + ½ turn), so
-//!   [`ProbeSampler::sample_probe_pair`](crate::bssrdf::ProbeSampler::sample_probe_pair)
-//!   draws the channel, the radius (the inverse CDF), the axis
-//!   probabilities and the chord once, and only the sine and cosine per
-//!   probe; and the curvature correction's exit half, κo and f(κo)
-//!   ([`CurvatureCorrection::at_exit`](crate::bssrdf::curvature_correction::CurvatureCorrection::at_exit)),
-//!   is read once per exit point instead of once per probe. Both give each
-//!   probe bit for bit the segment and weight it had (tested; the rendered
-//!   pixels are identical). Measured on the smooth sphere (96², 8 spp, 1
-//!   thread, Embree 3, one run each): the tile loop 648.7M → 623.2M
-//!   instructions (−3.9 %), of which the shared sampling −13.4M
-//!   (`sample_probe` inclusive 39.6M → 26.2M, −2.1 %) and the exit half
-//!   −10.1M (`mean_curvature` 23.6M → 17.9M, `factor` 18.0M → 13.6M,
-//!   −1.6 %).
-//!
-//! Tricks measured and removed (each below 0.5 % of the tile loop, under the
-//! wall-time noise of a render): Vec3A radiance and throughput in
-//! `path::trace`, a u64 bounce range instead of `0..=max_depth`, a packed
-//! finiteness test in `render_tile`, an SSE truncation in `sin_cos_turns`,
-//! integer-width detours in float conversions, compare-select clamps, and
-//! `#[inline(always)]` on the analytic inverse CDF. Together they saved
-//! 1.0 % of the tile loop's instructions (704.0M with them and the
-//! placement above, 711.2M with the placement alone).
-//!
-//! Measured and not taken: `#[inline]` on `ProbeSampler::sample_probe` and
-//! `ProbeSampler::weigh`, the two calls the probe split put between the
-//! integrator and the BSSRDF (711.2M → 709.5M, −0.25 %).
+//! Measured gains, and the tricks measured and removed or not taken:
+//! docs/performance.md, "Speed kernels".
 
 use glam::Vec4;
 

@@ -277,8 +277,9 @@ fn sigma_a_zero_spectralon_is_white_and_at_most_a() {
 /// the channel is inactive —
 /// never sampled, never divided by. With no specular layer (which would
 /// reflect the white environment in every channel) every pixel of the slab
-/// must be exactly 0 in blue, for the recommended and the seed's sampling
-/// options, while red is lit and finite.
+/// must be exactly 0 in blue, for the recommended and the course report's
+/// sampling options (normal axis, single channel, table), while red is lit
+/// and finite.
 #[test]
 fn zero_albedo_channel_ketchup_blue_is_exactly_zero() {
     let p = SubsurfaceParams::from_preset_with(
@@ -433,7 +434,7 @@ fn thin_wedge(alpha_deg: f32) -> Mesh {
 ///   the segment's hit count (`ProbeHits::total`), whatever the geometry —
 ///   asserted for every sample at 24 exit points near the blade; and every
 ///   pixel of a render is under that bound × 4 (the wedge has 4 triangles).
-/// - `ProbeAxes::Normal` (the seed): its weight is ∝ 1/|V·N| and reaches
+/// - `ProbeAxes::Normal` (normal-only axes): its weight is ∝ 1/|V·N| and reaches
 ///   A/sin 0.5° ≈ 115·A here; the test asserts its maximum exceeds 2× the
 ///   Mis3 bound, documenting that it is unbounded as the angle closes
 ///   (both estimators have the same mean; only the tails differ).

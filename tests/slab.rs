@@ -91,7 +91,7 @@ fn uniformly_lit_slab_reflects_its_albedo() {
             }
         }
     }
-    // Every option on our BVH; on Embree the default and the seed-style one
+    // Every option on our BVH; on Embree the default and the course report's
     // (normal axis, single channel, table)
     // (the backends trace identical sample streams: their means agree to
     // four digits, backend_equivalence.rs compares the queries themselves).

@@ -1,39 +1,16 @@
 //! The surface albedo A that a homogeneous medium behind a smooth
 //! dielectric boundary actually reflects (`docs/bssrdf.md` §9): a table of
 //! the total diffuse reflectance R(α', η) of a semi-infinite medium of
-//! reduced albedo α' = σs' / (σs' + σa), for light entering from uniform
-//! radiance outside, computed by the random walk's own physics (the
-//! generator is `tools::halfspace`, run by `examples/albedo_table.rs`; the
-//! data file's header states its seed, walk counts and errors).
+//! reduced albedo α', for light entering from uniform radiance outside,
+//! computed by the random walk's own physics (generator `tools::halfspace`,
+//! run by `examples/albedo_table.rs`; the data file's header states its
+//! seed, walk counts and errors).
 //!
-//! Why this R is the A the diffusion model needs: under uniform light the
-//! model gives Lo(ωo) = Fr + Ft(ωo)·A (`docs/bssrdf.md` §1, §6, since ∫Sw
-//! cos = 1), the medium gives Fr + Ft(ωo)·P(ωo) with P the escape
-//! probability of light entering along ωo; the two agree in the mean over
-//! cosine-weighted view directions (all a sphere's pixels, a furnace) when
-//! A = ∫Ft P μ dμ / ∫Ft μ dμ, the fraction of entering diffuse light that
-//! leaves — what the table holds.
-//!
-//! **Parameterization.** Rows are η ∈ [1, 2] (step 0.1), columns
-//! x = √(1 − α') ∈ [0, 1] (step 1/40). Near α' = 1 the reflectance goes as
-//! 1 − R ∝ √(1 − α') (diffusion theory: the dipole's e^{−√(3(1−α'))}), so R
-//! is smooth in x where it varies fastest in α'. It is still strongly
-//! curved near x = 0 at high η (the boundary term e^{−4/3·A_η·√(3(1−α'))}),
-//! so what is interpolated (bilinearly in x and η) is the ratio
-//! ρ = R / R_dipole(α', η) to the classical dipole
-//! (`dipole::dipole_reflectance`), which carries that curvature: the
-//! interpolation error at the x midpoints fell 5× (η = 1.5) to 4× (η = 2)
-//! against interpolating R itself. The generator measures it at every
-//! x midpoint with the same walks, and at η midpoints (header of the data
-//! file). x = 0 is exact: a half-space that absorbs nothing returns all the
-//! light that enters (ρ = 1). At x = 1 (α' = 0) both R and the dipole are
-//! 0; ρ there is taken from its neighbour, so R = ρ·R_dipole → 0 as α' → 0. Anisotropic media (g ≠ 0) use
-//! the table through similarity (α' depends on σs(1 − g)); its error is
-//! measured in `docs/bssrdf.md` §9.
-//!
-//! **Range.** η outside [1, 2] is outside the table: [`AlbedoTable::reflectance`]
-//! returns None and the caller falls back to the classical dipole
-//! (`dipole::dipole_reflectance`).
+//! Rows are η ∈ [1, 2], columns x = √(1 − α'); what is interpolated is the
+//! ratio to the classical dipole. Why this R is the A the diffusion model
+//! needs, and the parameterization: `docs/bssrdf.md` §12.5. η outside
+//! [1, 2] is outside the table: [`AlbedoTable::reflectance`] returns None
+//! and the caller falls back to `dipole::dipole_reflectance`.
 
 use std::sync::OnceLock;
 

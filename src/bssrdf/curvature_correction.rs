@@ -1,55 +1,16 @@
 //! A curvature correction of the diffusion BSSRDF's weight
 //! (`docs/bssrdf.md` §10): the profile Rd describes a half-space, and on a
-//! convex body it returns too little light.
+//! convex body it returns too little light. The weight of a probe hit from
+//! xo to xi is multiplied by √(f(κo)·f(κi)), f(κ) = A_sphere(ρ)/(A·g(R)) at
+//! the local mean curvature κ = 1/R ([`mean_curvature`]), A_sphere from
+//! [`super::curvature_table`]; f = 1 exactly where κ ≤ 0. f is clamped to
+//! [[`MIN_FACTOR`], [`MAX_FACTOR`]], so every weight bound of the probe
+//! estimator grows by at most [`MAX_FACTOR`]. Media without a recorded
+//! medium get no correction.
 //!
-//! **The deficit.** Under uniform light a sphere of radius R returns, per
-//! unit area, what the probe estimator integrates: ∫ Rd(|xo − xi|) dA over
-//! the sphere. With chord distance r = |xo − xi| the sphere's area element
-//! is exactly 2πr dr for r ≤ 2R (Archimedes' hat-box theorem), so the
-//! integral is A·CDF(min(2R, Rmax)) — the half-space's A·CDF(Rmax), less
-//! what lies beyond the sphere's diameter. The medium itself returns more
-//! than the half-space, A_sphere = 1 − h·(1 − A) with h < 1 the ratio of
-//! what the sphere and the half-space absorb ([`super::curvature_table`],
-//! computed by the random walk's physics). Neither d nor A can fix this:
-//! the deficit depends on the size of the body.
-//!
-//! **The correction.** At a point where the surface's mean curvature is
-//! κ > 0, read R = 1/κ and, per channel of diffusion length ℓd, ρ = R/ℓd:
-//!
-//! ```text
-//! f(κ) = A_sphere(ρ) / (A · g(R)),
-//! A_sphere(ρ) = 1 − h(ρ, √(1 − α'), η)·(1 − A),
-//! g(R) = CDF(min(2R, Rmax)) / CDF(Rmax),
-//! ```
-//!
-//! so that on a sphere under uniform light the estimator's mean becomes
-//! A_sphere (times the same truncation CDF(Rmax) as on a flat surface, or
-//! exactly A_sphere when renormalizing). The weight of a probe hit from
-//! exit point xo to entry point xi is multiplied by √(f(κo)·f(κi)), which
-//! keeps the BSSRDF symmetric in xo and xi (reciprocity), and is f(κ) on
-//! a sphere. f = 1 exactly where κ ≤ 0: flat or concave surfaces, and
-//! meshes without shading normals, are weighted as before, bit for bit.
-//!
-//! **Curvature** ([`mean_curvature`]): from a triangle's vertex positions
-//! p and shading normals n, the normal curvature along each edge,
-//! (n_i − n_j)·(p_i − p_j) / |p_i − p_j|² (exactly 1/R on a sphere whose
-//! normals are radial; positive where the normals spread, i.e. convex),
-//! averaged over the three edges: for a near-equilateral triangle the mean
-//! of the normal curvatures along three directions 60° apart is the mean
-//! curvature (κ1 + κ2)/2 (Euler), so a cylinder of radius R reads 1/(2R).
-//!
-//! **Precision and bound.** On a sphere under uniform light the corrected
-//! estimator's mean is the random walk's to the table's error (standard
-//! error of A_sphere in the data file's header, ≲ 2e-3, plus interpolation
-//! between nodes) — measured per preset in `docs/accuracy.md`. On other
-//! shapes and under directional light it is a first-order model: it
-//! rescales the half-space profile by how much more light the local
-//! curvature returns; it does not move light to the far side of a thin
-//! body (`docs/accuracy.md` reports the lit and dark halves). f is clamped
-//! to [[`MIN_FACTOR`], [`MAX_FACTOR`]], so every weight bound of the probe
-//! estimator (`ProbeAxes::weight_bound`) grows by at most [`MAX_FACTOR`].
-//! Media without a recorded medium (hand-built parameters) get no
-//! correction: α' and ℓd are unknown.
+//! The deficit's derivation, the curvature estimate and the model's
+//! precision: `docs/bssrdf.md` §12.2; measured per preset:
+//! `docs/accuracy.md`, "Curvature correction".
 
 use super::albedo_table::TableError;
 use super::curvature_table::CurvatureTable;

@@ -3,32 +3,12 @@
 //!
 //!   p_c(xi) = Σ_a P(a) |V_a·N(xi)| p_disk,c(r_a),   Rd_c(|xo − xi|) = A_c R_c(|xo − xi|),
 //!
-//! with r_a the radius of xi − xo projected ⟂ the axis V_a and p_disk,c the
-//! disk density of the channel's radius sampler. This is the one evaluation
-//! the renderer uses, for every sampler; the f64 transcription in
-//! [`super::probe`]'s tests is its oracle.
-//!
-//! Layout: the four radii of a hit — the three disk radii and the 3D
-//! distance — sit in the four lanes of one `Vec4`, so each channel's profile
-//! at all four costs one [`exp4`] (see [`crate::kernels`] for what that
-//! gains). For the exact samplers (analytic, mixture) p_disk = R/CDF(Rmax)
-//! comes from the same lanes; the uniform sampler's is a constant; the
-//! table's is the density of its piecewise-linear map, evaluated in f64 per
-//! axis.
-//!
-//! Precision: every length is scaled by the widest active channel's d
-//! (written L), so ranges do not depend on scene units, and the radii come
-//! from squared local coordinates computed in f64 (no cancellation at small
-//! r). [`exp4`] is within 2 ulp for arguments down to −87, i.e. for
-//! ρ = r/d ≤ 261, and 0 below: the profile in a lane is then below
-//! e^{−87} ≈ 1.6e-38 of its value at the origin. The widest channel never
-//! gets there (its disk radii are at most Rmax = quantile(q)·L, and
-//! quantile(q) < 120 for every q < 1 in f64), so the MIS density over
-//! channels never underflows. Under the single-channel strategy the
-//! density is the sampled channel's alone; it leaves f32's normal range
-//! (and the sample weighs 0) only for a sampled radius beyond about 240 d,
-//! probability CCDF(240) < 1e-34 per probe. Tests bound the relative error
-//! of the weights against the f64 oracle.
+//! with r_a the radius of xi − xo projected ⟂ the axis V_a. This is the one
+//! evaluation the renderer uses, for every sampler; the f64 transcription in
+//! [`super::probe`]'s tests is its oracle. The four radii of a hit sit in
+//! the lanes of one `Vec4`, so each channel's profile costs one [`exp4`]
+//! ([`crate::kernels`]). The layout and the precision argument (the MIS
+//! density never underflows): `docs/bssrdf.md` §12.6.
 
 use glam::Vec4;
 

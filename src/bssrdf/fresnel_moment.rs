@@ -4,8 +4,8 @@
 //! `SeparableBSSRDF::Sw`; d'Eon & Irving 2011 for the moment polynomials).
 //!
 //! Sw is the incident/exit direction factor when the profile carries all the
-//! energy: with it, a flat slab still reflects exactly A. The seed drops the
-//! exit Fresnel altogether (`docs/bssrdf.md` §6); the integrator chooses.
+//! energy: with it, a flat slab still reflects exactly A. The course report drops
+//! the exit Fresnel altogether (`docs/bssrdf.md` §6); the integrator chooses.
 
 use crate::fresnel;
 

@@ -1,51 +1,14 @@
 //! Material parameters of the normalized diffusion BSSRDF: per channel the
 //! surface albedo A and the profile parameter d (scene units), plus the
-//! relative index of refraction η.
+//! relative index of refraction η (Christensen & Burley 2015, §5;
+//! `docs/bssrdf.md` §3). Three ways in: a named preset (Jensen et al. 2001,
+//! Fig. 5), measured coefficients, or the artist form (A, ℓ).
 //!
-//! Three ways in (Christensen & Burley 2015, §5; `docs/bssrdf.md` §3):
-//! - a named preset from Jensen et al. 2001, "A Practical Model for
-//!   Subsurface Light Transport", Fig. 5 (σs', σa in mm⁻¹ as in pbrt-v4);
-//! - measured coefficients (σs, g, σa, A, η): σs' = σs(1 − g),
-//!   σt' = σs' + σa, σtr = √(3 σa σt'), ℓd = 1/σtr, d = ℓd / s(A);
-//! - the artist form (A, ℓ): d = ℓ / s(A).
-//!
-//! Hard cases, decided here:
-//! - **σa = 0** (Spectralon): σtr = 0 and ℓd = ∞, which would make d infinite
-//!   and the object render black (all energy lands beyond any probe). We floor
-//!   the absorption at `MIN_ABSORPTION_FRACTION`·σt', i.e. 1 − α' ≥ 1e-6,
-//!   which caps ℓd at 1/√(3·1e-6) ≈ 577 volume mean free paths. No measured
-//!   material in the table is affected (the most forward one, Cream red, has
-//!   1 − α' = 2.7e-5); Spectralon gets ℓd ≈ 50/28/39 mm: finite, white, and
-//!   the energy stays A·CDF(Rmax) ≤ A. A material with σs' = σa = 0 is an
-//!   error (no medium).
-//! - **A = 0** (Ketchup blue with [`AlbedoSource::Given`]): the channel is inactive ([`SubsurfaceParams::active`]);
-//!   samplers never pick it and never divide by its pdf; its d is still
-//!   computed (finite) but unused. d = 0 (artist ℓ = 0) is inactive too.
-//! - **Units**: the table is in mm⁻¹; `units_per_mm` converts lengths to
-//!   scene units (a scene in metres uses 1e-3).
-//!
-//! Every constructor also records the volumetric [`Medium`] (σs, σa, g in
-//! scene units) that the brute-force random walk
-//! (`integrator::randomwalk`, which builds on this module) simulates. The preset and measured
-//! forms carry it directly (unfloored: the walk handles σa = 0 exactly).
-//! The artist form has none, so one is derived by inverting a total
-//! diffuse reflectance R(α', η): α' is found by bisection so that
-//! R(α', η) = A, then σt' from the given length (σtr = 1/ℓd, or σt' = 1/ℓ
-//! for [`Fit::VolumeMfp`]), with g = 0.
-//!
-//! **Where A comes from** ([`AlbedoSource`], `docs/bssrdf.md` §9). By
-//! default ([`AlbedoSource::Table`]) A is what the medium with its boundary
-//! reflects, R(α', η) from [`super::albedo_table`] (computed by the random
-//! walk's physics): for presets and measured media A = R(α', η) with
-//! α' = σs(1 − g) / (σs(1 − g) + σa) (the given `albedo` / the Jensen
-//! table's Rd column is not used), and the artist form inverts R. So the
-//! diffusion model and the random walk describe the same material. With
-//! [`AlbedoSource::Given`] (the behaviour before the table) presets and
-//! measured media use the given A and the artist form inverts the classical
-//! dipole's Rd (Jensen et al. 2001, eq. 5; the relation the Jensen table's
-//! Rd column follows, `docs/bssrdf.md` §3). η outside the table's [1, 2]
-//! falls back to the dipole in both places. d = ℓd / s(A) keeps its
-//! relation, with the A in use.
+//! Every constructor also records the volumetric [`Medium`] that the random
+//! walk simulates. A comes from [`super::albedo_table`] by default
+//! ([`AlbedoSource`], `docs/bssrdf.md` §9). The hard cases decided here
+//! (σa = 0, A = 0, units), the artist form's medium and the albedo sources:
+//! `docs/bssrdf.md` §12.3.
 
 use super::albedo_table::AlbedoTable;
 pub use super::dipole::dipole_reflectance;

@@ -2,56 +2,15 @@
 //! 2013, "BSSRDF Importance Sampling"; pbrt-v3 §15.4.2
 //! `SeparableBSSRDF::Sample_Sp` / `Pdf_Sp`; `docs/bssrdf.md` §5).
 //!
-//! To estimate ∫_A Rd(|xo − xi|) g(xi) dA(xi) at an exit point xo, pick a
-//! projection axis V and a channel, sample a radius r and an angle φ on the
-//! disk ⟂ V, and shoot a probe segment through the sphere of radius Rmax
-//! around xo, parallel to V, at that disk point. Every hit xi on the same
-//! object is a candidate; its surface-area density is
-//! p_disk(r)·|V·N(xi)|. One hit is kept among those the query kept, in
-//! proportion to its weight ([`pick_by_score`]), and scaled so that the
-//! estimate is the sum over the segment's `total` hits: the kept ones are a
-//! uniform random subset, so the estimator stays unbiased.
-//!
-//! Options:
-//! - [`ProbeAxes::Normal`]: probe along N only (the seed). Grazing hits
-//!   (|V·N| → 0) give unbounded weights.
-//! - [`ProbeAxes::Mis3`]: N, T, B with probabilities ½, ¼, ¼, combined with
-//!   the balance heuristic over axes: the density of a hit is
-//!   Σ_a p_a p_disk(r_a) |V_a·N|, with r_a the radius of xi − xo projected ⟂
-//!   V_a. Since Σ_a (V_a·N)² = 1 some axis has |V_a·N| ≥ 1/√3, and since
-//!   r_a ≤ |xo − xi| and R decreases, p_disk(r_a) ≥ R(|xo − xi|) for the
-//!   exact samplers: the weight of one hit is at most
-//!   4√3 · n_active · A / CDF(Rmax)^(renormalize) (× total), independent of
-//!   the geometry.
-//! - [`ProbeAxes::Curvature`] (the default): N, T, B with probabilities
-//!   1 − 2ε, ε, ε and the same balance heuristic, ε a function of κ·d at xo
-//!   ([`tangent_probability`]), κ the surface's curvature there (the
-//!   integrator reads it from the shading normals of xo's triangle,
-//!   floored at 1/R for the object's bounding radius R) and d
-//!   the widest channel's. Why: where d·κ is small the profile's mass lies
-//!   on a nearly flat surface, which probes along T and B almost never
-//!   meet; mis3 spends half its probes there and doubles the weight of the
-//!   other half, so its relMSE per sample on a smooth convex body is about
-//!   twice normal-only's (2.3× on scenes/smooth-sphere.toml,
-//!   docs/accuracy.md). Where the surface turns within the profile (d·κ ≳ 1,
-//!   and thin or small objects) T and B are what bound the weights, and ε
-//!   rises to mis3's ¼. ε depends on xo alone, so sampling and density use
-//!   the same probabilities and the estimator stays exact. Since ε ≥ ε_min
-//!   = [`TANGENT_PROB_MIN`] and 1 − 2ε ≥ ½, the argument above bounds the
-//!   weight of one hit by
-//!   (√3/ε_min) · n_active · A / CDF(Rmax)^(renormalize) (× total)
-//!   (√3/0.005 ≈ 346 against mis3's 4√3 ≈ 6.9), for any geometry: larger
-//!   than mis3's, but finite, where normal-only's is not.
-//! - [`ChannelStrategy::Single`]: pick one active channel uniformly and
-//!   estimate only it (the others get 0 from this sample) — the seed.
-//! - [`ChannelStrategy::Mis`]: pick a channel uniformly, estimate all of them
-//!   with the balance-heuristic density Σ_c p_c / n_active.
-//! - `renormalize`: divide Rd by CDF(Rmax) per channel, so the truncation to
-//!   Rmax loses no energy (a flat slab reflects exactly A instead of
-//!   A·CDF(Rmax)).
-//!
-//! Channels with A = 0 or d = 0 are never chosen, never divided by, and
-//! always get weight 0.
+//! At an exit point xo: pick a projection axis V and a channel, sample a
+//! radius and an angle on the disk ⟂ V, and build the probe segment through
+//! the sphere of radius Rmax around xo; the integrator runs the query, and
+//! this module weighs the hits it finds, keeping one in proportion to its
+//! weight ([`pick_by_score`]). The axis rules ([`ProbeAxes`]: normal-only,
+//! mis3, curvature with ε from [`tangent_probability`]), the channel
+//! strategies ([`ChannelStrategy`]), renormalization, and the weight bound
+//! of each: `docs/bssrdf.md` §12.1. Channels with A = 0 or d = 0 are never
+//! chosen, never divided by, and always get weight 0.
 
 use glam::DVec3;
 
@@ -66,7 +25,7 @@ use crate::sampling::Draw;
 /// Which axes probes are shot along.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum ProbeAxes {
-    /// Along the shading normal only (the seed).
+    /// Along the shading normal only (normal-only axes).
     Normal,
     /// N, T, B with probabilities ½, ¼, ¼ and the balance heuristic.
     Mis3,
@@ -151,7 +110,7 @@ pub fn tangent_probability(kd: f64) -> f64 {
 /// How the color channels share one probe sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum ChannelStrategy {
-    /// Estimate only the channel the radius was sampled for (the seed).
+    /// Estimate only the channel the radius was sampled for (single-channel sampling).
     Single,
     /// Estimate all channels with the balance heuristic over channels.
     #[default]
@@ -193,9 +152,9 @@ impl Default for ProbeOptions {
 }
 
 impl ProbeOptions {
-    /// The configuration of the seed document (the estimator lucent started
-    /// from, README "The math") with a given radius sampler: normal axis,
-    /// one channel per sample, no renormalization.
+    /// The configuration of the course report (README "The math") with a
+    /// given radius sampler: normal axis, one channel per sample, no
+    /// renormalization.
     pub fn seed_document(radius: RadiusSampler) -> Self {
         ProbeOptions {
             axes: ProbeAxes::Normal,

@@ -163,7 +163,7 @@ pub fn quantile(p: f64) -> f64 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Fit {
     /// Searchlight configuration, ℓ = diffuse mean free path:
-    /// s = 3.5 + 100 (A − 0.33)⁴ (their eq. 8). The seed's choice.
+    /// s = 3.5 + 100 (A − 0.33)⁴ (their eq. 8). The course report's choice.
     #[default]
     Searchlight,
     /// Diffuse surface transmission, ℓ = diffuse mean free path:

@@ -6,18 +6,18 @@
 //! ∫_0^Rmax p(r) 2πr dr = 1. The angle is uniform and drawn by the caller.
 //!
 //! - [`RadiusSampler::Uniform`]: p = 1/(π Rmax²), the baseline.
-//! - [`RadiusSampler::Table`]: the seed's precomputed inverse CDF at d = 1,
+//! - [`RadiusSampler::Table`]: the course report's precomputed inverse CDF at d = 1,
 //!   scaled by d, linearly interpolated. Its pdf is the exact density of the
 //!   piecewise-linear map (not R(r)), so the estimator stays unbiased for any
 //!   table size and only the variance depends on the size. Node placement is
-//!   an option: [`TableSpacing::Uniform`] in ξ (the seed) or
+//!   an option: [`TableSpacing::Uniform`] in ξ (the course report's table) or
 //!   [`TableSpacing::Tail`], nodes at ξ = 1 − (1 − i/n)², which keeps the
 //!   interpolation error O(1/n²) in the tail where r(ξ) has a log
 //!   singularity (uniform spacing is O(1/n) there; see the tests).
 //! - [`RadiusSampler::Analytic`]: the closed-form inverse of
 //!   [`profile`], truncated by sampling ξ·CDF(Rmax);
 //!   pdf = R(r)/CDF(Rmax).
-//! - [`RadiusSampler::Mixture`]: the seed's two exponential lobes with
+//! - [`RadiusSampler::Mixture`]: the course report's two exponential lobes with
 //!   truncation; the combined one-sample pdf is (w1 p1 + w2 p2)/(w1 + w2),
 //!   which equals R(r)/CDF(Rmax) exactly, so this is exact importance sampling
 //!   of the truncated profile by a different route than `Analytic`.
@@ -34,7 +34,7 @@ use crate::error::{Constraint, Param, ParamError};
 /// Where the nodes of a tabulated inverse CDF sit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TableSpacing {
-    /// ξ_i = i/n (the seed's table).
+    /// ξ_i = i/n (the course report's table).
     Uniform,
     /// ξ_i = 1 − (1 − i/n)²: denser toward ξ = 1, where r(ξ) ~ −3 ln(1 − ξ).
     Tail,
@@ -416,7 +416,7 @@ impl RadialDist {
         }
     }
 
-    /// The seed's mixture pdf for the lobe that was chosen, reading its
+    /// The course report's mixture pdf for the lobe that was chosen, reading its
     /// "pdf_disk · pdf_strategy" as (w1 p1 + w2 p2)/(w1 + w2) · P(lobe): the
     /// lobe probability counted twice (`docs/bssrdf.md` §4d). Kept only so a
     /// test can show the estimator it yields is biased.
@@ -428,7 +428,7 @@ impl RadialDist {
         }
     }
 
-    /// The seed's mixture pdf read literally, (p1(r) + p2(r)) · P(lobe), with
+    /// The course report's mixture pdf read literally, (p1(r) + p2(r)) · P(lobe), with
     /// each lobe normalized on its own. That is a one-sample MIS estimator
     /// with weights p_k/(p1 + p2): unbiased, but its weight is not constant.
     #[cfg(test)]
@@ -701,7 +701,7 @@ mod tests {
         let (m, se) = run(&|r, l| dist.seed_double_counted_lobe_pdf(r, l), 2);
         assert!((m - truth).abs() > 50.0 * se, "{m} ± {se} vs {truth}");
         assert!(m / truth > 1.5, "{m} vs {truth}");
-        // the seed read literally, (p1 + p2)·P(lobe), is an unbiased
+        // the course report read literally, (p1 + p2)·P(lobe), is an unbiased
         // one-sample MIS, only noisier than exact sampling
         let (m, se) = run(&|r, l| dist.seed_literal_pdf(r, l), 3);
         assert!((m - truth).abs() < 5.0 * se, "{m} ± {se} vs {truth}");
@@ -760,7 +760,7 @@ mod tests {
     }
 
     /// sup over ξ of |CDF(r_table(ξ)) − ξ|, the Kolmogorov distance between
-    /// what the table samples and the profile; for the seed's estimator
+    /// what the table samples and the profile; for the course report's estimator
     /// (which divides by R(r)) it bounds the bias of any indicator integrand.
     fn table_error(size: usize, spacing: TableSpacing) -> f64 {
         let t = InverseCdfTable::new(size, spacing);
@@ -797,7 +797,7 @@ mod tests {
 
     #[test]
     fn seed_table_pdf_bias_vs_size() {
-        // The seed samples with the table but divides by the profile, R(r).
+        // The course report samples with the table but divides by the profile, R(r).
         // Its bias is ∫ f (p_table/p_R − 1) dA: zero for f ∝ R (a flat
         // plane) but not for other integrands. Measured by quadrature for
         // f = R(r; 1.7 d) (a channel mismatch, as curved geometry causes).

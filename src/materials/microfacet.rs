@@ -1,58 +1,14 @@
 //! The rough coat of a subsurface material: reflection off a dielectric
 //! interface of relative index η whose microfacet normals follow the GGX
-//! (Trowbridge–Reitz) distribution. Directions are local to the shading
+//! (Trowbridge–Reitz) distribution, α = roughness² (Walter et al. 2007;
+//! Heitz 2014, 2018; pbrt-v4 §9.6). Directions are local to the shading
 //! frame, z = the macro-surface normal on the outside, where light arrives.
 //!
-//! **Distribution** (Walter et al. 2007, "Microfacet Models for Refraction
-//! through Rough Surfaces", eq. 33; pbrt-v4 §9.6.1), isotropic, width α:
-//!
-//!   D(m) = α² / (π ((α² − 1) cos²θm + 1)²),   ∫ D(m) cos θm dωm = 1.
-//!
-//! α = roughness², the perceptual remapping of Burley 2012 ("Physically
-//! Based Shading at Disney", §5.4): roughness ∈ [0, 1] is the scene value.
-//! Below [`SMOOTH_ALPHA`] (roughness < 0.0316) the interface is a mirror and
-//! the material uses its smooth coat instead (pbrt-v4 §9.6.1 treats α < 10⁻³
-//! as effectively smooth the same way).
-//!
-//! **Masking-shadowing**, Smith's height-correlated form (Heitz 2014,
-//! "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs",
-//! eq. 99; pbrt-v4 §9.6.3):
-//!
-//!   Λ(ω) = (√(1 + α² tan²θ) − 1) / 2,   G1(ω) = 1 / (1 + Λ(ω)),
-//!   G2(ωo, ωi) = 1 / (1 + Λ(ωo) + Λ(ωi)).
-//!
-//! Λ is evaluated as ½ x / (√(1 + x) + 1), x = α² tan²θ, which has no
-//! cancellation for small α.
-//!
-//! **BRDF** (Torrance–Sparrow with the dielectric Fresnel of the coat,
-//! [`crate::fresnel::dielectric`]), ωh = (ωo + ωi)/|ωo + ωi|:
-//!
-//!   f(ωo, ωi) = D(ωh) G2(ωo, ωi) Fr(ωo·ωh, η) / (4 cos θo cos θi).
-//!
-//! It is symmetric in ωo and ωi (ωo·ωh = ωi·ωh), i.e. reciprocal.
-//!
-//! **Sampling** visible normals (Heitz 2018, "Sampling the GGX Distribution
-//! of Visible Normals", JCGT 7(4); pbrt-v4 §9.6.4): m is drawn from
-//! D_ωo(m) = G1(ωo) max(0, ωo·m) D(m) / cos θo and ωi is ωo mirrored about
-//! m, so pdf(ωi) = D_ωo(m) / (4 ωo·m) = G1(ωo) D(m) / (4 cos θo) and the
-//! sample's weight f cos θi / pdf = Fr(ωo·m) G2 / G1(ωo) ≤ 1. Mirrored
-//! directions below the horizon (possible for rough surfaces) are lost
-//! samples: their mass is part of the pdf, so the estimator stays unbiased
-//! and the coat reflects less than Fr (single scattering only; the energy
-//! of inter-reflections between microfacets is not reflected).
-//!
-//! **Directional albedo** E(μo) = ∫ f cos θi dωi, the fraction of light
-//! arriving with cosine μo that the coat reflects. [`RoughCoat`] tabulates it
-//! on [`ALBEDO_NODES`] + 1 cosines by a midpoint rule over the sampling
-//! square: with the VNDF map u ↦ ωi, E(μo) = ∫ over [0, 1)² of Fr G2/G1 du, an
-//! integrand bounded by 1 that falls to 0 at the horizon (G2 → 0), though
-//! for narrow lobes so steeply that the rule sees an edge. Measured against a
-//! 256² rule on 200 cosines per α, the table (64² points per node, linear
-//! between nodes) is within 2.6·10⁻³ of E for α ≥ 0.03, within 6·10⁻³ for
-//! narrower lobes, and off by up to 1.5·10⁻² only for α = 10⁻³ at μo < 10⁻³
-//! (tested at 5·10⁻³ for μo ≥ 0.003 against a 512² rule). The light the coat does not reflect, 1 − E(μo), is what
-//! the material sends into the medium, so a coat over a white medium
-//! reflects everything (white furnace; `docs/bssrdf.md` §6).
+//! D, Smith's height-correlated G2, the Torrance–Sparrow BRDF with the
+//! coat's Fresnel ([`crate::fresnel::dielectric`]), visible-normal sampling
+//! and the tabulated directional albedo E(μo) ([`RoughCoat`]) with its
+//! accuracy: `docs/bssrdf.md` §12.7. Below [`SMOOTH_ALPHA`] the interface
+//! is a mirror and the material uses its smooth coat instead.
 //!
 //! This file depends only on geometry, sampling and Fresnel: no ray queries.
 
