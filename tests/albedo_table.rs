@@ -12,7 +12,7 @@
 //!    diffusion (A from the table) against the random walk, in the mean
 //!    over view directions weighted by cos θ (what a uniformly lit body's
 //!    pixels average), by a three-point Gauss–Legendre rule in μ²: within
-//!    1.5 % (measured: within 0.8 %), which the old A (the Jensen table's
+//!    1.5 % (measured: within 0.8 %), which the given A (the Jensen table's
 //!    Rd column, 2–4 % off) misses.
 
 mod common;
@@ -171,13 +171,13 @@ fn view_mean(
 ///
 /// - table A: marble −0.81 ± 0.38, −0.75 ± 0.33, −0.50 ± 0.36 %;
 ///   skin1 −0.36 ± 0.48, −0.30 ± 0.48, −0.16 ± 0.66 %;
-/// - old A (Jensen Rd): marble −2.09, −2.35, −2.54 %; skin1 −3.92, −3.09,
+/// - given A (Jensen Rd): marble −2.09, −2.35, −2.54 %; skin1 −3.92, −3.09,
 ///   +2.57 %.
 ///
 /// Bound 1.5 % per channel: the table's A passes with room for the noise;
-/// the old A is off by more than that on average over the channels (by
-/// 1.5–2.9 % per channel, within noise of the figures above, once the
-/// curvature axis rule became the default: marble −1.47, −1.79, −2.04 %,
+/// the given A is off by more than that on average over the channels (by
+/// 1.5–2.9 % per channel, within noise of the figures above, under the
+/// curvature axis rule: marble −1.47, −1.79, −2.04 %,
 /// skin1 −2.91, −2.56, +2.80 %).
 #[test]
 fn diffusion_matches_random_walk_on_the_slab_for_marble_and_skin1() {

@@ -186,7 +186,7 @@ fn white_furnace_holds_where_coated_hits_choose() {
 
 /// A closed box around the scene, its faces turned inward and emitting
 /// radiance 1: inside, every direction sees radiance 1, as under the
-/// uniform environment, but the light is now an area light, so the rough
+/// uniform environment, but here the light is an area light, so the rough
 /// coat's light sampling and its MIS with the coat's lobe sampling carry
 /// the reflection. Their weights must sum to 1 for every direction (both
 /// strategies using the same pdf of the coat lobe), or the coat's

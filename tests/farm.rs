@@ -1,4 +1,4 @@
-//! One frame split into parts and merged (issue 16, docs/farm.md): the
+//! One frame split into parts and merged (docs/farm.md): the
 //! merged frame is bitwise the uncut render for random splits by pixels,
 //! by sample indices and both, on every backend of the build; the CLI's
 //! `render --tile/--crop/--samples` in separate processes and `merge` give

@@ -1,4 +1,4 @@
-//! Hostile input through the real binary (issue 14): thread counts beyond
+//! Hostile input through the real binary: thread counts beyond
 //! any machine, outputs that cannot all be written, OBJ files that mix
 //! coloured and plain vertices, and special files (FIFOs, directories) given
 //! as the scene or a mesh. Each must end promptly with a clear error (exit 2

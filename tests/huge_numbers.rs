@@ -1,9 +1,9 @@
-//! Huge but finite numbers (issue 14, class 1): geometry, camera or
+//! Huge but finite numbers: geometry, camera or
 //! subsurface radii that end up far beyond the supported range
 //! (docs/scene-format.md, "Supported ranges") must fail at load time with
 //! exit code 2, naming the file, the line and the field that put the value
-//! out of range, and write nothing. Before the fix, these scenes passed the
-//! loader and Embree aborted the process (SIGABRT in its `ray.valid()`
+//! out of range, and write nothing. Unchecked, these scenes would pass the
+//! loader and Embree would abort the process (SIGABRT in its `ray.valid()`
 //! assertion), so each case runs the real binary as a child process: an
 //! abort shows up as a failed test, not a dead test runner.
 

@@ -1,4 +1,4 @@
-//! SIGINT and SIGTERM (issue 14, class 8; issue 16): a render stops at the
+//! SIGINT and SIGTERM: a render stops at the
 //! next pixel, drops the pass under way, keeps the finished samples in
 //! OUT.partial.exr and commits nothing else, no temporary file remains, and
 //! the exit code is 128 + the signal (130, 143); outputs staged when the

@@ -291,8 +291,8 @@ fn dipole_inversion_round_trips_and_matches_the_table() {
 ///   table's normal-entry column R_normal(α') (asserted, 4σ + 0.5 %), and
 ///   diffusion, which has one A for all directions, is above it by
 ///   A / R_normal − 1 (bounds [20, 36] %, [10, 22] %, [1, 9] %). (With the
-///   dipole inversion, before the table, the same scene gave −15.0 %,
-///   −4.6 %, +0.03 %: the dipole's medium reflected less than A.)
+///   dipole inversion instead of the table, the same scene gives −15.0 %,
+///   −4.6 %, +0.03 %: the dipole's medium reflects less than A.)
 #[test]
 fn diffusion_agrees_with_random_walk_on_the_flat_slab() {
     let marble = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
@@ -850,7 +850,7 @@ fn study_matrix_has_the_other_boundary() {
 /// start that meets a face at total internal reflection first (cosine
 /// 0.30 < 0.75 at η = 1.5), every walk must leave at one of the face hits
 /// of the folded line, through that face. A reflection off the mirror
-/// direction (2μ → 2 + μ in the walk was a mutation no test caught) leaves
+/// direction (the mutation 2μ → 2 + μ in the walk) leaves
 /// elsewhere. The cube is walked twice, wound outwards and inwards: the
 /// exit normal faces the way the walk leaves, whichever way the mesh's
 /// triangles face.

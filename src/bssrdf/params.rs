@@ -602,8 +602,7 @@ mod tests {
         );
     }
 
-    /// A preset with the table's own A (the behaviour before the albedo
-    /// table), so the formulas can be checked with the tabulated numbers.
+    /// A preset with the Jensen table's own A ([`AlbedoSource::Given`]), so the formulas can be checked with the tabulated numbers.
     fn given(name: &str, units: f64, fit: Fit) -> SubsurfaceParams {
         SubsurfaceParams::from_preset_with(name, units, fit, AlbedoSource::Given, None).unwrap()
     }
@@ -648,7 +647,7 @@ mod tests {
     /// The default albedo source: A = R(α', η) of the albedo table for
     /// presets and measured media (whatever `albedo` says), d = ℓd / s(A)
     /// with that A, η overrides applied before A; the artist form's medium
-    /// reflects the A asked for; `given` keeps the old numbers.
+    /// reflects the A asked for; `given` keeps the Jensen table's numbers.
     #[test]
     fn table_albedo_replaces_the_given_one() {
         let t = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();

@@ -72,11 +72,11 @@ impl ProbeAxes {
 /// The smallest probability of each tangent axis under
 /// [`ProbeAxes::Curvature`]: it keeps every surface within Rmax reachable
 /// (so the estimator stays unbiased on any geometry) and bounds the weight
-/// of a hit by (√3/ε_min)·n_active·A (module docs). 0.005 since the plane
+/// of a hit by (√3/ε_min)·n_active·A (module docs). 0.005 to suit the plane
 /// control variate (`integrator::control_variate`), which models only
-/// probes along N: on the smooth sphere relMSE×spp with it falls from
-/// 0.079 at 0.02 to 0.052 at 0.005 and 0.049 at 0.002 (docs/accuracy.md,
-/// "The plane control variate"); the grazing scene keeps ε = ¼.
+/// probes along N, so a smaller ε leaves it more of the probes; the bound
+/// grows as 1/ε_min (docs/accuracy.md, "The plane control variate", for the
+/// trade measured); the grazing scene keeps ε = ¼.
 pub const TANGENT_PROB_MIN: f64 = 0.005;
 
 /// κ·d at and beyond which [`ProbeAxes::Curvature`] uses mis3's ¼.
@@ -541,7 +541,7 @@ impl ProbeSampler {
         let dist = self.dists[channel].as_ref()?;
         let r = dist.sample_radius(u.radius);
         let (t, b, n) = (frame.t.as_dvec3(), frame.b.as_dvec3(), frame.n.as_dvec3());
-        // N below P(N), then T, then B (for mis3: ½, ¼, ¼ as before).
+        // N below P(N), then T, then B (for mis3: ½, ¼, ¼).
         let probs = self.axis_probs(curvature);
         let axis = if u.axis < probs[AXIS_N] {
             AXIS_N

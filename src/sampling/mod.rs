@@ -41,7 +41,7 @@ pub fn concentric_disk(u: [f32; 2]) -> [f32; 2] {
 /// minimax polynomials of Cephes `sinf`/`cosf`: within 2 ulp of the true
 /// values there. The samplers only need angles in this range or whole
 /// turns ([`sin_cos_turns`]), and libm's general `sincosf` (argument
-/// reduction for any float) was a visible share of the time outside ray
+/// reduction for any float) is a visible share of the time outside ray
 /// queries.
 #[inline]
 pub fn sin_cos_quarter(x: f32) -> (f32, f32) {

@@ -116,8 +116,9 @@ impl Draw for Rng {
 /// The render's per-sample stream: the key of [`Rng::new`] for the same
 /// (seed, pixel, sample), but one mix per draw instead of two — SplitMix64
 /// (Steele et al. 2014) started at the key: state += γ, output mix64(state).
-/// The draws were ~15 % of the render's instructions outside ray queries;
-/// this halves their hashing. Streams of different samples are the same
+/// The draws are a visible share of the render's instructions outside ray
+/// queries (docs/performance.md, "Where the renderer's time goes"); this
+/// halves their hashing. Streams of different samples are the same
 /// Weyl sequence entered at hashed, effectively random, points, so they
 /// overlap only if two keys fall within a path's few dozen steps of each
 /// other (probability ~1e-17 per pair). [`Rng`] keeps the doubly mixed
@@ -237,13 +238,13 @@ mod tests {
 
     #[test]
     fn stream_keys_were_not_changed() {
-        // the first draws of two streams, as before the key was split into
-        // levels: changing them would change every rendered image
+        // the first draws of a stream keyed in one call and keyed level by
+        // level agree: changing them would change every rendered image
         let mut r = Rng::new(1, 2, 3);
         let first = [r.next_u64(), r.next_u64()];
         let mut r = Rng::for_sample(Rng::pixel_key(Rng::seed_key(1), 2), 3);
         assert_eq!(first, [r.next_u64(), r.next_u64()]);
-        // computed from the original one-function key derivation
+        // a pinned value of the key derivation
         let mut r = Rng::new(0, 0, 0);
         assert_eq!(r.next_u64(), 0xa65b_97c9_51aa_8759);
     }

@@ -139,8 +139,8 @@ impl RayTri {
 ///
 /// The ids sit beside the vertices (as in Embree's `Triangle4v`) rather
 /// than in a separate slot-to-id table: on a 5M-triangle mesh that table
-/// is 21 MB, and looking a hit's id up in it was one more cache miss per
-/// hit, paid by every probe segment.
+/// is 21 MB, and looking a hit's id up in it would be one more cache miss
+/// per hit, paid by every probe segment.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
 pub struct Tri4 {

@@ -223,7 +223,8 @@ mod tests {
 
     #[test]
     fn unit_ball_rays_are_the_criterion_bench_sequence() {
-        // The generator benches/accel.rs used before it called this one.
+        // The sequence the criterion bench (benches/accel.rs) was written
+        // against, drawn inline: the shared generator must reproduce it.
         let mut rng = Rng::from_key(1);
         let old: Vec<Ray> = (0..200)
             .map(|_| {

@@ -36,7 +36,7 @@ pub enum Axis {
     /// The variance reduction at the camera vertex: the scene's (by
     /// default the plane control variate, which the baseline keeps)
     /// against the others of none, the control variate, the antithetic
-    /// probe pair (the previous default) and both
+    /// probe pair and both
     /// (`crate::integrator::control_variate`).
     Variance,
 }
@@ -385,7 +385,7 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
     );
     // The variance reduction at the camera vertex, each choice other than
     // the scene's (the default: the control variate alone); the quick
-    // study keeps the pair (the previous default).
+    // study keeps the pair.
     let own = scene_variance(scene);
     let variance: &[(&str, bool, bool)] = if quick {
         &[("pair", false, true)]

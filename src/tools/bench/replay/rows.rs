@@ -10,7 +10,8 @@
 
 use super::record::Kind;
 
-/// The issue's target for end-to-end over raw.
+/// The target ratio of end-to-end over raw (docs/performance.md, "Where
+/// the renderer's time goes").
 pub const TARGET_RATIO: f64 = 0.7;
 
 /// Per-kind replay of one (backend, threads).
