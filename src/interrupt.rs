@@ -1,25 +1,17 @@
 //! Interruption by SIGINT or SIGTERM: a flag that long work polls, and a
-//! registry of the temporary files that must not outlive the process.
+//! registry of the temporary files that must not outlive the process
+//! (`docs/farm.md`, "Interruption, checkpoints, resume").
 //!
 //! [`install`] (the CLI calls it first thing) starts a thread that waits for
-//! the signals (through `signal-hook`'s self-pipe, so all the work happens
-//! in an ordinary thread, not in a signal handler):
-//!
-//! - the **first** signal only records itself ([`requested`]). The renderer
-//!   checks the flag between pixels and stops, dropping the pass under way
-//!   (`crate::render`); the CLI writes the samples of the finished passes
-//!   to `OUT.partial.exr`, a part to `--resume` from (`crate::farm`; the
-//!   one commit allowed after a signal,
-//!   [`crate::film::commit_even_if_interrupted`]). Other outputs are not
-//!   committed ([`crate::film::commit_all`] refuses once the flag is set),
-//!   their temporary files are removed as they are dropped, and the CLI
-//!   exits with [`exit_code`]: 128 + the signal's number, the shell's
-//!   convention (130 for SIGINT, 143 for SIGTERM).
-//! - a **second** signal exits at once with the same code, after removing
-//!   every temporary file still registered ([`register_temporary`]).
-//!
-//! Without [`install`] (the library used on its own) nothing is caught, the
-//! flag is never set, and the registry only costs a lock per output file.
+//! the signals through `signal-hook`'s self-pipe. The **first** signal only
+//! records itself ([`requested`]): the renderer stops between pixels, the CLI
+//! commits only `OUT.partial.exr` ([`crate::film::commit_even_if_interrupted`];
+//! [`crate::film::commit_all`] refuses once the flag is set) and exits with
+//! [`exit_code`], 128 + the signal's number. A **second** signal exits at
+//! once with the same code, after removing every temporary file still
+//! registered ([`register_temporary`]). Without [`install`] nothing is
+//! caught, the flag is never set, and the registry only costs a lock per
+//! output file.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicI32, Ordering};

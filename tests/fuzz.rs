@@ -1,44 +1,17 @@
 //! A seeded mutation fuzzer over the real binary: scene TOML, OBJ text and
 //! command-line arguments, damaged and run as `lucent render` in a child
 //! process, so that an abort inside a C library (Embree) is a failed case,
-//! not a dead test runner.
+//! not a dead test runner (`docs/testing.md`, "Input fuzzing", for the
+//! inputs, the mutations and the environment variables).
 //!
-//! The property every case must hold (the README's promises):
-//! - exit 0, with an EXR whose every pixel is finite and its PNG beside it,
-//!   and nothing else new in the directory; or
-//! - exit 2, with a message on stderr that names the damaged file
-//!   (`scene.toml` or `mesh.obj`; for damaged arguments, any `error:`
-//!   message), and the directory exactly as it was;
-//! - never a signal, an exit code other than 0 or 2, a panic message
-//!   (`panicked at`), a run past the case timeout (killed: a hang), or a
-//!   temporary or partial output left behind.
-//!
-//! Inputs: the shipped `scenes/*.toml` (OBJ references pointed at a small
-//! fixture, resolution forced to 8×6, `subdivisions` to at most 2, and
-//! `--spp 1 --threads 1` on the command line, so a case costs
-//! milliseconds) and small OBJ fixtures. Mutations, one to three per case:
-//! numeric extremes (±1e±38, f32/f64 max, subnormals, −0, NaN/inf
-//! spellings valid and not, huge integers), structural edits of the parsed
-//! TOML (dropped and duplicated keys, tables and array entries, wrong
-//! types, arrays of the wrong length, misspelt keys), line edits (dropped,
-//! duplicated, swapped lines) and byte-level damage (bit flips, truncation,
-//! control bytes, invalid UTF-8, deleted and repeated spans); arguments get
-//! hostile option values, dropped, repeated and swapped arguments, and
-//! extra options.
-//!
-//! Case `i` of seed `s` is a pure function of `(s, i)`: a failure is
-//! reproduced with `LUCENT_FUZZ_SEED=s` and printed in full. Environment:
-//! `LUCENT_FUZZ_SECONDS` (budget, default 60), `LUCENT_FUZZ_SEED` (default
-//! 1), `LUCENT_FUZZ_JOBS` (parallel cases, default 2), `LUCENT_FUZZ_BIN`
-//! (the binary to run, default this build's),
-//! `LUCENT_FUZZ_CORPUS` (a directory: every failing case is saved there,
-//! as `scripts/fuzz.sh` does into `tests/fuzz-corpus/`).
-//!
-//! `tests/fuzz-corpus/` holds the cases found so far; [`corpus_replays`]
-//! runs every one of them on each test run and checks its `expect` file
-//! (`0`, `2` or `0|2`: the exit codes it may end with, under the same
-//! property). Cases under `tests/fuzz-corpus/open/` are known failures not
-//! fixed yet, replayed only by the ignored [`open_corpus_replays`].
+//! The property every case must hold (the README's promises): exit 0, with
+//! an EXR whose every pixel is finite and its PNG beside it, and nothing
+//! else new in the directory; or exit 2, with a message on stderr that
+//! names the damaged file, and the directory exactly as it was; never a
+//! signal, another exit code, a panic message, a hang or a temporary or
+//! partial output left behind. Case `i` of seed `s` is a pure function of
+//! `(s, i)`. [`corpus_replays`] replays `tests/fuzz-corpus/`; known
+//! failures under `open/` are replayed only by [`open_corpus_replays`].
 
 use std::collections::BTreeSet;
 use std::fs;

@@ -1,15 +1,10 @@
 //! Ray queries behind one trait, with three backends: our own BVH
 //! ([`bvh`]), Embree 3 (`embree`, linked, with the `embree` feature) and
 //! Embree 4 (`embree4`, loaded at run time, with the `embree4` feature).
-//!
-//! Which Embree: a binary may have both. Embree 3 is linked, so a binary
-//! with it needs `libembree3.so.3` to start (Debian 12). Embree 4 is
-//! opened at run time, so the same binary runs whether or not the machine
-//! has it, and `--no-default-features --features embree4` gives one binary
-//! for Debian 12 (BVH only, or Embree 4 if provided) and Debian 13 (Embree
-//! 4.3). [`Backend::Embree`] is the best Embree this process can use:
-//! Embree 4 if it loads with a known version, else Embree 3 (why: see
-//! [`EMBREE_PREFERENCE`]).
+//! [`Backend::Embree`] is the best Embree this process can use: Embree 4
+//! if it loads with a known version, else Embree 3 ([`EMBREE_PREFERENCE`];
+//! which binary runs where: `docs/performance.md`, "Embree 3 and Embree 4
+//! side by side").
 //!
 //! Three queries serve the integrators:
 //! - [`Accel::intersect`]: the nearest hit on a ray interval;

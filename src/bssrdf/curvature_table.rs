@@ -6,25 +6,12 @@
 //! ```
 //!
 //! the ratio of the fractions of entering diffuse light that a sphere of
-//! radius ρ diffusion lengths (ℓd = 1/σtr) and the half-space absorb, both
-//! behind a smooth dielectric of index η, computed by the random walk's
-//! own physics (generator `tools::sphere_albedo`, run by
-//! `examples/curvature_table.rs`; the data file's header states its seed,
-//! walk counts and largest errors). A convex body absorbs less than the
-//! half-space (h < 1): light that would have wandered into the depth of a
-//! half-space meets the boundary of the curved body sooner and leaves.
-//!
-//! **Why h.** As α' → 1, A_sphere and A_slab both tend to 1 and their
-//! ratio to 1, while the ratio of what they absorb tends to a function of
-//! ρ alone (diffusion theory has no other length); h varies little with x
-//! at fixed ρ (compare the rows of the data file), so linear interpolation
-//! in x is accurate, and x below the first node is clamped to it.
-//!
-//! **Interpolation.** Linear in η, in x and in ln ρ between nodes. Outside
-//! the grid: η and x are clamped to it; below the smallest ρ, h is taken
-//! at the smallest ρ; beyond the largest ρ_N, h = 1 − (1 − h(ρ_N))·ρ_N/ρ,
-//! first order in the curvature 1/ρ, so h → 1 (the half-space) as the
-//! curvature vanishes.
+//! radius ρ diffusion lengths and the half-space absorb, behind a smooth
+//! dielectric of index η, computed by the random walk's own physics
+//! (generator `tools::sphere_albedo`, run by `examples/curvature_table.rs`;
+//! the data file's header states its seed, walk counts and largest
+//! errors). Interpolated linearly in η, x and ln ρ; why h, and the rules
+//! outside the grid: `docs/bssrdf.md` §12.10.
 
 use std::sync::OnceLock;
 

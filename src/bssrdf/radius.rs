@@ -4,26 +4,13 @@
 //! Each sampler draws a radius r ∈ [0, Rmax] on the disk of the tangent plane
 //! and reports the density p(r) **per unit area of the disk**, so that
 //! ∫_0^Rmax p(r) 2πr dr = 1. The angle is uniform and drawn by the caller.
-//!
-//! - [`RadiusSampler::Uniform`]: p = 1/(π Rmax²), the baseline.
-//! - [`RadiusSampler::Table`]: the course report's precomputed inverse CDF at d = 1,
-//!   scaled by d, linearly interpolated. Its pdf is the exact density of the
-//!   piecewise-linear map (not R(r)), so the estimator stays unbiased for any
-//!   table size and only the variance depends on the size. Node placement is
-//!   an option: [`TableSpacing::Uniform`] in ξ (the course report's table) or
-//!   [`TableSpacing::Tail`], nodes at ξ = 1 − (1 − i/n)², which keeps the
-//!   interpolation error O(1/n²) in the tail where r(ξ) has a log
-//!   singularity (uniform spacing is O(1/n) there; see the tests).
-//! - [`RadiusSampler::Analytic`]: the closed-form inverse of
-//!   [`profile`], truncated by sampling ξ·CDF(Rmax);
-//!   pdf = R(r)/CDF(Rmax).
-//! - [`RadiusSampler::Mixture`]: the course report's two exponential lobes with
-//!   truncation; the combined one-sample pdf is (w1 p1 + w2 p2)/(w1 + w2),
-//!   which equals R(r)/CDF(Rmax) exactly, so this is exact importance sampling
-//!   of the truncated profile by a different route than `Analytic`.
-//!
-//! Every sampler returns finite r ≤ Rmax and a finite positive pdf for all
-//! u ∈ [0, 1); r is at least `RHO_MIN·d` (see [`profile::RHO_MIN`]).
+//! [`RadiusSampler::Uniform`] (p = 1/(π Rmax²)), [`RadiusSampler::Table`]
+//! (a tabulated inverse CDF, [`TableSpacing::Uniform`] or
+//! [`TableSpacing::Tail`], unbiased at any size), [`RadiusSampler::Analytic`]
+//! (the closed-form inverse of [`profile`]) and [`RadiusSampler::Mixture`]
+//! (two exponential lobes, exact by another route): `docs/bssrdf.md` §4 and
+//! §12.11. Every sampler returns finite r ≤ Rmax and a finite positive pdf
+//! for all u ∈ [0, 1); r is at least `RHO_MIN·d` (see [`profile::RHO_MIN`]).
 
 use std::f64::consts::PI;
 use std::sync::{Arc, Mutex, OnceLock};

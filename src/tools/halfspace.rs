@@ -3,36 +3,14 @@
 //! the generator of the albedo table (`bssrdf::albedo_table`,
 //! `docs/bssrdf.md` §9).
 //!
-//! The medium fills z < 0 (scale-free: σt = 1), with single-scattering
-//! albedo α and a Henyey–Greenstein phase function of mean cosine g; the
-//! boundary z = 0 has relative index η (inside / outside). A walk is what
-//! `integrator::randomwalk` does inside a mesh, with the mesh replaced by
-//! the analytic plane: the same free-flight sampler
-//! ([`free_flight`]), phase-function sampler
-//! ([`sample_hg`]) and boundary ([`dielectric::sample`], which
-//! reflects with probability Fr, refracts otherwise, and reflects totally
-//! beyond the critical angle).
-//!
-//! **Entry.** [`Entry::Diffuse`]: light of uniform radiance outside; a
-//! direction is drawn cosine-weighted and refracted in with probability
-//! Ft(μ) (rejection on reflection), so entering walks start with the
-//! density ∝ Ft(μ) μ of the light that enters. The escaping fraction is
-//! then R = ∫ Ft P μ dμ / ∫ Ft μ dμ, with P(μ) the escape probability of a
-//! walk entering at μ: the A for which the diffusion model,
-//! Lo = Fr + Ft(ωo)·A under uniform light, gives the same mean radiance over
-//! the cosine-weighted view directions (a sphere's pixels) as the walk,
-//! Lo = Fr + Ft(ωo)·P(ωo). [`Entry::Normal`]: one direction, μ = 1 — what
-//! a camera straight above a slab sees, Lo = Fr(1) + Ft(1)·P(1); the test
-//! against the full integrator uses it.
-//!
-//! **All albedos from one set of walks.** With σt fixed, absorption does
-//! not change where a walk goes, only whether it survives: a walk with n
-//! scattering events before it escapes contributes α^n (analog absorption
-//! at each event). So walks are run with α = 1 and their counts n give
-//! R(α) = E[α^n] for every α at once, with the per-walk variance
-//! E[α^{2n}] − R². A walk still inside after `cap` events is stopped and
-//! counted as 0; that underestimates R(α) by at most P(n > cap)·α^cap,
-//! which [`Tally::cap_bound`] reports.
+//! The medium fills z < 0 (σt = 1), albedo α, Henyey–Greenstein phase of
+//! mean cosine g, boundary z = 0 of relative index η; a walk is
+//! `integrator::randomwalk`'s with the mesh replaced by the plane
+//! ([`free_flight`], [`sample_hg`], [`dielectric::sample`]). Light enters
+//! as [`Entry::Diffuse`] or [`Entry::Normal`]; walks run with α = 1 and
+//! their event counts n give R(α) = E[α^n] for every α at once, a capped
+//! walk counting 0 ([`Tally::cap_bound`] bounds that). Why this R is the
+//! diffusion model's A, and the estimator: `docs/bssrdf.md` §12.8.
 
 use crate::bssrdf::albedo_table::interpolate_row;
 use crate::bssrdf::params::Medium;

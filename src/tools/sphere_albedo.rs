@@ -3,32 +3,13 @@
 //! reflects, by the random walk's own physics: the generator of the
 //! curvature table (`bssrdf::curvature_table`, `docs/bssrdf.md` §10).
 //!
-//! **The quantity.** Light of uniform radiance outside a sphere of radius ρ
-//! (in diffusion lengths ℓd = 1/σtr) enters it with the density ∝ Ft(μ)·μ
-//! of `halfspace::Entry::Diffuse`; A_sphere is the fraction of that light
-//! that leaves again (the rest is absorbed). By the sphere's symmetry every
-//! point of its surface receives and returns the same, so A_sphere is also
-//! the escape fraction of light entering at one point — the north pole here.
-//! A_slab is the same fraction for the half-space (the albedo table's R).
-//! Tabulated is the ratio of what the two absorb,
-//!
-//! ```text
-//! h(ρ, x, η) = (1 − A_sphere) / (1 − A_slab),    x = √(1 − α'),
-//! ```
-//!
-//! which tends to a function of ρ alone as α' → 1 (diffusion theory has no
-//! length but ℓd there), where A_sphere and A_slab both tend to 1 and
-//! their ratio carries no information.
-//!
-//! **The walk** is `integrator::randomwalk`'s inside a mesh with the mesh
-//! replaced by the analytic sphere (or plane): σt' = 1 (lengths in reduced
-//! mean free paths, so ρ ℓd = ρ / (√3 x) of them), isotropic scattering
-//! (the presets' g = 0; other g through similarity, as in the albedo
-//! table), the same free-flight sampler ([`free_flight`]), phase sampler
-//! ([`sample_hg`]) and boundary ([`dielectric::sample`]). Absorption is
-//! analog: at each scattering event the walk survives with probability α'.
-//! Every walk ends (α' < 1), so nothing is capped and each walk scores 0
-//! or 1: A's standard error is √(A(1 − A)/N).
+//! Tabulated is h(ρ, x, η) = (1 − A_sphere) / (1 − A_slab), x = √(1 − α'),
+//! the ratio of what a sphere of radius ρ ℓd and the half-space absorb.
+//! The walk is `integrator::randomwalk`'s with the mesh replaced by the
+//! analytic sphere or plane ([`free_flight`], [`sample_hg`],
+//! [`dielectric::sample`]), absorption analog, so each walk scores 0 or 1.
+//! The quantity, why one entry point suffices, and the walk's units:
+//! `docs/bssrdf.md` §12.9.
 
 use crate::geometry::Frame;
 use crate::integrator::randomwalk::{free_flight, sample_hg};

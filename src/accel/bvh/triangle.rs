@@ -1,26 +1,16 @@
 //! The watertight ray/triangle test of Woop, Benthin and Wald 2013,
 //! "Watertight Ray/Triangle Intersection" (JCGT 2(1)), without backface
-//! culling and with inclusive edges.
-//!
-//! The ray is sheared into a space where it runs along +z from the origin,
-//! so the test reduces to 2D edge functions of the sheared vertices. Every
-//! vertex is transformed by the same operations whichever triangle it
-//! belongs to, and an edge shared by two triangles yields edge functions of
-//! exactly opposite sign, so a ray through a shared edge or vertex hits at
-//! least one of the triangles around it. Edges are inclusive (an edge
-//! function of zero counts as inside, as in Embree's robust mode), so such a
-//! ray in fact hits every triangle touching that point. Edge functions that
-//! come out exactly zero in `f32` are recomputed in `f64`, as the paper
-//! prescribes, so a zero caused by rounding is not mistaken for an edge.
+//! culling and with inclusive edges: a ray through a shared edge or vertex
+//! hits every triangle touching that point, and edge functions that come
+//! out exactly zero in `f32` are recomputed in `f64`, as the paper
+//! prescribes.
 //!
 //! The BVH stores its triangles four to a [`Tri4`] packet and tests a
-//! packet with [`RayTri::intersect4`], the same arithmetic on four SSE
-//! lanes: every lane performs exactly the scalar test's operations in the
-//! same order (no fused multiply-add), so it returns bit-identical
-//! results, and a lane whose edge function comes out zero is redone by the
-//! scalar test with its `f64` fallback. The brute-force reference in the
-//! tests uses the scalar [`RayTri::intersect`], so the two agree bit for
-//! bit.
+//! packet with [`RayTri::intersect4`]: every lane performs exactly the
+//! scalar test's operations in the same order (no fused multiply-add), so
+//! it returns bit-identical results to [`RayTri::intersect`], which the
+//! brute-force reference in the tests uses. Why the test is watertight and
+//! the packet exact: `docs/performance.md`, "The BVH's triangle test".
 
 use crate::geometry::{Ray, Vec3};
 

@@ -3,34 +3,15 @@
 //! ones [`super::load`] accepts). The functions themselves are not declared
 //! here but looked up at run time ([`super::load::Api`]).
 //!
-//! Transcribed from the public Embree repository's `include/embree4/`
-//! headers of the 4.3/4.4 series (`rtcore_common.h`, `rtcore_ray.h`,
-//! `rtcore_scene.h`, `rtcore_device.h`, `rtcore_buffer.h`,
-//! `rtcore_geometry.h`), for a library configured as the release builds,
-//! Debian 13's 4.3.3 and the `embreex` 4.4.0 wheel are:
-//! `RTC_MAX_INSTANCE_LEVEL_COUNT == 1`, `RTC_MIN_WIDTH == 0` and
-//! `RTC_GEOMETRY_INSTANCE_ARRAY` defined. What changed from Embree 3
-//! (`super::super::embree::ffi`) and matters here:
-//! - `RTCHit` grew `instPrimID[RTC_MAX_INSTANCE_LEVEL_COUNT]` in 4.3 (under
-//!   `RTC_GEOMETRY_INSTANCE_ARRAY`): 32 → 48 bytes, so `RTCRayHit` is 96
-//!   bytes, not 80. Bindings generated from 4.2 headers give the library an
-//!   80-byte struct it writes 96 bytes into. A library built without
-//!   instance arrays writes only the first 80: our larger struct is safe
-//!   either way.
-//! - `RTCIntersectContext` is gone: queries take an optional
-//!   `RTCIntersectArguments` / `RTCOccludedArguments` (flags, feature mask,
-//!   a `RTCRayQueryContext*`, the argument filter, a user-geometry
-//!   callback), and the filter receives the `RTCRayQueryContext*`, which we
-//!   extend with our own fields as Embree's tutorials do.
-//! - The argument filter runs only if the scene has
-//!   `RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS` and the query sets
-//!   `RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER` (or the geometry enabled
-//!   it).
-//!
-//! Every size, offset and constant below is asserted at compile time, and
+//! Transcribed from the 4.3/4.4 headers for a library configured as the
+//! release builds are; what changed from Embree 3
+//! (`super::super::embree::ffi`) and matters here (the 96-byte `RTCRayHit`,
+//! the query arguments that replace `RTCIntersectContext`, when the argument
+//! filter runs): `docs/testing.md`, "The Embree 4 backend". Every size,
+//! offset and constant below is asserted at compile time, and
 //! `tests/embree4_layout.rs` compares [`layout_table`] with the C compiler's
 //! answer where Embree 4 headers are installed, and with [`TRANSCRIBED`]
-//! (the headers' values, written out by hand) everywhere.
+//! everywhere.
 
 #![allow(non_camel_case_types, dead_code)]
 

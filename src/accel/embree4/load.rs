@@ -2,23 +2,14 @@
 //! refusing a library whose version the binding was not checked against.
 //!
 //! Where: the path in `LUCENT_EMBREE4` if that is set (the only place
-//! looked at then: a wrong path is an error, not a reason to look
-//! elsewhere), else `libembree4.so.4`, then `libembree4.so`, by the dynamic
-//! loader's usual search (`LD_LIBRARY_PATH`, the `ld.so` cache: Debian 13's
-//! `libembree4-4` package puts it in `/usr/lib/x86_64-linux-gnu`). The
-//! library is opened `RTLD_LOCAL` and never closed: its symbols do not
-//! clash with Embree 3's, which the `embree` feature links into the same
-//! process, and its worker threads outlive any scene.
-//!
-//! Which: Embree 4.3 and 4.4, the releases whose headers [`super::ffi`]
-//! was transcribed from. The version is asked from the library itself
-//! (`rtcGetDeviceProperty(VERSION_MAJOR/MINOR/PATCH)`, whose signature is
-//! the same in every Embree since 3.0) before any call whose structs
-//! differ between releases: 4.0–4.2 lay out `RTCRayHit` in 80 bytes, 4.3+
-//! in 96, and a release after 4.4 may change another struct, so both are
-//! refused with a message naming what was found and what is needed, never
-//! called. A library that lacks one of the functions (not Embree at all)
-//! is refused the same way.
+//! looked at then), else `libembree4.so.4`, then `libembree4.so`, by the
+//! dynamic loader's usual search; opened `RTLD_LOCAL` and never closed.
+//! Which: Embree 4.3 and 4.4, the releases whose headers [`super::ffi`] was
+//! transcribed from; the version is asked from the library itself before
+//! any call whose structs differ between releases, and any other version,
+//! or a library that lacks one of the functions, is refused with a message
+//! naming what was found and what is needed. Why each of these:
+//! `docs/testing.md`, "The Embree 4 backend".
 
 use std::ffi::{c_char, c_uint, c_void, CString};
 use std::sync::OnceLock;

@@ -1,37 +1,17 @@
-//! `lucent study SCENE`: what accuracy costs in time.
+//! `lucent study SCENE`: what accuracy costs in time (`docs/accuracy.md`,
+//! "How a study works").
 //!
 //! Renders a matrix of sampling configurations of the subsurface estimator
-//! ([`config`]: a baseline and one-axis-at-a-time variations) at a ladder
-//! of sample counts 1, 2, 4, …, times each render and measures its error
-//! against a long reference render ([`metrics`]). Writes `results.csv`
-//! ([`results`], resumable), plots ([`plots`]) and `report.md` ([`report`])
-//! into the output directory.
-//!
-//! The ladder is progressive: rung j adds a chunk of samples with seed
-//! `seed + j` to the running mean, so the image at 2^j spp costs 2^j spp of
-//! render time in total (not 2^(j+1) − 1) and its time is the sum of the
-//! chunks' wall times. Rungs are rendered round-robin (every
-//! configuration's rung j before any rung j + 1), so load drift on a shared
-//! machine spreads over all configurations. Every configuration uses the
-//! same seeds, and the reference uses seeds no configuration uses
-//! ([`REFERENCE_SEED_OFFSET`]), so reference noise is independent of the
-//! images it judges. The running
-//! mean after each rung is kept in `DIR/state/`, so an interrupted study
-//! resumes where it stopped without re-rendering anything, and a rerun with
-//! a larger `max_spp` extends the ladder. The final image of each
-//! configuration is written to `DIR/images/<config>.exr` (and `.png`).
-//!
-//! The reference is cached as `DIR/reference-<hash>.exr`, where the hash is
-//! 64-bit FNV-1a ([`Fnv1a`], written here so it is stable across Rust
-//! versions, unlike `DefaultHasher`) over the scene file's bytes, every
-//! mesh's transformed vertex positions (so edits of an OBJ invalidate it
-//! too), and the reference settings (integrator, spp, seed, resolution,
-//! path depth, probe options).
-//!
-//! The files: `settings` (what it is told), [`config`] (the matrix),
-//! `reference` (the cached reference), `resume` (what is already done),
-//! `ladder` (the renders), [`metrics`], [`results`] (the CSV), [`plots`]
-//! and [`report`].
+//! ([`config`]: a baseline and one-axis-at-a-time variations) at a
+//! progressive ladder of sample counts 1, 2, 4, …, times each render and
+//! measures its error against a long, cached reference render
+//! ([`metrics`]; the reference's seeds are offset by
+//! [`REFERENCE_SEED_OFFSET`], its cache key is [`Fnv1a`]). Writes
+//! `results.csv` ([`results`], resumable), plots ([`plots`]) and
+//! `report.md` ([`report`]) into the output directory. The files:
+//! `settings` (what it is told), [`config`] (the matrix), `reference`,
+//! `resume` (what is already done), `ladder` (the renders), [`metrics`],
+//! [`results`], [`plots`] and [`report`].
 
 pub mod config;
 mod ladder;

@@ -1,33 +1,17 @@
 //! `lucent bench --scene`: how fast the renderer runs against how fast its
-//! backend answers the very queries the render issued.
+//! backend answers the very queries the render issued (`docs/performance.md`,
+//! "Where the renderer's time goes").
 //!
-//! The synthetic ray sets of `lucent bench` only approximate a render's
-//! queries. Here the render itself is the workload:
-//!
-//! 1. the scene is rendered normally (the code path of `lucent render`),
-//!    timed: the end-to-end rate is the render's ray count over its wall
-//!    time;
-//! 2. it is rendered once more through a [`Recorder`], an [`Accel`](crate::accel::Accel) that
-//!    forwards every query to the real backend and appends it (kind, ray,
-//!    interval, geometry, seed) to the log of the rayon worker that issued
-//!    it, in issue order, with a digest of every answer;
-//! 3. each worker's log is replayed on its own thread of a pool of the same
-//!    size, through the bare backend as `&dyn Accel` (the dispatch the
-//!    integrator uses): the raw rate is the number of queries over the
-//!    replay's wall time, and replaying one kind at a time gives per-kind
-//!    rates. The first replay recomputes the digest; an answer that differs
-//!    from what the render saw is an error.
-//!
-//! The ratio of the two rates is the share of the render's wall time spent
-//! inside ray queries; the rest is shading, sampling and bookkeeping.
-//! Memory: a record is [`RECORD_BYTES`] bytes, and a run stops with an
-//! error beyond [`Settings::max_records`] queries per (backend, threads).
-//!
-//! The files: `record` (a logged query), `recorder` (the logging
-//! `Accel`), `digest` (answers summarized), `playback` (the replays),
-//! `timing` (best of repeated runs), `measure` (one backend and thread
-//! count), `rows` (the figures), `csv` and `report` (the output),
-//! `settings`; `tests` records and replays the marble-ball fixture.
+//! The scene is rendered normally (timed: the end-to-end rate), then once
+//! more through a [`Recorder`], an [`Accel`](crate::accel::Accel) that
+//! forwards every query to the real backend and logs it per rayon worker
+//! with a digest of every answer; each worker's log is then replayed on its
+//! own thread through the bare backend as `&dyn Accel` (the raw rate), and
+//! an answer that differs from the render's is an error. A record is
+//! [`RECORD_BYTES`] bytes; a run stops beyond [`Settings::max_records`]
+//! queries. The files: `record`, `recorder`, `digest`, `playback`,
+//! `timing`, `measure`, `rows`, `csv`, `report`, `settings`; `tests`
+//! records and replays the marble-ball fixture.
 
 mod csv;
 mod digest;
