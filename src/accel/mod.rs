@@ -389,11 +389,9 @@ pub fn embree_report() -> Vec<String> {
 ///   Mitsuba 3 renders by default. A ray aimed exactly at a shared edge
 ///   can slip through (the constructed edge rays of
 ///   `tests/backend_equivalence.rs` do), but a Monte Carlo ray almost
-///   never is: 0 misses in 10⁷ rays into a 20,480- and a 1,310,720-triangle
-///   sphere from outside, 9 in 5·10⁶ from inside the larger one
-///   (1.8·10⁻⁶), against 0 watertight. A slipped ray loses one sample of
-///   one pixel. It saves 12 % of the instructions of a frame of
-///   `scenes/smooth-sphere.toml` (docs/performance.md, "Traversal").
+///   never is, and a slipped ray loses one sample of one pixel. The leak
+///   rates measured and the instructions it saves: docs/performance.md,
+///   "Traversal".
 ///
 /// Our BVH is watertight in either mode ([`bvh`]); the choice is Embree's.
 /// `lucent render` renders `Fast` unless the scene asks for `watertight`

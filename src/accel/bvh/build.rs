@@ -14,9 +14,8 @@
 //! 256-byte [`NodeW`]s (four cache lines, fetched together) holding their
 //! children's boxes in structure-of-arrays form, tested four at a time with
 //! SSE. Incoherent rays on a million triangles wait mostly on cache
-//! misses, one per level, so a shallower tree is a faster one: 4-wide
-//! nodes gave 0.40-0.46 Mrays/s and 8-wide 0.56-0.57 on the 1.31M-triangle
-//! displaced sphere (one thread of a shared, loaded machine).
+//! misses, one per level, so a shallower tree is a faster one
+//! (docs/performance.md, "The BVH's triangle test", for 4- against 8-wide).
 
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;

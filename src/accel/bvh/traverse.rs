@@ -251,11 +251,12 @@ pub(super) fn traverse<const ORDERED: bool, L>(
         return matches!(leaf(first, count, tmax), Visit::Stop);
     }
     // Prefetching hides DRAM latency on trees too big for the caches; on
-    // small ones it only costs its instructions (~10 % of a camera ray's
-    // on the bunny).
+    // small ones it only costs its instructions (docs/performance.md, "The
+    // BVH's triangle test", has the figure).
     let prefetching = tree.nodes.len() >= PREFETCH_NODES;
-    // Left uninitialized: zeroing 2 KiB per traversal (two per query) cost
-    // ~4% of an incoherent ray. Only entries below `sp` are ever read.
+    // Left uninitialized: zeroing 2 KiB per traversal (two per query) costs
+    // a measurable share of an incoherent ray (same section). Only entries
+    // below `sp` are ever read.
     let mut stack: [MaybeUninit<(NodeRef, f32)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
     let mut sp = 0usize;
     let mut r = tree.root;

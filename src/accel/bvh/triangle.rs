@@ -78,8 +78,8 @@ impl RayTri {
         tmax: f32,
     ) -> Option<(f32, f32, f32)> {
         // Masking with 3 lets the compiler drop the bounds checks on the
-        // padded arrays (glam's `Vec3[i]` is a branchy match): 7% of the
-        // whole nearest-hit query on a cache-resident mesh.
+        // padded arrays (glam's `Vec3[i]` is a branchy match; the gain:
+        // docs/performance.md, "The BVH's triangle test").
         let (kx, ky, kz) = (self.kx & 3, self.ky & 3, self.kz & 3);
         let pad = |v: Vec3| [v.x, v.y, v.z, 0.0];
         let a = pad(p0 - self.o);
