@@ -312,6 +312,34 @@ impl Subsurface {
 }
 
 impl SubsurfaceOverrides {
+    /// The options given, `key=value` separated by spaces in a fixed
+    /// order, with the names the scene format and the command line use (a
+    /// part's identity: stable across builds, unlike `Debug`).
+    pub fn canonical(&self) -> String {
+        let pairs: [(&str, Option<String>); 12] = [
+            ("radius", self.radius.map(|r| r.name())),
+            ("rmax_quantile", self.rmax_quantile.map(|q| q.to_string())),
+            ("axes", self.axes.map(|a| a.name().into())),
+            ("channel", self.channel.map(|c| c.name().into())),
+            ("renormalize", self.renormalize.map(|b| b.to_string())),
+            ("exit_sw", self.exit_sw.map(|b| b.to_string())),
+            ("specular", self.specular.map(|b| b.to_string())),
+            ("boundary", self.boundary.map(|b| b.name().into())),
+            ("roughness", self.roughness.map(|r| r.to_string())),
+            ("lod", self.lod.map(|l| l.name().into())),
+            (
+                "control_variate",
+                self.control_variate.map(|b| b.to_string()),
+            ),
+            ("probe_pair", self.probe_pair.map(|b| b.to_string())),
+        ];
+        let given: Vec<String> = pairs
+            .into_iter()
+            .filter_map(|(k, v)| Some(format!("{k}={}", v?)))
+            .collect();
+        given.join(" ")
+    }
+
     pub fn is_empty(&self) -> bool {
         *self == SubsurfaceOverrides::default()
     }
@@ -384,6 +412,9 @@ mod tests {
             ..Default::default()
         };
         assert!(bad.apply(&ss).is_err());
+        // the identity names options as the scene format does, not as Debug
+        assert_eq!(ov.canonical(), "axes=normal specular=false");
+        assert_eq!(SubsurfaceOverrides::default().canonical(), "");
         // lobe: Sw integrates to 1 against cos; the plain lobe is 1/π
         assert_eq!(out.lobe(-0.1), 0.0);
         let plain = SubsurfaceOverrides {
