@@ -8,10 +8,6 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
-#[cfg(feature = "subsurface")]
-use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
-#[cfg(feature = "subsurface")]
-use lucent::error::ParamError;
 use lucent::farm::part;
 use lucent::film::cryptomatte;
 use lucent::film::exr_layers::{self, ExrCompression, OutputOptions, Precision, Preview};
@@ -20,7 +16,7 @@ use lucent::film::region::Region;
 use lucent::film::ToneMap;
 use lucent::integrator::{effects, plan, IntegratorKind};
 #[cfg(feature = "subsurface")]
-use lucent::materials::{LodMode, SubsurfaceOverrides, WalkBoundary};
+use lucent::materials::{EstimatorOptions, OPTIONS};
 use lucent::render::RenderOptions;
 use lucent::scene;
 use lucent::session;
@@ -229,53 +225,60 @@ fn parse_checkpoint(s: &str) -> Result<f64, String> {
         .ok_or_else(|| format!("expected a positive number of seconds, found \"{s}\""))
 }
 
-/// Subsurface sampling choices that override every subsurface material's
-/// own (see docs/scene-format.md for what each means).
+/// The subsurface sampling options, one flag per row of the option table
+/// (`lucent::materials::estimator_options`); each replaces every
+/// subsurface material's own.
 #[cfg(feature = "subsurface")]
-#[derive(clap::Args)]
-struct SubsurfaceArgs {
-    /// Radius sampler: uniform | table[:N] | table-uniform[:N] | analytic | mixture.
-    #[arg(long, value_parser = parse_radius)]
-    radius: Option<RadiusSampler>,
-    /// Probe sphere radius as a quantile of the widest channel's profile, in (0, 1).
-    #[arg(long)]
-    rmax_quantile: Option<f64>,
-    /// Probe axes: curvature (N/T/B with MIS, T/B probabilities from the
-    /// curvature) | normal (the seed) | mis3 (N/T/B at ½, ¼, ¼ with MIS).
-    #[arg(long, value_enum)]
-    axes: Option<AxesArg>,
-    /// Channel choice: single (the seed) | mis (all channels, balance heuristic).
-    #[arg(long, value_enum)]
-    channel: Option<ChannelArg>,
-    /// Divide the profile by CDF(Rmax) so truncation loses no energy.
-    #[arg(long)]
-    renormalize: Option<bool>,
-    /// Normalized Fresnel lobe Sw at the entry point (false: cosine lobe).
-    #[arg(long)]
-    exit_sw: Option<bool>,
-    /// Specular reflection layer on top.
-    #[arg(long)]
-    specular: Option<bool>,
-    /// Roughness of that layer in [0, 1] (0: a mirror; GGX with α = roughness²).
-    #[arg(long)]
-    roughness: Option<f32>,
-    /// Random-walk boundary: dielectric (exact, smooth) | diffuse (diffuse
-    /// Fresnel transmission with light sampling at the exit; another model).
-    #[arg(long, value_enum)]
-    boundary: Option<BoundaryArg>,
-    /// Subsurface level of detail: auto (albedo A where the path's
-    /// footprint is wide against the profile, per material threshold) | off
-    /// (always probe) | force (every hit shaded with albedo A; for tests).
-    #[arg(long, value_enum)]
-    lod: Option<LodArg>,
-    /// At the camera vertex, the plane control variate on the light
-    /// sampled at the entry point (true by default).
-    #[arg(long)]
-    control_variate: Option<bool>,
-    /// At the camera vertex, an antithetic pair of probes (false by
-    /// default).
-    #[arg(long)]
-    probe_pair: Option<bool>,
+#[derive(Clone, Debug, Default)]
+struct SubsurfaceArgs(session::Overrides);
+
+#[cfg(feature = "subsurface")]
+impl clap::FromArgMatches for SubsurfaceArgs {
+    fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let mut given = session::Overrides::default();
+        for row in OPTIONS.iter().filter(|o| o.flag) {
+            if let Some(v) = m.get_one::<String>(row.name) {
+                given
+                    .push(row, v)
+                    .map_err(|e| clap::Error::raw(clap::error::ErrorKind::ValueValidation, e))?;
+            }
+        }
+        Ok(SubsurfaceArgs(given))
+    }
+
+    fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
+}
+
+#[cfg(feature = "subsurface")]
+impl clap::Args for SubsurfaceArgs {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        OPTIONS.iter().filter(|o| o.flag).fold(cmd, |cmd, row| {
+            // clap keeps flag names for the program's life
+            let long: &'static str = Box::leak(row.flag_name().into_boxed_str());
+            cmd.arg(
+                clap::Arg::new(row.name)
+                    .long(long)
+                    .help(row.help())
+                    .value_parser(move |s: &str| {
+                        (row.set)(&mut EstimatorOptions::default(), s).map(|()| s.to_string())
+                    }),
+            )
+        })
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
+}
+
+#[cfg(feature = "subsurface")]
+impl SubsurfaceArgs {
+    fn overrides(&self) -> session::Overrides {
+        self.0.clone()
+    }
 }
 
 /// How the EXR is stored (docs/output.md); each overrides the scene's
@@ -349,77 +352,8 @@ enum ExplainArg {
     Json,
 }
 
-#[cfg(feature = "subsurface")]
-#[derive(Clone, Copy, ValueEnum)]
-enum LodArg {
-    Auto,
-    Off,
-    Force,
-}
-
-#[cfg(feature = "subsurface")]
-#[derive(Clone, Copy, ValueEnum)]
-enum BoundaryArg {
-    Dielectric,
-    Diffuse,
-}
-
-#[cfg(feature = "subsurface")]
-#[derive(Clone, Copy, ValueEnum)]
-enum AxesArg {
-    Curvature,
-    Normal,
-    Mis3,
-}
-
-#[cfg(feature = "subsurface")]
-#[derive(Clone, Copy, ValueEnum)]
-enum ChannelArg {
-    Single,
-    Mis,
-}
-
-#[cfg(feature = "subsurface")]
-fn parse_radius(s: &str) -> Result<RadiusSampler, ParamError> {
-    RadiusSampler::parse(s)
-}
-
 fn parse_aov(s: &str) -> Result<PassSet, String> {
     PassSet::parse_list(s).map_err(|e| e.problem())
-}
-
-#[cfg(feature = "subsurface")]
-impl SubsurfaceArgs {
-    fn overrides(&self) -> SubsurfaceOverrides {
-        SubsurfaceOverrides {
-            radius: self.radius,
-            rmax_quantile: self.rmax_quantile,
-            axes: self.axes.map(|a| match a {
-                AxesArg::Curvature => ProbeAxes::Curvature,
-                AxesArg::Normal => ProbeAxes::Normal,
-                AxesArg::Mis3 => ProbeAxes::Mis3,
-            }),
-            channel: self.channel.map(|c| match c {
-                ChannelArg::Single => ChannelStrategy::Single,
-                ChannelArg::Mis => ChannelStrategy::Mis,
-            }),
-            renormalize: self.renormalize,
-            exit_sw: self.exit_sw,
-            specular: self.specular,
-            boundary: self.boundary.map(|b| match b {
-                BoundaryArg::Dielectric => WalkBoundary::Dielectric,
-                BoundaryArg::Diffuse => WalkBoundary::Diffuse { exit_nee: true },
-            }),
-            roughness: self.roughness,
-            lod: self.lod.map(|l| match l {
-                LodArg::Auto => LodMode::Auto,
-                LodArg::Off => LodMode::Off,
-                LodArg::Force => LodMode::Force,
-            }),
-            control_variate: self.control_variate,
-            probe_pair: self.probe_pair,
-        }
-    }
 }
 
 /// A build without the `subsurface` feature has no subsurface materials,

@@ -5,6 +5,8 @@
 
 pub mod dielectric;
 pub mod diffuse;
+#[cfg(feature = "subsurface")]
+pub mod estimator_options;
 pub mod lod;
 #[cfg(feature = "subsurface")]
 pub mod microfacet;
@@ -15,6 +17,8 @@ pub mod subsurface;
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
+#[cfg(feature = "subsurface")]
+pub use estimator_options::{EstimatorOptions, OPTIONS};
 pub use lod::LodMode;
 #[cfg(feature = "subsurface")]
 pub use subsurface::{CurvatureMode, Subsurface, SubsurfaceOverrides, WalkBoundary};

@@ -5,9 +5,10 @@
 use crate::error::Error;
 use crate::materials::Material;
 
-/// Sampling options that replace every subsurface material's own.
+/// Sampling options that replace every subsurface material's own, by
+/// name (`crate::materials::estimator_options`).
 #[cfg(feature = "subsurface")]
-pub use crate::materials::SubsurfaceOverrides as Overrides;
+pub use crate::materials::estimator_options::Assignments as Overrides;
 
 /// Sampling options that replace every subsurface material's own: none
 /// without the `subsurface` feature.
