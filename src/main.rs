@@ -201,28 +201,64 @@ impl From<SplitArgs> for session::Split {
     }
 }
 
-fn parse_crop(s: &str) -> Result<Region, String> {
-    Region::parse(s)
-        .filter(|r| !r.is_empty())
-        .ok_or_else(|| format!("expected X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1, found \"{s}\""))
+/// A flag's value that does not parse.
+#[derive(Debug)]
+enum ValueError {
+    /// Not of the form `expected`.
+    Expected {
+        expected: &'static str,
+        found: String,
+    },
+    /// Not one of the names of `what`.
+    Unknown { what: &'static str, found: String },
+    /// A problem the parser named.
+    Problem(String),
 }
 
-fn parse_tile(s: &str) -> Result<(u32, u32), String> {
+impl std::fmt::Display for ValueError {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            ValueError::Expected { expected, found } => {
+                write!(f, "expected {expected}, found \"{found}\"")
+            }
+            ValueError::Unknown { what, found } => write!(f, "unknown {what} \"{found}\""),
+            ValueError::Problem(p) => f.write_str(p),
+        }
+    }
+}
+
+impl std::error::Error for ValueError {}
+
+/// [`ValueError::Expected`] for the value `s`.
+fn expected(expected: &'static str, s: &str) -> ValueError {
+    ValueError::Expected {
+        expected,
+        found: s.into(),
+    }
+}
+
+fn parse_crop(s: &str) -> Result<Region, ValueError> {
+    Region::parse(s)
+        .filter(|r| !r.is_empty())
+        .ok_or_else(|| expected("X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1", s))
+}
+
+fn parse_tile(s: &str) -> Result<(u32, u32), ValueError> {
     s.split_once('/')
         .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)))
         .filter(|&(i, n)| i < n)
-        .ok_or_else(|| format!("expected I/N with 0 ≤ I < N, found \"{s}\""))
+        .ok_or_else(|| expected("I/N with 0 ≤ I < N", s))
 }
 
-fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
-    part::parse_samples(s).ok_or_else(|| format!("expected A..B with A < B, found \"{s}\""))
+fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, ValueError> {
+    part::parse_samples(s).ok_or_else(|| expected("A..B with A < B", s))
 }
 
-fn parse_checkpoint(s: &str) -> Result<f64, String> {
+fn parse_checkpoint(s: &str) -> Result<f64, ValueError> {
     s.parse::<f64>()
         .ok()
         .filter(|v| v.is_finite() && *v > 0.0)
-        .ok_or_else(|| format!("expected a positive number of seconds, found \"{s}\""))
+        .ok_or_else(|| expected("a positive number of seconds", s))
 }
 
 /// The subsurface sampling options, one flag per row of the option table
@@ -352,8 +388,8 @@ enum ExplainArg {
     Json,
 }
 
-fn parse_aov(s: &str) -> Result<PassSet, String> {
-    PassSet::parse_list(s).map_err(|e| e.problem())
+fn parse_aov(s: &str) -> Result<PassSet, ValueError> {
+    PassSet::parse_list(s).map_err(|e| ValueError::Problem(e.problem()))
 }
 
 /// A build without the `subsurface` feature has no subsurface materials,
@@ -623,14 +659,17 @@ struct StudyArgs {
 }
 
 #[cfg(feature = "subsurface")]
-fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, String> {
+fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, ValueError> {
     lucent::tools::study::config::parse_integrator(s)
-        .ok_or_else(|| format!("expected diffusion or randomwalk, found \"{s}\""))
+        .ok_or_else(|| expected("diffusion or randomwalk", s))
 }
 
 #[cfg(feature = "subsurface")]
-fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, String> {
-    lucent::tools::study::Axis::parse(s).ok_or_else(|| format!("unknown axis \"{s}\""))
+fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, ValueError> {
+    lucent::tools::study::Axis::parse(s).ok_or_else(|| ValueError::Unknown {
+        what: "axis",
+        found: s.into(),
+    })
 }
 
 #[cfg(feature = "subsurface")]

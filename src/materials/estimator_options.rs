@@ -14,7 +14,6 @@
 use std::fmt;
 
 use super::lod::{LodMode, DEFAULT_THRESHOLD};
-use super::subsurface::{CurvatureMode, WalkBoundary};
 use crate::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, RadiusSampler};
 use crate::error::ParamError;
 
@@ -58,6 +57,70 @@ impl Default for EstimatorOptions {
             lod_threshold: DEFAULT_THRESHOLD,
             control_variate: true,
             probe_pair: false,
+        }
+    }
+}
+
+/// The scene's `curvature_correction` setting.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CurvatureMode {
+    /// Correct the diffusion weight on convex surfaces (the default).
+    #[default]
+    Auto,
+    /// The half-space profile everywhere.
+    Off,
+}
+
+impl CurvatureMode {
+    /// "auto" or "off" (case-insensitive).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "auto" => Some(CurvatureMode::Auto),
+            "off" => Some(CurvatureMode::Off),
+            _ => None,
+        }
+    }
+
+    /// The name [`parse`](Self::parse) reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            CurvatureMode::Auto => "auto",
+            CurvatureMode::Off => "off",
+        }
+    }
+}
+
+/// The boundary of a subsurface object in the random walk
+/// (`docs/bssrdf.md` §7, `crate::integrator::randomwalk`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WalkBoundary {
+    /// The exact smooth dielectric: Fresnel reflection or refraction along
+    /// Snell's direction.
+    #[default]
+    Dielectric,
+    /// The same Fresnel probabilities, but transmission forgets the
+    /// direction (`crate::integrator::diffuse_boundary`): a different model,
+    /// whose exit point is a vertex where lights are sampled.
+    /// `exit_nee: false` renders the same model without light sampling at
+    /// the exit (for tests and measurements; not in the scene format).
+    Diffuse { exit_nee: bool },
+}
+
+impl WalkBoundary {
+    /// "dielectric" or "diffuse" (case-insensitive).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "dielectric" => Some(WalkBoundary::Dielectric),
+            "diffuse" => Some(WalkBoundary::Diffuse { exit_nee: true }),
+            _ => None,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            WalkBoundary::Dielectric => "dielectric",
+            WalkBoundary::Diffuse { exit_nee: true } => "diffuse",
+            WalkBoundary::Diffuse { exit_nee: false } => "diffuse-no-nee",
         }
     }
 }

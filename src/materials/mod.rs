@@ -18,10 +18,10 @@ use std::sync::Arc;
 
 use crate::geometry::Vec3;
 #[cfg(feature = "subsurface")]
-pub use estimator_options::{EstimatorOptions, OPTIONS};
+pub use estimator_options::{CurvatureMode, EstimatorOptions, WalkBoundary, OPTIONS};
 pub use lod::LodMode;
 #[cfg(feature = "subsurface")]
-pub use subsurface::{CurvatureMode, Subsurface, SubsurfaceOverrides, WalkBoundary};
+pub use subsurface::{Subsurface, SubsurfaceOverrides};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {

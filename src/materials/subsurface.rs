@@ -10,8 +10,7 @@
 //!
 //! where Ft = 1 − Fr is always applied at xo, optionally as the complement
 //! of a specular reflection layer, and the lobe at xi is either the
-//! normalized Fresnel lobe Sw (pbrt-v3 §11.4) or, as in the seed, a plain
-//! cosine lobe 1/π.
+//! normalized Fresnel lobe Sw (pbrt-v3 §11.4) or a plain cosine lobe 1/π.
 //!
 //! **The coat.** The boundary is smooth (`roughness` = 0, a mirror) or a
 //! rough GGX dielectric ([`super::microfacet`], α = roughness²). For a rough
@@ -25,7 +24,7 @@
 //! weighted by the transmitted fraction (1 − Fr or 1 − E) and the reflected
 //! light is lost, for either roughness.
 
-use super::estimator_options::{EstimatorOptions, OPTIONS};
+use super::estimator_options::{CurvatureMode, EstimatorOptions, WalkBoundary, OPTIONS};
 use super::lod::{LodMode, LodRule};
 use super::microfacet::{alpha_from_roughness, RoughCoat, SMOOTH_ALPHA};
 use crate::bssrdf::curvature_correction::CurvatureCorrection;
@@ -50,35 +49,6 @@ pub struct Subsurface {
     curvature: Option<CurvatureCorrection>,
     /// The level-of-detail rule ([`super::lod`]).
     lod: LodRule,
-}
-
-/// The scene's `curvature_correction` setting.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum CurvatureMode {
-    /// Correct the diffusion weight on convex surfaces (the default).
-    #[default]
-    Auto,
-    /// The half-space profile everywhere.
-    Off,
-}
-
-impl CurvatureMode {
-    /// "auto" or "off" (case-insensitive).
-    pub fn parse(s: &str) -> Option<Self> {
-        match s.to_ascii_lowercase().as_str() {
-            "auto" => Some(CurvatureMode::Auto),
-            "off" => Some(CurvatureMode::Off),
-            _ => None,
-        }
-    }
-
-    /// The name [`parse`](Self::parse) reads.
-    pub fn name(self) -> &'static str {
-        match self {
-            CurvatureMode::Auto => "auto",
-            CurvatureMode::Off => "off",
-        }
-    }
 }
 
 impl PartialEq for Subsurface {
@@ -296,41 +266,6 @@ fn curvature_for(
         CurvatureMode::Off => None,
         CurvatureMode::Auto => CurvatureCorrection::new(params, probe)
             .unwrap_or_else(|e| panic!("embedded curvature table: {e}")),
-    }
-}
-
-/// The boundary of a subsurface object in the random walk
-/// (`docs/bssrdf.md` §7, `crate::integrator::randomwalk`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum WalkBoundary {
-    /// The exact smooth dielectric: Fresnel reflection or refraction along
-    /// Snell's direction.
-    #[default]
-    Dielectric,
-    /// The same Fresnel probabilities, but transmission forgets the
-    /// direction (`crate::integrator::diffuse_boundary`): a different model,
-    /// whose exit point is a vertex where lights are sampled.
-    /// `exit_nee: false` renders the same model without light sampling at
-    /// the exit (for tests and measurements; not in the scene format).
-    Diffuse { exit_nee: bool },
-}
-
-impl WalkBoundary {
-    /// "dielectric" or "diffuse" (case-insensitive).
-    pub fn parse(s: &str) -> Option<Self> {
-        match s.to_ascii_lowercase().as_str() {
-            "dielectric" => Some(WalkBoundary::Dielectric),
-            "diffuse" => Some(WalkBoundary::Diffuse { exit_nee: true }),
-            _ => None,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            WalkBoundary::Dielectric => "dielectric",
-            WalkBoundary::Diffuse { exit_nee: true } => "diffuse",
-            WalkBoundary::Diffuse { exit_nee: false } => "diffuse-no-nee",
-        }
     }
 }
 

@@ -28,9 +28,10 @@ use crate::materials::Material;
 #[cfg(feature = "subsurface")]
 use crate::materials::Subsurface;
 
-/// The keys a `type = "subsurface"` material accepts.
+/// The parameter keys a `type = "subsurface"` material accepts; its
+/// sampling options are the option table's ([`OPTIONS`]).
 #[cfg(feature = "subsurface")]
-const SUBSURFACE_KEYS: &[&str] = &[
+const PARAMETER_KEYS: &[&str] = &[
     "preset",
     "sigma_s_prime",
     "sigma_a",
@@ -40,20 +41,6 @@ const SUBSURFACE_KEYS: &[&str] = &[
     "eta",
     "fit",
     "albedo_source",
-    "radius",
-    "rmax_quantile",
-    "axes",
-    "channel",
-    "renormalize",
-    "exit_sw",
-    "specular",
-    "boundary",
-    "roughness",
-    "curvature_correction",
-    "lod",
-    "lod_threshold",
-    "control_variate",
-    "probe_pair",
 ];
 
 /// The parameter forms, for messages.
@@ -110,7 +97,12 @@ pub(super) fn material(
         )),
         #[cfg(feature = "subsurface")]
         MaterialKind::Subsurface => {
-            cx.only_keys(&field, kind.name(), d.present_keys(), SUBSURFACE_KEYS)?;
+            let keys: Vec<&str> = PARAMETER_KEYS
+                .iter()
+                .copied()
+                .chain(OPTIONS.iter().map(|o| o.name))
+                .collect();
+            cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             let params = parameters(cx, &field, m, units_per_mm as f64)?;
             let options = estimator_options(cx, &field, m)?;
             let ss = Subsurface::from_options(params, &options)
