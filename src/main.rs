@@ -210,6 +210,7 @@ enum ValueError {
         found: String,
     },
     /// Not one of the names of `what`.
+    #[cfg(feature = "subsurface")]
     Unknown { what: &'static str, found: String },
     /// A problem the parser named.
     Problem(String),
@@ -221,6 +222,7 @@ impl std::fmt::Display for ValueError {
             ValueError::Expected { expected, found } => {
                 write!(f, "expected {expected}, found \"{found}\"")
             }
+            #[cfg(feature = "subsurface")]
             ValueError::Unknown { what, found } => write!(f, "unknown {what} \"{found}\""),
             ValueError::Problem(p) => f.write_str(p),
         }

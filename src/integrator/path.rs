@@ -1165,7 +1165,7 @@ fn probe_entry<'s>(
         geom: si.geom,
         mesh: &ctx.scene.meshes[si.geom as usize],
     };
-    let ps = entry_on_segment(&ss.probe(), seg, u, &target, &mut scratch.probe_hits)?;
+    let ps = entry_on_segment(ss.probe(), seg, u, &target, &mut scratch.probe_hits)?;
     // The curvature correction (bssrdf::curvature_correction): None, and
     // the weight untouched, on flat and concave surfaces.
     let mut weight = ps.weight;
