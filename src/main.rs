@@ -8,24 +8,18 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
-#[cfg(feature = "subsurface")]
-use lucent::bssrdf::{ChannelStrategy, ProbeAxes, RadiusSampler};
-use lucent::error::InputError;
-#[cfg(feature = "subsurface")]
-use lucent::error::{Param, ParamError};
-use lucent::farm::part::{self, Identity};
+use lucent::farm::part;
 use lucent::film::cryptomatte;
-use lucent::film::exr_layers::{
-    self, ExrCompression, FrameHeader, OutputOptions, Precision, Preview,
-};
+use lucent::film::exr_layers::{self, ExrCompression, OutputOptions, Precision, Preview};
 use lucent::film::passes::PassSet;
 use lucent::film::region::Region;
 use lucent::film::ToneMap;
 use lucent::integrator::{effects, plan, IntegratorKind};
 #[cfg(feature = "subsurface")]
-use lucent::materials::{LodMode, SubsurfaceOverrides, WalkBoundary};
-use lucent::render::{self, RenderOptions};
+use lucent::materials::{EstimatorOptions, OPTIONS};
+use lucent::render::RenderOptions;
 use lucent::scene;
+use lucent::session;
 use lucent::Error;
 
 #[derive(Parser)]
@@ -195,84 +189,134 @@ struct SplitArgs {
     resume: Option<PathBuf>,
 }
 
-impl SplitArgs {
-    /// Whether the output is a part rather than a frame.
-    fn is_part(&self) -> bool {
-        self.crop.is_some() || self.tile.is_some() || self.samples.is_some()
+impl From<SplitArgs> for session::Split {
+    fn from(a: SplitArgs) -> session::Split {
+        session::Split {
+            crop: a.crop,
+            tile: a.tile,
+            samples: a.samples,
+            checkpoint: a.checkpoint,
+            resume: a.resume,
+        }
     }
 }
 
-fn parse_crop(s: &str) -> Result<Region, String> {
-    Region::parse(s)
-        .filter(|r| !r.is_empty())
-        .ok_or_else(|| format!("expected X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1, found \"{s}\""))
+/// A flag's value that does not parse.
+#[derive(Debug)]
+enum ValueError {
+    /// Not of the form `expected`.
+    Expected {
+        expected: &'static str,
+        found: String,
+    },
+    /// Not one of the names of `what`.
+    #[cfg(feature = "subsurface")]
+    Unknown { what: &'static str, found: String },
+    /// A problem the parser named.
+    Problem(String),
 }
 
-fn parse_tile(s: &str) -> Result<(u32, u32), String> {
+impl std::fmt::Display for ValueError {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            ValueError::Expected { expected, found } => {
+                write!(f, "expected {expected}, found \"{found}\"")
+            }
+            #[cfg(feature = "subsurface")]
+            ValueError::Unknown { what, found } => write!(f, "unknown {what} \"{found}\""),
+            ValueError::Problem(p) => f.write_str(p),
+        }
+    }
+}
+
+impl std::error::Error for ValueError {}
+
+/// [`ValueError::Expected`] for the value `s`.
+fn expected(expected: &'static str, s: &str) -> ValueError {
+    ValueError::Expected {
+        expected,
+        found: s.into(),
+    }
+}
+
+fn parse_crop(s: &str) -> Result<Region, ValueError> {
+    Region::parse(s)
+        .filter(|r| !r.is_empty())
+        .ok_or_else(|| expected("X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1", s))
+}
+
+fn parse_tile(s: &str) -> Result<(u32, u32), ValueError> {
     s.split_once('/')
         .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)))
         .filter(|&(i, n)| i < n)
-        .ok_or_else(|| format!("expected I/N with 0 ≤ I < N, found \"{s}\""))
+        .ok_or_else(|| expected("I/N with 0 ≤ I < N", s))
 }
 
-fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
-    part::parse_samples(s).ok_or_else(|| format!("expected A..B with A < B, found \"{s}\""))
+fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, ValueError> {
+    part::parse_samples(s).ok_or_else(|| expected("A..B with A < B", s))
 }
 
-fn parse_checkpoint(s: &str) -> Result<f64, String> {
+fn parse_checkpoint(s: &str) -> Result<f64, ValueError> {
     s.parse::<f64>()
         .ok()
         .filter(|v| v.is_finite() && *v > 0.0)
-        .ok_or_else(|| format!("expected a positive number of seconds, found \"{s}\""))
+        .ok_or_else(|| expected("a positive number of seconds", s))
 }
 
-/// Subsurface sampling choices that override every subsurface material's
-/// own (see docs/scene-format.md for what each means).
+/// The subsurface sampling options, one flag per row of the option table
+/// (`lucent::materials::estimator_options`); each replaces every
+/// subsurface material's own.
 #[cfg(feature = "subsurface")]
-#[derive(clap::Args)]
-struct SubsurfaceArgs {
-    /// Radius sampler: uniform | table[:N] | table-uniform[:N] | analytic | mixture.
-    #[arg(long, value_parser = parse_radius)]
-    radius: Option<RadiusSampler>,
-    /// Probe sphere radius as a quantile of the widest channel's profile, in (0, 1).
-    #[arg(long)]
-    rmax_quantile: Option<f64>,
-    /// Probe axes: curvature (N/T/B with MIS, T/B probabilities from the
-    /// curvature) | normal (the seed) | mis3 (N/T/B at ½, ¼, ¼ with MIS).
-    #[arg(long, value_enum)]
-    axes: Option<AxesArg>,
-    /// Channel choice: single (the seed) | mis (all channels, balance heuristic).
-    #[arg(long, value_enum)]
-    channel: Option<ChannelArg>,
-    /// Divide the profile by CDF(Rmax) so truncation loses no energy.
-    #[arg(long)]
-    renormalize: Option<bool>,
-    /// Normalized Fresnel lobe Sw at the entry point (false: cosine lobe).
-    #[arg(long)]
-    exit_sw: Option<bool>,
-    /// Specular reflection layer on top.
-    #[arg(long)]
-    specular: Option<bool>,
-    /// Roughness of that layer in [0, 1] (0: a mirror; GGX with α = roughness²).
-    #[arg(long)]
-    roughness: Option<f32>,
-    /// Random-walk boundary: dielectric (exact, smooth) | diffuse (diffuse
-    /// Fresnel transmission with light sampling at the exit; another model).
-    #[arg(long, value_enum)]
-    boundary: Option<BoundaryArg>,
-    /// Subsurface level of detail: auto (albedo A where the path's
-    /// footprint is wide against the profile, per material threshold) | off
-    /// (always probe) | force (every hit shaded with albedo A; for tests).
-    #[arg(long, value_enum)]
-    lod: Option<LodArg>,
-    /// At the camera vertex, the plane control variate on the light
-    /// sampled at the entry point (true by default).
-    #[arg(long)]
-    control_variate: Option<bool>,
-    /// At the camera vertex, an antithetic pair of probes (false by
-    /// default).
-    #[arg(long)]
-    probe_pair: Option<bool>,
+#[derive(Clone, Debug, Default)]
+struct SubsurfaceArgs(session::Overrides);
+
+#[cfg(feature = "subsurface")]
+impl clap::FromArgMatches for SubsurfaceArgs {
+    fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let mut given = session::Overrides::default();
+        for row in OPTIONS.iter().filter(|o| o.flag) {
+            if let Some(v) = m.get_one::<String>(row.name) {
+                given
+                    .push(row, v)
+                    .map_err(|e| clap::Error::raw(clap::error::ErrorKind::ValueValidation, e))?;
+            }
+        }
+        Ok(SubsurfaceArgs(given))
+    }
+
+    fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
+}
+
+#[cfg(feature = "subsurface")]
+impl clap::Args for SubsurfaceArgs {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        OPTIONS.iter().filter(|o| o.flag).fold(cmd, |cmd, row| {
+            // clap keeps flag names for the program's life
+            let long: &'static str = Box::leak(row.flag_name().into_boxed_str());
+            cmd.arg(
+                clap::Arg::new(row.name)
+                    .long(long)
+                    .help(row.help())
+                    .value_parser(move |s: &str| {
+                        (row.set)(&mut EstimatorOptions::default(), s).map(|()| s.to_string())
+                    }),
+            )
+        })
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
+}
+
+#[cfg(feature = "subsurface")]
+impl SubsurfaceArgs {
+    fn overrides(&self) -> session::Overrides {
+        self.0.clone()
+    }
 }
 
 /// How the EXR is stored (docs/output.md); each overrides the scene's
@@ -346,85 +390,8 @@ enum ExplainArg {
     Json,
 }
 
-#[cfg(feature = "subsurface")]
-#[derive(Clone, Copy, ValueEnum)]
-enum LodArg {
-    Auto,
-    Off,
-    Force,
-}
-
-#[cfg(feature = "subsurface")]
-#[derive(Clone, Copy, ValueEnum)]
-enum BoundaryArg {
-    Dielectric,
-    Diffuse,
-}
-
-#[cfg(feature = "subsurface")]
-#[derive(Clone, Copy, ValueEnum)]
-enum AxesArg {
-    Curvature,
-    Normal,
-    Mis3,
-}
-
-#[cfg(feature = "subsurface")]
-#[derive(Clone, Copy, ValueEnum)]
-enum ChannelArg {
-    Single,
-    Mis,
-}
-
-#[cfg(feature = "subsurface")]
-fn parse_radius(s: &str) -> Result<RadiusSampler, ParamError> {
-    RadiusSampler::parse(s)
-}
-
-fn parse_aov(s: &str) -> Result<PassSet, String> {
-    PassSet::parse_list(s).map_err(|e| e.problem())
-}
-
-#[cfg(feature = "subsurface")]
-impl SubsurfaceArgs {
-    /// Applies the overrides to every subsurface material of `materials`;
-    /// returns them as the render's identity records them.
-    fn apply(&self, materials: &mut [lucent::materials::Material]) -> Result<String, Error> {
-        let o = self.overrides();
-        o.apply_all(materials).map_err(option_error)?;
-        Ok(format!("{o:?}"))
-    }
-
-    fn overrides(&self) -> SubsurfaceOverrides {
-        SubsurfaceOverrides {
-            radius: self.radius,
-            rmax_quantile: self.rmax_quantile,
-            axes: self.axes.map(|a| match a {
-                AxesArg::Curvature => ProbeAxes::Curvature,
-                AxesArg::Normal => ProbeAxes::Normal,
-                AxesArg::Mis3 => ProbeAxes::Mis3,
-            }),
-            channel: self.channel.map(|c| match c {
-                ChannelArg::Single => ChannelStrategy::Single,
-                ChannelArg::Mis => ChannelStrategy::Mis,
-            }),
-            renormalize: self.renormalize,
-            exit_sw: self.exit_sw,
-            specular: self.specular,
-            boundary: self.boundary.map(|b| match b {
-                BoundaryArg::Dielectric => WalkBoundary::Dielectric,
-                BoundaryArg::Diffuse => WalkBoundary::Diffuse { exit_nee: true },
-            }),
-            roughness: self.roughness,
-            lod: self.lod.map(|l| match l {
-                LodArg::Auto => LodMode::Auto,
-                LodArg::Off => LodMode::Off,
-                LodArg::Force => LodMode::Force,
-            }),
-            control_variate: self.control_variate,
-            probe_pair: self.probe_pair,
-        }
-    }
+fn parse_aov(s: &str) -> Result<PassSet, ValueError> {
+    PassSet::parse_list(s).map_err(|e| ValueError::Problem(e.problem()))
 }
 
 /// A build without the `subsurface` feature has no subsurface materials,
@@ -435,8 +402,8 @@ struct SubsurfaceArgs {}
 
 #[cfg(not(feature = "subsurface"))]
 impl SubsurfaceArgs {
-    fn apply(&self, _: &mut [lucent::materials::Material]) -> Result<String, Error> {
-        Ok(String::new())
+    fn overrides(&self) -> session::Overrides {
+        session::Overrides
     }
 }
 
@@ -484,18 +451,18 @@ fn main() -> ExitCode {
                 return finish(run_explain(&scene, integrator, aov, &subsurface, format));
             }
             file.settings().and_then(|file| {
-                run_render(
-                    &scene,
-                    &output,
+                let r = session::Request {
+                    scene,
+                    output,
                     backend,
-                    &opts,
+                    opts,
                     aov,
-                    &subsurface,
-                    &file,
-                    &split,
-                    Preview { tonemap, exposure },
-                    quiet,
-                )
+                    overrides: subsurface.overrides(),
+                    file,
+                    split: split.into(),
+                    preview: Preview { tonemap, exposure },
+                };
+                run_render(&r, quiet)
             })
         }
         Command::Merge {
@@ -551,218 +518,16 @@ fn exit_code(e: &Error) -> u8 {
     }
 }
 
-/// A subsurface override from the command line out of its domain, named by
-/// its option.
-#[cfg(feature = "subsurface")]
-fn option_error(e: ParamError) -> Error {
-    let (argument, problem) = match e.param {
-        Param::RmaxQuantile => ("--rmax-quantile", e.problem()),
-        Param::RadiusSampler => ("--radius", e.problem()),
-        Param::TableSize => ("--radius", format!("table size {}", e.problem())),
-        _ => ("subsurface option", e.to_string()),
-    };
-    Error::Argument {
-        argument: argument.into(),
-        problem,
-    }
-}
-
-/// An output path that ends in `.exr` and lies in an existing directory.
-fn check_exr_output(output: &Path) -> Result<(), Error> {
-    if output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        != Some("exr".into())
-    {
-        return Err(Error::Argument {
-            argument: format!("output {}", output.display()),
-            problem: "expected a path ending in .exr".into(),
-        });
-    }
-    let dir = output
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !dir.is_dir() {
-        return Err(Error::Argument {
-            argument: format!("output directory {}", dir.display()),
-            problem: "does not exist".into(),
-        });
-    }
-    Ok(())
-}
-
-/// Where a render keeps its finished samples for `--resume` (at a signal,
-/// at checkpoints): `OUT.partial.exr` beside `OUT.exr`.
-fn checkpoint_path(output: &Path) -> PathBuf {
-    output.with_extension("partial.exr")
-}
-
-#[allow(clippy::too_many_arguments)]
-fn run_render(
-    scene_path: &Path,
-    output: &Path,
-    backend: Backend,
-    opts: &RenderOptions,
-    aov: Option<PassSet>,
-    subsurface: &SubsurfaceArgs,
-    file: &scene::OutputSettings,
-    split: &SplitArgs,
-    preview: Preview,
-    quiet: bool,
-) -> Result<(), Error> {
-    check_exr_output(output)?;
-    if opts.spp == Some(0) {
-        return Err(Error::Argument {
-            argument: "--spp".into(),
-            problem: "must be at least 1".into(),
-        });
-    }
-    if opts.threads == Some(0) {
-        return Err(Error::Argument {
-            argument: "--threads".into(),
-            problem: "must be at least 1".into(),
-        });
-    }
-    let mut scene = scene::load(scene_path)?;
-    let scene_bytes = scene::load::read_regular_file(scene_path, scene::load::MAX_SCENE_BYTES)
-        .map_err(|e| InputError::new(scene_path, format!("cannot read scene file: {e}")))?;
-    let overrides = subsurface.apply(&mut scene.materials)?;
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let spp = opts.spp.unwrap_or(scene.settings.spp);
-    let region = match (split.crop, split.tile) {
-        (Some(c), _) if !c.within(&Region::full(w, h)) => {
-            return Err(Error::Argument {
-                argument: "--crop".into(),
-                problem: format!("{c} is not inside the {w}×{h} frame"),
-            })
-        }
-        (Some(c), _) => c,
-        (None, Some((i, n))) => Region::band(i, n, w, h).ok_or_else(|| Error::Argument {
-            argument: "--tile".into(),
-            problem: format!("{i}/{n}: the {w}×{h} frame splits into at most {h} bands"),
-        })?,
-        (None, None) => Region::full(w, h),
-    };
-    let samples = split.samples.clone().unwrap_or(0..spp);
-    if samples.end > spp {
-        return Err(Error::Argument {
-            argument: "--samples".into(),
-            problem: format!(
-                "{}..{} reaches beyond the {spp} samples per pixel",
-                samples.start, samples.end
-            ),
-        });
-    }
-    let passes = aov.unwrap_or(scene.output.aovs);
-    let layout = (!passes.is_empty()).then(|| lucent::integrator::aov::layout(&scene, passes));
-    let mut out = file.over(scene.output.file.over(OutputOptions::default()));
-    let identity = Identity {
-        passes: part::passes_text(layout.as_ref()),
-        names: part::names_text(layout.as_ref()),
-        output: part::output_text(&out),
-        version: env!("CARGO_PKG_VERSION").into(),
-        scene_hash: lucent::farm::scene_hash(scene_bytes.as_bytes(), &scene),
-        seed: opts.seed.unwrap_or(scene.settings.seed),
-        spp,
-        options: format!(
-            "accel={} integrator={:?} {overrides}",
-            backend.name(),
-            opts.integrator
-        ),
-        frame: (w, h),
-    };
-    let scene_name = scene_path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let header = |sums: &render::Accumulated| part::Header {
-        identity: identity.clone(),
-        scene: scene_name.clone(),
-        region,
-        samples: sums.start..sums.done,
-        requested: samples.clone(),
-        layers: part::layers_of(layout.as_ref()),
-        counters: sums.counters,
-    };
-    let job = render::Job {
-        region,
-        samples: samples.clone(),
-        pass_seconds: split.checkpoint.map_or(2.0, |c| (c / 2.0).min(2.0)),
-        passes,
-    };
-    let resume = match &split.resume {
-        Some(p) => Some(resumable(p, &identity, &job)?),
-        None => None,
-    };
-    stop_if_interrupted()?;
-    let traversal = opts.integrator.traversal(scene.settings.traversal);
-    let accel = accel::build_with(&scene.meshes, backend, traversal)?;
-    stop_if_interrupted()?;
-    out.preview = Some(preview);
-    let keep = checkpoint_path(output);
-    let mut last = std::time::Instant::now();
-    let mut checkpoint = |sums: &render::Accumulated| -> Result<(), Error> {
-        match split.checkpoint {
-            Some(every) if last.elapsed().as_secs_f64() >= every && sums.done < samples.end => {
-                lucent::film::commit_all(vec![part::stage(&keep, &header(sums), sums)?])?;
-                last = std::time::Instant::now();
-                Ok(())
-            }
-            _ => Ok(()),
-        }
-    };
-    let r = render::render_job(&scene, accel.as_ref(), opts, &job, resume, &mut checkpoint)?;
-    if let Some(signal) = r.interrupted {
-        if r.sums.count() == 0 {
-            return Err(Error::Interrupted(signal));
-        }
-        let staged = part::stage(&keep, &header(&r.sums), &r.sums)?;
-        lucent::film::commit_even_if_interrupted(vec![staged])?;
-        return Err(Error::InterruptedKept {
-            signal,
-            part: keep,
-            samples: r.sums.start..r.sums.done,
-            requested: samples,
-        });
-    }
-    if split.is_part() {
-        lucent::film::commit_all(vec![part::stage(output, &header(&r.sums), &r.sums)?])?;
-    } else {
-        let header = frame_header(
-            scene_path,
-            &scene,
-            accel.name(),
-            backend,
-            opts,
-            PassSet::EMPTY,
-            r.stats.seconds,
-        )?;
-        let (layers, coverage) = r.sums.layers()?;
-        exr_layers::write_frame(output, &r.sums.film()?, &layers, &coverage, &header, &out)?;
-    }
-    // the finished output replaces what was kept to resume from
-    if keep.is_file() {
-        let _ = std::fs::remove_file(&keep);
-    }
-    // and a checkpoint a killed process was writing
-    lucent::film::stale::clean(&keep);
+/// Renders `r` and says how it went (unless `quiet`).
+fn run_render(r: &session::Request, quiet: bool) -> Result<(), Error> {
+    let o = session::run(r)?;
     if !quiet {
-        eprintln!(
-            "{}: {}{region} of {w}×{h}, samples {}..{} of {spp}, {} triangles: {}",
-            output.display(),
-            if split.is_part() { "part, " } else { "" },
-            samples.start,
-            samples.end,
-            scene.triangle_count(),
-            r.stats.summary(accel.name())
-        );
+        eprintln!("{}", o.summary(&r.output));
     }
-    if opts.stats {
-        eprint!("{}", effects::summary(&r.stats.counters));
+    if r.opts.stats {
+        eprint!("{}", effects::summary(&o.stats.counters));
     }
-    report_rejected_rays(accel.as_ref());
+    report_rejected_rays(o.rejected_rays);
     Ok(())
 }
 
@@ -776,140 +541,14 @@ fn run_explain(
     format: ExplainArg,
 ) -> Result<(), Error> {
     let mut scene = scene::load(scene_path)?;
-    subsurface.apply(&mut scene.materials)?;
-    let plan = render_plan(&scene, integrator, aov.unwrap_or(scene.output.aovs));
+    session::overrides::apply(&subsurface.overrides(), &mut scene.materials)?;
+    let passes = aov.unwrap_or(scene.output.aovs);
+    let plan = session::identity::render_plan(&scene, integrator, passes);
     match format {
         ExplainArg::Text => print!("{}", plan::text::render(&plan)),
         ExplainArg::Json => println!("{}", plan.to_json_pretty()),
     }
     Ok(())
-}
-
-/// The plan a render of `scene` with `integrator` and `passes` follows.
-fn render_plan(
-    scene: &scene::Scene,
-    integrator: IntegratorKind,
-    passes: PassSet,
-) -> plan::Explanation {
-    plan::Explanation::new(
-        scene,
-        &plan::PlanOptions {
-            integrator,
-            passes,
-            ..plan::PlanOptions::default()
-        },
-    )
-}
-
-/// What the EXR header records about this render (docs/output.md): the
-/// scene file and its SHA-256, samples, seed, depth, backend and version,
-/// integrator, every subsurface material's sampling options (named by the
-/// objects that use it) and the render time.
-fn frame_header(
-    scene_path: &Path,
-    scene: &scene::Scene,
-    accel_name: &str,
-    backend: Backend,
-    opts: &RenderOptions,
-    passes: PassSet,
-    seconds: f64,
-) -> Result<FrameHeader, Error> {
-    use sha2::{Digest, Sha256};
-    let text =
-        scene::load::read_regular_file(scene_path, scene::load::MAX_SCENE_BYTES).map_err(|e| {
-            Error::Read {
-                path: scene_path.to_path_buf(),
-                problem: e.to_string(),
-            }
-        })?;
-    let sha: String = Sha256::digest(text.as_bytes())
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    #[cfg_attr(not(feature = "subsurface"), allow(unused_mut))]
-    let mut sampling = Vec::new();
-    #[cfg(feature = "subsurface")]
-    for (i, m) in scene.materials.iter().enumerate() {
-        let lucent::materials::Material::Subsurface(ss) = m else {
-            continue;
-        };
-        let users: Vec<&str> = scene
-            .objects
-            .iter()
-            .filter(|o| o.material == i)
-            .map(|o| o.name.as_str())
-            .collect();
-        if !users.is_empty() {
-            sampling.push((users.join(","), ss.sampling_description()));
-        }
-    }
-    Ok(FrameHeader {
-        scene_path: Some(scene_path.display().to_string()),
-        scene_sha256: Some(sha),
-        spp: Some(opts.spp.unwrap_or(scene.settings.spp)),
-        seed: Some(opts.seed.unwrap_or(scene.settings.seed)),
-        max_depth: Some(scene.settings.max_depth),
-        backend: Some(accel_name.into()),
-        backend_version: Some(backend_version(backend)?),
-        integrator: Some(
-            match opts.integrator {
-                IntegratorKind::Path => "path",
-                #[cfg(feature = "subsurface")]
-                IntegratorKind::RandomWalk => "randomwalk",
-            }
-            .into(),
-        ),
-        sampling,
-        plan: Some(render_plan(scene, opts.integrator, passes).to_json()),
-        render_seconds: Some(seconds),
-    })
-}
-
-/// The backend's version: the Embree in use (the one `backend` resolves
-/// to), or lucent's for its own BVH.
-fn backend_version(backend: Backend) -> Result<String, Error> {
-    Ok(match backend.resolve()? {
-        #[cfg(feature = "embree")]
-        Backend::Embree3 => format!("Embree {}", accel::embree::version()),
-        #[cfg(feature = "embree4")]
-        Backend::Embree4 => format!("Embree {}", accel::embree4::version()?),
-        _ => format!("lucent {}", env!("CARGO_PKG_VERSION")),
-    })
-}
-
-/// The sums of the part at `path`, checked to be a start of `job` of the
-/// frame `identity`.
-fn resumable(
-    path: &Path,
-    identity: &Identity,
-    job: &render::Job,
-) -> Result<render::Accumulated, Error> {
-    let (h, sums) = part::read(path)?;
-    let located = |field: &str, problem: String| -> Error {
-        InputError::new(path, problem).in_field(field).into()
-    };
-    if let Some((field, theirs, ours)) = h.identity.difference(identity) {
-        return Err(located(
-            field,
-            format!("`{theirs}`, but this render has `{ours}`: not a part of this render"),
-        ));
-    }
-    if h.region != job.region {
-        return Err(located(
-            "lucent.region",
-            format!("{}, but this render covers {}", h.region, job.region),
-        ));
-    }
-    if h.samples.start != job.samples.start || h.samples.end > job.samples.end {
-        return Err(located(
-            "lucent.samples",
-            format!(
-                "{}..{}, not a start of this render's samples {}..{}",
-                h.samples.start, h.samples.end, job.samples.start, job.samples.end
-            ),
-        ));
-    }
-    Ok(sums)
 }
 
 fn run_merge(
@@ -919,7 +558,7 @@ fn run_merge(
     exposure: f32,
     quiet: bool,
 ) -> Result<(), Error> {
-    check_exr_output(output)?;
+    session::check_exr_output(output)?;
     let start = std::time::Instant::now();
     let m = lucent::farm::merge::merge(parts)?;
     let header = lucent::film::exr_attributes::FrameHeader {
@@ -966,18 +605,9 @@ fn without_control_characters(s: &str) -> String {
         .collect()
 }
 
-/// [`Error::Interrupted`] once a signal asked the process to stop.
-fn stop_if_interrupted() -> Result<(), Error> {
-    match lucent::interrupt::requested() {
-        Some(sig) => Err(Error::Interrupted(sig)),
-        None => Ok(()),
-    }
-}
-
 /// Says on stderr (even with `--quiet`: it means the image may be wrong)
 /// how many ray queries the backend refused as out of range, if any.
-fn report_rejected_rays(accel: &dyn accel::Accel) {
-    let n = accel.rejected_rays();
+fn report_rejected_rays(n: u64) {
     if n > 0 {
         eprintln!(
             "warning: {n} ray queries had a non-finite or out-of-range origin, direction or \
@@ -1031,14 +661,17 @@ struct StudyArgs {
 }
 
 #[cfg(feature = "subsurface")]
-fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, String> {
+fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, ValueError> {
     lucent::tools::study::config::parse_integrator(s)
-        .ok_or_else(|| format!("expected diffusion or randomwalk, found \"{s}\""))
+        .ok_or_else(|| expected("diffusion or randomwalk", s))
 }
 
 #[cfg(feature = "subsurface")]
-fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, String> {
-    lucent::tools::study::Axis::parse(s).ok_or_else(|| format!("unknown axis \"{s}\""))
+fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, ValueError> {
+    lucent::tools::study::Axis::parse(s).ok_or_else(|| ValueError::Unknown {
+        what: "axis",
+        found: s.into(),
+    })
 }
 
 #[cfg(feature = "subsurface")]

@@ -325,22 +325,26 @@ pub struct Rendered {
     pub interrupted: Option<i32>,
 }
 
-/// The scene with `opts`' spp and seed overrides applied.
-fn with_overrides<'a>(scene: &'a Scene, opts: &RenderOptions) -> std::borrow::Cow<'a, Scene> {
-    let mut settings = scene.settings;
-    if let Some(s) = opts.spp {
-        settings.spp = s;
-    }
-    if let Some(s) = opts.seed {
-        settings.seed = s;
-    }
-    if settings != scene.settings {
-        std::borrow::Cow::Owned(Scene {
-            settings,
-            ..scene.clone()
-        })
-    } else {
-        std::borrow::Cow::Borrowed(scene)
+/// The settings of one render, each fixed once from the scene and the
+/// options: what the tile loop, the frame header and a part's identity
+/// read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    pub spp: u32,
+    pub seed: u64,
+    pub max_depth: u32,
+    pub integrator: IntegratorKind,
+}
+
+impl Settings {
+    /// `opts`' spp and seed where given, else the scene's.
+    pub fn resolved(scene: &Scene, opts: &RenderOptions) -> Settings {
+        Settings {
+            spp: opts.spp.unwrap_or(scene.settings.spp),
+            seed: opts.seed.unwrap_or(scene.settings.seed),
+            max_depth: scene.settings.max_depth,
+            integrator: opts.integrator,
+        }
     }
 }
 
@@ -351,7 +355,7 @@ pub fn render(
     accel: &dyn Accel,
     opts: &RenderOptions,
 ) -> Result<(Film, RenderStats), Error> {
-    let spp = opts.spp.unwrap_or(scene.settings.spp);
+    let spp = Settings::resolved(scene, opts).spp;
     let r = render_job(
         scene,
         accel,
@@ -379,8 +383,7 @@ pub fn render_job(
     resume: Option<Accumulated>,
     after_pass: &mut dyn FnMut(&Accumulated) -> Result<(), Error>,
 ) -> Result<Rendered, Error> {
-    let scene = with_overrides(scene, opts);
-    let scene = scene.as_ref();
+    let settings = Settings::resolved(scene, opts);
     if let Some(n) = opts.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
         return Err(Error::Argument {
             argument: "--threads".into(),
@@ -456,7 +459,8 @@ pub fn render_job(
         }
         let pass = Pass {
             ctx: &ctx,
-            integrator: opts.integrator,
+            integrator: settings.integrator,
+            seed: settings.seed,
             samples: s.clone(),
             pool: &pool,
             bar: &bar,
@@ -508,6 +512,7 @@ pub fn render_job(
 struct Pass<'a> {
     ctx: &'a Context<'a>,
     integrator: IntegratorKind,
+    seed: u64,
     samples: Range<u32>,
     pool: &'a rayon::ThreadPool,
     bar: &'a ProgressBar,
@@ -526,11 +531,12 @@ impl Pass<'_> {
                 .into_par_iter()
                 .map(|((t, prev, out), passes)| {
                     let (ctx, i, s) = (self.ctx, self.integrator, self.samples.clone());
+                    let key = Rng::seed_key(self.seed);
                     // the timed instance only with --stats (integrator::effects)
                     let c = if self.stats {
-                        render_tile::<_, Stopwatch>(ctx, i, t, s, prev, out, passes)
+                        render_tile::<_, Stopwatch>(ctx, i, key, t, s, prev, out, passes)
                     } else {
-                        render_tile::<_, NoClock>(ctx, i, t, s, prev, out, passes)
+                        render_tile::<_, NoClock>(ctx, i, key, t, s, prev, out, passes)
                     };
                     self.bar.inc(t.area() * self.samples.len() as u64);
                     c
@@ -541,15 +547,18 @@ impl Pass<'_> {
 }
 
 // Kept out of line so profiles (scripts/profile.sh) can name the tile loop.
-/// Adds the samples `samples` of every pixel of `tile` to its sums `prev`
+/// Adds the samples `samples` (streams keyed by `seed_key`,
+/// [`Rng::seed_key`]) of every pixel of `tile` to its sums `prev`
 /// (the tile's pixels row by row), writing the result to `out`, and to the
 /// sums of its `passes` (with [`NoAov`]: none, and this instance is the
 /// loop without passes). Stops at the next pixel once a signal came (the
 /// pass is then dropped).
 #[inline(never)]
+#[allow(clippy::too_many_arguments)]
 fn render_tile<P: PixelPasses, T: Clock>(
     ctx: &Context,
     integrator: IntegratorKind,
+    seed_key: u64,
     tile: &Region,
     samples: Range<u32>,
     prev: &[i128],
@@ -561,7 +570,6 @@ fn render_tile<P: PixelPasses, T: Clock>(
     let w = scene.camera.width;
     let mut counters = Counters::default();
     let mut scratch = Scratch::default();
-    let seed_key = Rng::seed_key(scene.settings.seed);
     let mut i = 0;
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
@@ -627,7 +635,7 @@ pub fn render_passes(
     opts: &RenderOptions,
     passes: PassSet,
 ) -> Result<RenderOutput, Error> {
-    let spp = opts.spp.unwrap_or(scene.settings.spp);
+    let spp = Settings::resolved(scene, opts).spp;
     let job = Job {
         passes,
         ..Job::full(scene, spp)

@@ -234,7 +234,7 @@ fn scene_key_albedo_source() {
         .unwrap()
         .materials[0]
     {
-        Material::Subsurface(s) => s.params.albedo,
+        Material::Subsurface(s) => s.params().albedo,
         _ => unreachable!(),
     };
     assert_eq!(albedo("albedo_source = \"given\""), [0.83, 0.79, 0.75]);

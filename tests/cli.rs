@@ -328,3 +328,54 @@ fn accel_embree_without_the_feature_exits_2() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
+
+/// `render --help` offers every render flag of the option table with its
+/// description and default, and none of the research variants (they stay
+/// accepted, for studies and tests).
+#[cfg(feature = "subsurface")]
+#[test]
+fn render_help_offers_the_option_table_without_research_variants() {
+    let out = lucent().args(["render", "--help"]).output().unwrap();
+    let help = String::from_utf8_lossy(&out.stdout);
+    for row in lucent::materials::OPTIONS.iter().filter(|o| o.flag) {
+        assert!(help.contains(&format!("--{}", row.flag_name())), "{help}");
+        assert!(
+            help.contains(row.description.split(':').next().unwrap()),
+            "{help}"
+        );
+    }
+    let words: Vec<&str> = help
+        .split(|c: char| !(c.is_alphanumeric() || c == '-'))
+        .collect();
+    for research in [
+        "normal",
+        "single",
+        "uniform",
+        "table",
+        "table-uniform",
+        "force",
+    ] {
+        assert!(!words.contains(&research), "`{research}` offered:\n{help}");
+    }
+    assert!(!help.contains("the seed"), "{help}");
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("axes.exr");
+    let mut args = vec![scene("smooth-sphere.toml"), "-o".into()];
+    args.push(exr.to_str().unwrap().into());
+    for a in [
+        "--spp",
+        "1",
+        "--crop",
+        "120,120,136,136",
+        "--axes",
+        "normal",
+    ] {
+        args.push(a.into());
+    }
+    let out = lucent().arg("render").args(&args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -234,7 +234,7 @@ fn sigma_a_zero_spectralon_is_white_and_at_most_a() {
         p.d
     );
     let ss = plain(p, ProbeOptions::default());
-    let rmax = subsurface_of(&ss).probe.rmax() as f32;
+    let rmax = subsurface_of(&ss).probe().rmax() as f32;
     assert!(rmax.is_finite() && rmax > 0.0);
     let slab = cuboid(
         Vec3::new(10.0 * rmax, 2.0 * rmax, 10.0 * rmax),
@@ -296,7 +296,7 @@ fn zero_albedo_channel_ketchup_blue_is_exactly_zero() {
         ProbeOptions::seed_document(RadiusSampler::table(256)),
     ] {
         let m = material(p, opts, true, false);
-        let rmax = subsurface_of(&m).probe.rmax() as f32;
+        let rmax = subsurface_of(&m).probe().rmax() as f32;
         let slab = cuboid(
             Vec3::new(10.0 * rmax, 2.0 * rmax, 10.0 * rmax),
             Vec3::new(0.0, -2.0 * rmax, 0.0),
@@ -664,7 +664,7 @@ fn more_probe_hits_than_the_buffer_holds() {
     let albedo = [0.9, 0.6, 0.4];
     let p = params(albedo, [0.05, 0.04, 0.03], 1.0);
     let m = plain(p, ProbeOptions::default());
-    let rmax = subsurface_of(&m).probe.rmax();
+    let rmax = subsurface_of(&m).probe().rmax();
     let max_hits = 2 * ((2.0 * rmax / delta as f64) as usize + 2);
     let sc = scene(vec![stack], vec![m], looking_down(2.0, 20.0, 16), 64, 1);
     for (backend, acc) in accels(&sc.meshes) {

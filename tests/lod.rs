@@ -203,7 +203,7 @@ fn forced_lod_keeps_the_coat_energy() {
 fn auto_lod_switches_at_the_analytic_camera_footprint() {
     let base = slab_scene();
     let ss = subsurface(&base);
-    let rmax = ss.probe.rmax() as f32;
+    let rmax = ss.probe().rmax() as f32;
     let w_centre = 10.0 * 2.0 * 10f32.to_radians().tan() / 32.0;
     let at = |threshold: f32| {
         let mut s = base.clone();

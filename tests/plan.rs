@@ -561,7 +561,7 @@ fn level_of_detail_at_distance_forced_or_off() {
     let Material::Subsurface(ss) = &s.materials[1] else {
         panic!("sauce is the second material")
     };
-    let rmax = ss.probe.rmax() as f32;
+    let rmax = ss.probe().rmax() as f32;
     let p = plan_of(&s, IntegratorKind::Path, PassSet::EMPTY);
     let methods = &p.materials[1].subsurface;
     match &methods[..] {

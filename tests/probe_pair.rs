@@ -164,7 +164,7 @@ fn the_control_variate_keeps_the_mean_and_cuts_the_lit_bodys_variance() {
         })
         .unwrap();
     assert_eq!(
-        (ss.control_variate, ss.probe_pair),
+        (ss.control_variate(), ss.probe_pair()),
         (true, false),
         "one probe with the control variate is the default"
     );

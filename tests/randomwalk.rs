@@ -657,9 +657,11 @@ fn with_boundary(params: SubsurfaceParams, boundary: WalkBoundary) -> Material {
     let Material::Subsurface(ss) = subsurface(params) else {
         unreachable!()
     };
-    let mut ss = (*ss).clone();
-    ss.boundary = boundary;
-    Material::Subsurface(Arc::new(ss))
+    let options = lucent::materials::EstimatorOptions {
+        boundary,
+        ..*ss.options()
+    };
+    Material::Subsurface(Arc::new(ss.with_options(&options).unwrap()))
 }
 
 /// The diffuse Fresnel boundary conserves energy exactly
@@ -788,7 +790,7 @@ fn diffuse_boundary_is_deterministic_across_thread_counts() {
     let Material::Subsurface(ss) = subsurface(params) else {
         unreachable!()
     };
-    assert_eq!(ss.boundary, WalkBoundary::Dielectric);
+    assert_eq!(ss.boundary(), WalkBoundary::Dielectric);
     let ball = placed(shapes::sphere(2), Vec3::splat(1.0), Vec3::ZERO);
     let make = |b| {
         scene(
@@ -835,7 +837,7 @@ fn study_matrix_has_the_other_boundary() {
     let applied = apply(&s, &row.overrides).unwrap();
     for m in &applied.materials {
         if let Material::Subsurface(ss) = m {
-            assert_eq!(ss.boundary, WalkBoundary::Diffuse { exit_nee: true });
+            assert_eq!(ss.boundary(), WalkBoundary::Diffuse { exit_nee: true });
         }
     }
     assert!(!matrix(&s, true, &[Backend::Bvh])

@@ -456,14 +456,14 @@ fn cases() -> Vec<Case> {
         case(
             "subsurface bad axes",
             format!("{CAM}{SSS}preset = \"skin1\"\naxes = \"tangent\"\n"),
-            "expected \"curvature\", \"normal\" or \"mis3\", found \"tangent\"",
+            "expected \"curvature\" or \"mis3\", found \"tangent\"",
             Some("tangent"),
             Some("materials.skin.axes"),
         ),
         case(
             "subsurface bad channel",
             format!("{CAM}{SSS}preset = \"skin1\"\nchannel = \"all\"\n"),
-            "expected \"single\" or \"mis\", found \"all\"",
+            "expected \"mis\", found \"all\"",
             Some("all"),
             Some("materials.skin.channel"),
         ),

@@ -185,7 +185,7 @@ fn annulus_reference(a: f64, d: f64, r1: f64, r2: f64, h: f64, le: f64) -> f64 {
 fn pencil_beam_profile_follows_a_times_r() {
     let base = slab_scene();
     let ss = slab_material(&base);
-    let d_ref = ss.params.d[1]; // bins in units of the green channel's d
+    let d_ref = ss.params().d[1]; // bins in units of the green channel's d
     let h = 2e-4f32;
     let le = 1.0f32;
     let edges: Vec<f64> = (0..=6)
@@ -227,8 +227,8 @@ fn pencil_beam_profile_follows_a_times_r() {
             let (mean, se) = mean_se(&film);
             for c in 0..3 {
                 let expect = annulus_reference(
-                    ss.params.albedo[c],
-                    ss.params.d[c],
+                    ss.params().albedo[c],
+                    ss.params().d[c],
                     r1,
                     r2,
                     h as f64,

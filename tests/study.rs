@@ -84,7 +84,7 @@ fn slab_exact_samplers_are_unbiased_and_outputs_exist() {
     let Material::Subsurface(ss) = &applied.materials[0] else {
         panic!("slab material")
     };
-    let expected = ss.probe.planar_reflectance();
+    let expected = ss.probe().planar_reflectance();
     assert!((expected[0] / 0.2 - 0.999).abs() < 1e-6, "{expected:?}");
 
     // Exact samplers (analytic = baseline, mixture) and the tabulated

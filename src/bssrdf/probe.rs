@@ -25,7 +25,8 @@ use crate::sampling::Draw;
 /// Which axes probes are shot along.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum ProbeAxes {
-    /// Along the shading normal only (normal-only axes).
+    /// Along the shading normal only: normal-only axes (King et al. 2013),
+    /// a research variant.
     Normal,
     /// N, T, B with probabilities ½, ¼, ¼ and the balance heuristic.
     Mis3,
@@ -110,7 +111,8 @@ pub fn tangent_probability(kd: f64) -> f64 {
 /// How the color channels share one probe sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum ChannelStrategy {
-    /// Estimate only the channel the radius was sampled for (single-channel sampling).
+    /// Estimate only the channel the radius was sampled for: one channel
+    /// per sample (King et al. 2013), a research variant.
     Single,
     /// Estimate all channels with the balance heuristic over channels.
     #[default]

@@ -97,9 +97,9 @@ impl<'a> Context<'a> {
                 crate::materials::Material::Subsurface(ss) => {
                     // only the `curvature` axis rule reads sharp edges
                     let reads_edges =
-                        ss.probe.options().axes == crate::bssrdf::ProbeAxes::Curvature;
+                        ss.probe().options().axes == crate::bssrdf::ProbeAxes::Curvature;
                     let reach = if reads_edges {
-                        ss.probe.rmax() as f32
+                        ss.probe().rmax() as f32
                     } else {
                         0.0
                     };

@@ -778,7 +778,7 @@ fn subsurface_probe<'s>(
         let split = depth < COAT_SPLIT_DEPTH;
         // The smooth coat: a mirror reflecting Fr.
         let fr = fresnel::dielectric(wo.dot(n_out).max(0.0), ss.eta());
-        if !ss.specular {
+        if !ss.specular() {
             *beta *= 1.0 - fr;
         } else if split {
             *beta *= 1.0 - fr;
@@ -809,7 +809,7 @@ fn subsurface_probe<'s>(
     } else {
         0.0
     };
-    if !ss.specular || e <= 0.0 {
+    if !ss.specular() || e <= 0.0 {
         *beta *= 1.0 - e;
         return entry_scatter(entries(
             ctx, ss, si, wo, beta, rng, scratch, counters, depth, width,
@@ -926,7 +926,7 @@ fn entries<'s>(
     // of detail above and the curvature correction read the triangle's.
     let kappa = ctx.axes_curvature(si.geom, si.prim, si.p);
     let cv =
-        ss.control_variate && control_variate::applies(ctx.cv_depth, ctx.plan.area_lights, depth);
+        ss.control_variate() && control_variate::applies(ctx.cv_depth, ctx.plan.area_lights, depth);
     // The control variate's light samples, drawn before the probe's randoms.
     let lights = cv.then(|| [draw_light(ctx, rng), None]);
     let u = ProbeRandoms::from_rng(rng);
@@ -938,14 +938,14 @@ fn entries<'s>(
         )
     });
     let beta_in = *beta;
-    if !(ss.probe_pair && depth < ctx.pair_depth) {
+    if !(ss.probe_pair() && depth < ctx.pair_depth) {
         let (seg, plane) = if cv {
-            match ss.probe.sample_probe_and_plane(si.p, &frame_o, kappa, &u) {
+            match ss.probe().sample_probe_and_plane(si.p, &frame_o, kappa, &u) {
                 Some(sp) => sp,
                 None => return (None, None, Ahead::default()),
             }
         } else {
-            match ss.probe.sample_probe(si.p, &frame_o, kappa, &u) {
+            match ss.probe().sample_probe(si.p, &frame_o, kappa, &u) {
                 Some(seg) => (seg, None),
                 None => return (None, None, Ahead::default()),
             }
@@ -975,14 +975,14 @@ fn entries<'s>(
     // entry_on_segment reads.
     let ([seg_a, seg_b], plane) = if cv {
         match ss
-            .probe
+            .probe()
             .sample_probe_pair_and_plane(si.p, &frame_o, kappa, &u)
         {
             Some(sp) => sp,
             None => return (None, None, Ahead::default()),
         }
     } else {
-        match ss.probe.sample_probe_pair(si.p, &frame_o, kappa, &u) {
+        match ss.probe().sample_probe_pair(si.p, &frame_o, kappa, &u) {
             Some(segs) => (segs, None),
             None => return (None, None, Ahead::default()),
         }
@@ -1059,7 +1059,7 @@ impl<'s> CvModel<'s> {
             xo: si.p,
             n: frame_o.n,
             kappa: k_mean,
-            a_plane: Vec3::from_array(ss.probe.planar_reflectance().map(|a| a as f32)),
+            a_plane: Vec3::from_array(ss.probe().planar_reflectance().map(|a| a as f32)),
             f_o: exit.map_or(Vec3::ONE, |e| e.at_exit_alone()),
         }
     }
@@ -1165,7 +1165,7 @@ fn probe_entry<'s>(
         geom: si.geom,
         mesh: &ctx.scene.meshes[si.geom as usize],
     };
-    let ps = entry_on_segment(&ss.probe, seg, u, &target, &mut scratch.probe_hits)?;
+    let ps = entry_on_segment(ss.probe(), seg, u, &target, &mut scratch.probe_hits)?;
     // The curvature correction (bssrdf::curvature_correction): None, and
     // the weight untouched, on flat and concave surfaces.
     let mut weight = ps.weight;

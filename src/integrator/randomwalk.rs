@@ -117,13 +117,13 @@ fn walk_hit<'s>(
 ) -> Scatter<'s> {
     // Parameters built by hand without a medium leave nothing to
     // simulate; the path ends as at a black surface.
-    let Some(medium) = ss.params.medium else {
+    let Some(medium) = ss.params().medium else {
         return Scatter::Absorbed;
     };
     // As in the path tracer, the side the ray arrives from is
     // "outside", so a mesh wound inside-out still works.
     let n_out = if si.front { si.ng } else { -si.ng };
-    match ss.boundary {
+    match ss.boundary() {
         WalkBoundary::Dielectric => {
             let frame = Frame::from_normal(n_out);
             let s = dielectric::sample(ss.eta(), frame.to_local(wo), rng.uniform());

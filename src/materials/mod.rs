@@ -5,6 +5,8 @@
 
 pub mod dielectric;
 pub mod diffuse;
+#[cfg(feature = "subsurface")]
+pub mod estimator_options;
 pub mod lod;
 #[cfg(feature = "subsurface")]
 pub mod microfacet;
@@ -15,9 +17,11 @@ pub mod subsurface;
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
+#[cfg(feature = "subsurface")]
+pub use estimator_options::{CurvatureMode, EstimatorOptions, WalkBoundary, OPTIONS};
 pub use lod::LodMode;
 #[cfg(feature = "subsurface")]
-pub use subsurface::{CurvatureMode, Subsurface, SubsurfaceOverrides, WalkBoundary};
+pub use subsurface::{Subsurface, SubsurfaceOverrides};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {

@@ -10,8 +10,7 @@
 //!
 //! where Ft = 1 − Fr is always applied at xo, optionally as the complement
 //! of a specular reflection layer, and the lobe at xi is either the
-//! normalized Fresnel lobe Sw (pbrt-v3 §11.4) or, as in the seed, a plain
-//! cosine lobe 1/π.
+//! normalized Fresnel lobe Sw (pbrt-v3 §11.4) or a plain cosine lobe 1/π.
 //!
 //! **The coat.** The boundary is smooth (`roughness` = 0, a mirror) or a
 //! rough GGX dielectric ([`super::microfacet`], α = roughness²). For a rough
@@ -25,148 +24,47 @@
 //! weighted by the transmitted fraction (1 − Fr or 1 − E) and the reflected
 //! light is lost, for either roughness.
 
-use super::lod::{LodMode, LodRule, DEFAULT_THRESHOLD};
+use super::estimator_options::{CurvatureMode, EstimatorOptions, WalkBoundary, OPTIONS};
+use super::lod::{LodMode, LodRule};
 use super::microfacet::{alpha_from_roughness, RoughCoat, SMOOTH_ALPHA};
 use crate::bssrdf::curvature_correction::CurvatureCorrection;
 use crate::bssrdf::{sw_normalization, ProbeOptions, ProbeSampler, SubsurfaceParams};
 use crate::error::{Constraint, Param, ParamError};
 use crate::geometry::Vec3;
 
+/// A subsurface material: its medium, its sampling options and what is
+/// derived from them once (the probe sampler, the coat, the curvature
+/// correction, the LOD rule), private so that they cannot disagree.
 #[derive(Clone, Debug)]
 pub struct Subsurface {
-    pub params: SubsurfaceParams,
-    pub probe: ProbeSampler,
-    /// Use the normalized Fresnel lobe Sw at the entry point xi (else 1/π).
-    pub exit_sw: bool,
-    /// Put a specular reflection layer (probability Fr) on top at xo; else
-    /// the path is weighted by Ft = 1 − Fr and the reflected part is lost.
-    pub specular: bool,
-    /// The boundary the random-walk integrator simulates (the diffusion
-    /// estimator ignores it).
-    pub boundary: WalkBoundary,
-    /// The coat's roughness in [0, 1] (α = roughness²); 0 is a mirror.
-    pub roughness: f32,
+    params: SubsurfaceParams,
+    options: EstimatorOptions,
+    probe: ProbeSampler,
     /// The rough coat, when α ≥ [`SMOOTH_ALPHA`]; None: the smooth one.
     coat: Option<RoughCoat>,
     /// c = 1 − 2 FM1(1/η), Sw's normalization (for a rough coat, 1 − Ē).
     sw_c: f32,
-    /// Whether the diffusion weight is corrected for the surface's
-    /// curvature (`bssrdf::curvature_correction`).
-    pub curvature_mode: CurvatureMode,
     /// The correction, when the mode is on and the parameters record a
     /// medium.
     curvature: Option<CurvatureCorrection>,
     /// The level-of-detail rule ([`super::lod`]).
     lod: LodRule,
-    /// At the camera vertex, the plane control variate on the entry
-    /// point's light sample (`integrator::control_variate`; the default).
-    pub control_variate: bool,
-    /// At the camera vertex, an antithetic pair of probes instead of one
-    /// (`integrator::path`, `PAIR_DEPTH`; off by default).
-    pub probe_pair: bool,
-}
-
-/// The scene's `curvature_correction` setting.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum CurvatureMode {
-    /// Correct the diffusion weight on convex surfaces (the default).
-    #[default]
-    Auto,
-    /// The half-space profile everywhere.
-    Off,
-}
-
-impl CurvatureMode {
-    /// "auto" or "off" (case-insensitive).
-    pub fn parse(s: &str) -> Option<Self> {
-        match s.to_ascii_lowercase().as_str() {
-            "auto" => Some(CurvatureMode::Auto),
-            "off" => Some(CurvatureMode::Off),
-            _ => None,
-        }
-    }
 }
 
 impl PartialEq for Subsurface {
     fn eq(&self, o: &Self) -> bool {
-        self.params == o.params
-            && self.probe.options() == o.probe.options()
-            && self.exit_sw == o.exit_sw
-            && self.specular == o.specular
-            && self.boundary == o.boundary
-            && self.roughness == o.roughness
-            && self.curvature_mode == o.curvature_mode
-            && self.lod.mode == o.lod.mode
-            && self.lod.threshold == o.lod.threshold
-            && self.control_variate == o.control_variate
-            && self.probe_pair == o.probe_pair
+        self.params == o.params && self.options == o.options
     }
 }
 
 impl Subsurface {
-    pub fn new(
+    /// The material of medium `params` sampled with `options`, everything
+    /// derived from them built (an option out of its domain is refused).
+    pub fn from_options(
         params: SubsurfaceParams,
-        opts: &ProbeOptions,
-        exit_sw: bool,
-        specular: bool,
+        options: &EstimatorOptions,
     ) -> Result<Self, ParamError> {
-        let probe = ProbeSampler::new(&params, opts)?;
-        let curvature = curvature_for(&params, &probe, CurvatureMode::default());
-        let lod = LodRule::new(
-            LodMode::default(),
-            DEFAULT_THRESHOLD,
-            probe.rmax(),
-            probe.planar_reflectance(),
-        );
-        Ok(Subsurface {
-            sw_c: sw_normalization(params.eta),
-            params,
-            probe,
-            exit_sw,
-            specular,
-            boundary: WalkBoundary::Dielectric,
-            roughness: 0.0,
-            coat: None,
-            curvature_mode: CurvatureMode::default(),
-            curvature,
-            lod,
-            control_variate: true,
-            probe_pair: false,
-        })
-    }
-
-    /// The material with level-of-detail `mode` and footprint-to-Rmax
-    /// `threshold` (finite, > 0; the scene loader checks it).
-    pub fn with_lod(mut self, mode: LodMode, threshold: f32) -> Self {
-        self.lod = LodRule::new(
-            mode,
-            threshold,
-            self.probe.rmax(),
-            self.probe.planar_reflectance(),
-        );
-        self
-    }
-
-    /// The level-of-detail rule.
-    pub fn lod(&self) -> &LodRule {
-        &self.lod
-    }
-
-    /// The material with the curvature correction `mode`.
-    pub fn with_curvature_mode(mut self, mode: CurvatureMode) -> Self {
-        self.curvature_mode = mode;
-        self.curvature = curvature_for(&self.params, &self.probe, mode);
-        self
-    }
-
-    /// The curvature correction of the diffusion weight, if on.
-    pub fn curvature_correction(&self) -> Option<&CurvatureCorrection> {
-        self.curvature.as_ref()
-    }
-
-    /// The material with a coat of `roughness` ∈ [0, 1] (NaN is refused);
-    /// below α = [`SMOOTH_ALPHA`] the coat is the smooth one.
-    pub fn with_roughness(mut self, roughness: f32) -> Result<Self, ParamError> {
+        let roughness = options.roughness;
         if !(0.0..=1.0).contains(&roughness) {
             return Err(ParamError::new(
                 Param::Roughness,
@@ -174,14 +72,154 @@ impl Subsurface {
                 Constraint::UnitInterval,
             ));
         }
+        let probe = ProbeSampler::new(&params, &options.probe)?;
+        let curvature = curvature_for(&params, &probe, options.curvature);
+        let lod = LodRule::new(
+            options.lod,
+            options.lod_threshold,
+            probe.rmax(),
+            probe.planar_reflectance(),
+        );
         let alpha = alpha_from_roughness(roughness);
-        self.roughness = roughness;
-        self.coat = (alpha >= SMOOTH_ALPHA).then(|| RoughCoat::new(alpha, self.params.eta));
-        self.sw_c = match &self.coat {
+        let coat = (alpha >= SMOOTH_ALPHA).then(|| RoughCoat::new(alpha, params.eta));
+        let sw_c = match &coat {
             Some(c) => 1.0 - c.mean_albedo(),
-            None => sw_normalization(self.params.eta),
+            None => sw_normalization(params.eta),
         };
-        Ok(self)
+        Ok(Subsurface {
+            params,
+            options: *options,
+            probe,
+            coat,
+            sw_c,
+            curvature,
+            lod,
+        })
+    }
+
+    /// The material with probe options `opts`, the lobe `exit_sw` and the
+    /// coat's reflection `specular`; every other option its default.
+    pub fn new(
+        params: SubsurfaceParams,
+        opts: &ProbeOptions,
+        exit_sw: bool,
+        specular: bool,
+    ) -> Result<Self, ParamError> {
+        let options = EstimatorOptions {
+            probe: *opts,
+            exit_sw,
+            specular,
+            ..EstimatorOptions::default()
+        };
+        Self::from_options(params, &options)
+    }
+
+    /// The same medium sampled with `options`.
+    pub fn with_options(&self, options: &EstimatorOptions) -> Result<Self, ParamError> {
+        Self::from_options(self.params, options)
+    }
+
+    /// The material with level-of-detail `mode` and footprint-to-Rmax
+    /// `threshold` (finite, > 0; the scene loader checks it).
+    pub fn with_lod(self, mode: LodMode, threshold: f32) -> Self {
+        let options = EstimatorOptions {
+            lod: mode,
+            lod_threshold: threshold,
+            ..self.options
+        };
+        self.with_options(&options)
+            .expect("options already accepted")
+    }
+
+    /// The material with the curvature correction `mode`.
+    pub fn with_curvature_mode(self, mode: CurvatureMode) -> Self {
+        let options = EstimatorOptions {
+            curvature: mode,
+            ..self.options
+        };
+        self.with_options(&options)
+            .expect("options already accepted")
+    }
+
+    /// The material with a coat of `roughness` ∈ [0, 1] (NaN is refused);
+    /// below α = [`SMOOTH_ALPHA`] the coat is the smooth one.
+    pub fn with_roughness(self, roughness: f32) -> Result<Self, ParamError> {
+        let options = EstimatorOptions {
+            roughness,
+            ..self.options
+        };
+        self.with_options(&options)
+    }
+
+    /// The medium's parameters.
+    #[inline]
+    pub fn params(&self) -> &SubsurfaceParams {
+        &self.params
+    }
+
+    /// Every sampling option.
+    #[inline]
+    pub fn options(&self) -> &EstimatorOptions {
+        &self.options
+    }
+
+    /// The probe sampler.
+    #[inline]
+    pub fn probe(&self) -> &ProbeSampler {
+        &self.probe
+    }
+
+    /// Whether the entry point's lobe is the normalized Fresnel lobe Sw
+    /// (else 1/π).
+    #[inline]
+    pub fn exit_sw(&self) -> bool {
+        self.options.exit_sw
+    }
+
+    /// Whether the coat's reflection is rendered (else the path is
+    /// weighted by the transmitted fraction and the reflected part lost).
+    #[inline]
+    pub fn specular(&self) -> bool {
+        self.options.specular
+    }
+
+    /// The coat's roughness in [0, 1] (α = roughness²); 0 is a mirror.
+    #[inline]
+    pub fn roughness(&self) -> f32 {
+        self.options.roughness
+    }
+
+    /// The boundary the random-walk integrator simulates (the diffusion
+    /// estimator ignores it).
+    #[inline]
+    pub fn boundary(&self) -> WalkBoundary {
+        self.options.boundary
+    }
+
+    /// At the camera vertex, the plane control variate on the entry
+    /// point's light sample (`integrator::control_variate`).
+    #[inline]
+    pub fn control_variate(&self) -> bool {
+        self.options.control_variate
+    }
+
+    /// At the camera vertex, an antithetic pair of probes instead of one
+    /// (`integrator::path`, `PAIR_DEPTH`).
+    #[inline]
+    pub fn probe_pair(&self) -> bool {
+        self.options.probe_pair
+    }
+
+    /// The level-of-detail rule.
+    #[inline]
+    pub fn lod(&self) -> &LodRule {
+        &self.lod
+    }
+
+    /// The curvature correction of the diffusion weight, if on.
+    #[inline]
+    pub fn curvature_correction(&self) -> Option<&CurvatureCorrection> {
+        self.curvature.as_ref()
     }
 
     /// The rough coat, or None for a smooth one.
@@ -199,7 +237,7 @@ impl Subsurface {
         if cos <= 0.0 {
             return 0.0;
         }
-        if self.exit_sw {
+        if self.options.exit_sw {
             match &self.coat {
                 Some(c) => (1.0 - c.albedo(cos)) * std::f32::consts::FRAC_1_PI / self.sw_c,
                 None => crate::bssrdf::sw(cos, self.params.eta, self.sw_c),
@@ -231,41 +269,6 @@ fn curvature_for(
     }
 }
 
-/// The boundary of a subsurface object in the random walk
-/// (`docs/bssrdf.md` §7, `crate::integrator::randomwalk`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum WalkBoundary {
-    /// The exact smooth dielectric: Fresnel reflection or refraction along
-    /// Snell's direction.
-    #[default]
-    Dielectric,
-    /// The same Fresnel probabilities, but transmission forgets the
-    /// direction (`crate::integrator::diffuse_boundary`): a different model,
-    /// whose exit point is a vertex where lights are sampled.
-    /// `exit_nee: false` renders the same model without light sampling at
-    /// the exit (for tests and measurements; not in the scene format).
-    Diffuse { exit_nee: bool },
-}
-
-impl WalkBoundary {
-    /// "dielectric" or "diffuse" (case-insensitive).
-    pub fn parse(s: &str) -> Option<Self> {
-        match s.to_ascii_lowercase().as_str() {
-            "dielectric" => Some(WalkBoundary::Dielectric),
-            "diffuse" => Some(WalkBoundary::Diffuse { exit_nee: true }),
-            _ => None,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            WalkBoundary::Dielectric => "dielectric",
-            WalkBoundary::Diffuse { exit_nee: true } => "diffuse",
-            WalkBoundary::Diffuse { exit_nee: false } => "diffuse-no-nee",
-        }
-    }
-}
-
 /// Sampling choices that replace a material's own (from the command line
 /// or a study configuration); `None` keeps the material's setting.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -286,57 +289,75 @@ pub struct SubsurfaceOverrides {
 
 impl Subsurface {
     /// Every sampling option, `key=value` separated by spaces, with the
-    /// names the scene format and the command line use (for the EXR
-    /// header).
+    /// names of the option table (for the EXR header).
     pub fn sampling_description(&self) -> String {
-        let o = self.probe.options();
-        format!(
-            "radius={} rmax_quantile={} axes={} channel={} renormalize={} exit_sw={} \
-             specular={} roughness={} boundary={} lod={} lod_threshold={} \
-             control_variate={} probe_pair={}",
-            o.radius.name(),
-            o.rmax_quantile,
-            o.axes.name(),
-            o.channel.name(),
-            o.renormalize,
-            self.exit_sw,
-            self.specular,
-            self.roughness,
-            self.boundary.name(),
-            self.lod.mode.name(),
-            self.lod.threshold,
-            self.control_variate,
-            self.probe_pair
-        )
+        let all: Vec<String> = OPTIONS
+            .iter()
+            .filter(|o| o.name != "curvature_correction")
+            .map(|o| format!("{}={}", o.name, (o.get)(&self.options)))
+            .collect();
+        all.join(" ")
     }
 }
 
 impl SubsurfaceOverrides {
+    /// The options given, `key=value` separated by spaces in a fixed
+    /// order, with the names the scene format and the command line use (a
+    /// part's identity: stable across builds, unlike `Debug`).
+    pub fn canonical(&self) -> String {
+        let pairs: [(&str, Option<String>); 12] = [
+            ("radius", self.radius.map(|r| r.name())),
+            ("rmax_quantile", self.rmax_quantile.map(|q| q.to_string())),
+            ("axes", self.axes.map(|a| a.name().into())),
+            ("channel", self.channel.map(|c| c.name().into())),
+            ("renormalize", self.renormalize.map(|b| b.to_string())),
+            ("exit_sw", self.exit_sw.map(|b| b.to_string())),
+            ("specular", self.specular.map(|b| b.to_string())),
+            ("boundary", self.boundary.map(|b| b.name().into())),
+            ("roughness", self.roughness.map(|r| r.to_string())),
+            ("lod", self.lod.map(|l| l.name().into())),
+            (
+                "control_variate",
+                self.control_variate.map(|b| b.to_string()),
+            ),
+            ("probe_pair", self.probe_pair.map(|b| b.to_string())),
+        ];
+        let given: Vec<String> = pairs
+            .into_iter()
+            .filter_map(|(k, v)| Some(format!("{k}={}", v?)))
+            .collect();
+        given.join(" ")
+    }
+
     pub fn is_empty(&self) -> bool {
         *self == SubsurfaceOverrides::default()
     }
 
+    /// `o` with these choices applied.
+    pub fn over(&self, o: &EstimatorOptions) -> EstimatorOptions {
+        let p = &o.probe;
+        EstimatorOptions {
+            probe: ProbeOptions {
+                radius: self.radius.unwrap_or(p.radius),
+                rmax_quantile: self.rmax_quantile.unwrap_or(p.rmax_quantile),
+                axes: self.axes.unwrap_or(p.axes),
+                channel: self.channel.unwrap_or(p.channel),
+                renormalize: self.renormalize.unwrap_or(p.renormalize),
+            },
+            exit_sw: self.exit_sw.unwrap_or(o.exit_sw),
+            specular: self.specular.unwrap_or(o.specular),
+            roughness: self.roughness.unwrap_or(o.roughness),
+            boundary: self.boundary.unwrap_or(o.boundary),
+            lod: self.lod.unwrap_or(o.lod),
+            control_variate: self.control_variate.unwrap_or(o.control_variate),
+            probe_pair: self.probe_pair.unwrap_or(o.probe_pair),
+            ..*o
+        }
+    }
+
     /// The material with these choices applied (its parameters unchanged).
     pub fn apply(&self, ss: &Subsurface) -> Result<Subsurface, ParamError> {
-        let mut opts = *ss.probe.options();
-        opts.radius = self.radius.unwrap_or(opts.radius);
-        opts.rmax_quantile = self.rmax_quantile.unwrap_or(opts.rmax_quantile);
-        opts.axes = self.axes.unwrap_or(opts.axes);
-        opts.channel = self.channel.unwrap_or(opts.channel);
-        opts.renormalize = self.renormalize.unwrap_or(opts.renormalize);
-        let mut out = Subsurface::new(
-            ss.params,
-            &opts,
-            self.exit_sw.unwrap_or(ss.exit_sw),
-            self.specular.unwrap_or(ss.specular),
-        )?
-        .with_roughness(self.roughness.unwrap_or(ss.roughness))?
-        .with_curvature_mode(ss.curvature_mode)
-        .with_lod(self.lod.unwrap_or(ss.lod.mode), ss.lod.threshold);
-        out.boundary = self.boundary.unwrap_or(ss.boundary);
-        out.control_variate = self.control_variate.unwrap_or(ss.control_variate);
-        out.probe_pair = self.probe_pair.unwrap_or(ss.probe_pair);
-        Ok(out)
+        ss.with_options(&self.over(&ss.options))
     }
 
     /// Applies the overrides to every subsurface material of `materials`.
@@ -365,25 +386,28 @@ mod tests {
             ..Default::default()
         };
         let out = ov.apply(&ss).unwrap();
-        assert_eq!(out.probe.options().axes, ProbeAxes::Normal);
-        assert_eq!(out.probe.options().radius, RadiusSampler::Analytic);
-        assert!(out.exit_sw && !out.specular);
-        assert_eq!(out.params, ss.params);
-        assert_eq!(out.boundary, WalkBoundary::Dielectric);
+        assert_eq!(out.probe().options().axes, ProbeAxes::Normal);
+        assert_eq!(out.probe().options().radius, RadiusSampler::Analytic);
+        assert!(out.exit_sw() && !out.specular());
+        assert_eq!(out.params(), ss.params());
+        assert_eq!(out.boundary(), WalkBoundary::Dielectric);
         let walk = SubsurfaceOverrides {
             boundary: WalkBoundary::parse("Diffuse"),
             ..Default::default()
         }
         .apply(&out)
         .unwrap();
-        assert_eq!(walk.boundary, WalkBoundary::Diffuse { exit_nee: true });
-        assert!(walk != out && walk.exit_sw && !walk.specular);
+        assert_eq!(walk.boundary(), WalkBoundary::Diffuse { exit_nee: true });
+        assert!(walk != out && walk.exit_sw() && !walk.specular());
         assert_eq!(WalkBoundary::parse("lambert"), None);
         let bad = SubsurfaceOverrides {
             rmax_quantile: Some(1.5),
             ..Default::default()
         };
         assert!(bad.apply(&ss).is_err());
+        // the identity names options as the scene format does, not as Debug
+        assert_eq!(ov.canonical(), "axes=normal specular=false");
+        assert_eq!(SubsurfaceOverrides::default().canonical(), "");
         // lobe: Sw integrates to 1 against cos; the plain lobe is 1/π
         assert_eq!(out.lobe(-0.1), 0.0);
         let plain = SubsurfaceOverrides {

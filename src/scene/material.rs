@@ -19,21 +19,19 @@ use super::key_path::key_segment;
 #[cfg(feature = "subsurface")]
 use super::MAX_SUBSURFACE_RADIUS;
 #[cfg(feature = "subsurface")]
-use crate::bssrdf::{
-    AlbedoSource, ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler,
-    SubsurfaceParams,
-};
+use crate::bssrdf::{AlbedoSource, Fit, Measured, SubsurfaceParams};
 #[cfg(feature = "subsurface")]
 use crate::error::{Constraint, InputError, Param, ParamError};
 #[cfg(feature = "subsurface")]
-use crate::materials::lod::DEFAULT_THRESHOLD;
+use crate::materials::estimator_options::{EstimatorOptions, OptionError, OPTIONS};
 use crate::materials::Material;
 #[cfg(feature = "subsurface")]
-use crate::materials::{CurvatureMode, LodMode, Subsurface, WalkBoundary};
+use crate::materials::Subsurface;
 
-/// The keys a `type = "subsurface"` material accepts.
+/// The parameter keys a `type = "subsurface"` material accepts; its
+/// sampling options are the option table's ([`OPTIONS`]).
 #[cfg(feature = "subsurface")]
-const SUBSURFACE_KEYS: &[&str] = &[
+const PARAMETER_KEYS: &[&str] = &[
     "preset",
     "sigma_s_prime",
     "sigma_a",
@@ -43,20 +41,6 @@ const SUBSURFACE_KEYS: &[&str] = &[
     "eta",
     "fit",
     "albedo_source",
-    "radius",
-    "rmax_quantile",
-    "axes",
-    "channel",
-    "renormalize",
-    "exit_sw",
-    "specular",
-    "boundary",
-    "roughness",
-    "curvature_correction",
-    "lod",
-    "lod_threshold",
-    "control_variate",
-    "probe_pair",
 ];
 
 /// The parameter forms, for messages.
@@ -113,67 +97,16 @@ pub(super) fn material(
         )),
         #[cfg(feature = "subsurface")]
         MaterialKind::Subsurface => {
-            cx.only_keys(&field, kind.name(), d.present_keys(), SUBSURFACE_KEYS)?;
-            let mut ss = Subsurface::new(
-                parameters(cx, &field, m, units_per_mm as f64)?,
-                &sampling_options(cx, &field, m)?,
-                flag(&d.exit_sw),
-                flag(&d.specular),
-            )
-            .and_then(|ss| {
-                ss.with_roughness(d.roughness.as_ref().map_or(0.0, |r| *r.get_ref() as f32))
-            })
-            .map_err(|e| locate_param(cx, &field, m, &e))?;
-            if let Some((s, span)) = text(&d.boundary) {
-                ss.boundary = WalkBoundary::parse(s).ok_or_else(|| {
-                    cx.err(
-                        span,
-                        &format!("{field}.boundary"),
-                        format!("expected \"dielectric\" or \"diffuse\", found \"{s}\""),
-                    )
-                })?;
-            }
-            if let Some((s, span)) = text(&d.curvature_correction) {
-                let mode = CurvatureMode::parse(s).ok_or_else(|| {
-                    cx.err(
-                        span,
-                        &format!("{field}.curvature_correction"),
-                        format!("expected \"auto\" or \"off\", found \"{s}\""),
-                    )
-                })?;
-                ss = ss.with_curvature_mode(mode);
-            }
-            let lod = match text(&d.lod) {
-                Some((s, span)) => LodMode::parse_scene(s).ok_or_else(|| {
-                    cx.err(
-                        span,
-                        &format!("{field}.lod"),
-                        format!("expected \"auto\" or \"off\", found \"{s}\""),
-                    )
-                })?,
-                None => LodMode::default(),
-            };
-            let threshold = match &d.lod_threshold {
-                Some(t) => {
-                    let v = *t.get_ref();
-                    if !(v.is_finite() && v > 0.0 && v <= f32::MAX as f64) {
-                        return Err(cx.err(
-                            t.span(),
-                            &format!("{field}.lod_threshold"),
-                            format!("expected a finite number > 0 (footprint / Rmax), found {v}"),
-                        ));
-                    }
-                    v as f32
-                }
-                None => DEFAULT_THRESHOLD,
-            };
-            ss = ss.with_lod(lod, threshold);
-            if let Some(b) = &d.control_variate {
-                ss.control_variate = *b.get_ref();
-            }
-            if let Some(b) = &d.probe_pair {
-                ss.probe_pair = *b.get_ref();
-            }
+            let keys: Vec<&str> = PARAMETER_KEYS
+                .iter()
+                .copied()
+                .chain(OPTIONS.iter().map(|o| o.name))
+                .collect();
+            cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
+            let params = parameters(cx, &field, m, units_per_mm as f64)?;
+            let options = estimator_options(cx, &field, m)?;
+            let ss = Subsurface::from_options(params, &options)
+                .map_err(|e| locate_param(cx, &field, m, &e))?;
             check_rmax(cx, &field, m, &ss, units_per_mm, units_def)?;
             Ok(Material::Subsurface(Arc::new(ss)))
         }
@@ -194,7 +127,7 @@ fn check_rmax(
     units_per_mm: f32,
     units_def: Option<&Spanned<f64>>,
 ) -> Res<()> {
-    let rmax = ss.probe.rmax();
+    let rmax = ss.probe().rmax();
     let lim = MAX_SUBSURFACE_RADIUS;
     if rmax <= lim {
         return Ok(());
@@ -240,12 +173,6 @@ fn check_rmax(
         None => field.to_string(),
     };
     Err(cx.err(span, &f, format!("the subsurface probe radius is {why}")))
-}
-
-/// A boolean option, true when absent.
-#[cfg(feature = "subsurface")]
-fn flag(b: &Option<Spanned<bool>>) -> bool {
-    b.as_ref().map(|b| *b.get_ref()).unwrap_or(true)
 }
 
 #[cfg(feature = "subsurface")]
@@ -437,54 +364,83 @@ fn measured(
     })
 }
 
-/// The sampling options of a subsurface material (defaults for the keys it
-/// does not give).
+/// The value of option `key` in the material table `d`, as text, and its
+/// span.
 #[cfg(feature = "subsurface")]
-fn sampling_options(cx: &Cx, field: &str, m: &Spanned<MaterialDef>) -> Res<ProbeOptions> {
+fn option_value(d: &MaterialDef, key: &str) -> Option<(String, std::ops::Range<usize>)> {
+    let s = |v: &Option<Spanned<String>>| v.as_ref().map(|v| (v.get_ref().clone(), v.span()));
+    let b = |v: &Option<Spanned<bool>>| v.as_ref().map(|v| (v.get_ref().to_string(), v.span()));
+    let f = |v: &Option<Spanned<f64>>| v.as_ref().map(|v| (v.get_ref().to_string(), v.span()));
+    match key {
+        "radius" => s(&d.radius),
+        "rmax_quantile" => f(&d.rmax_quantile),
+        "axes" => s(&d.axes),
+        "channel" => s(&d.channel),
+        "renormalize" => b(&d.renormalize),
+        "exit_sw" => b(&d.exit_sw),
+        "specular" => b(&d.specular),
+        "roughness" => f(&d.roughness),
+        "boundary" => s(&d.boundary),
+        "curvature_correction" => s(&d.curvature_correction),
+        "lod" => s(&d.lod),
+        "lod_threshold" => f(&d.lod_threshold),
+        "control_variate" => b(&d.control_variate),
+        "probe_pair" => b(&d.probe_pair),
+        _ => None,
+    }
+}
+
+/// The sampling options of a subsurface material, read through the
+/// option table (defaults for the keys it does not give).
+#[cfg(feature = "subsurface")]
+fn estimator_options(cx: &Cx, field: &str, m: &Spanned<MaterialDef>) -> Res<EstimatorOptions> {
     let d = m.get_ref();
-    let f = |k: &str| format!("{field}.{k}");
-    let mut opts = ProbeOptions::default();
-    if let Some((s, _)) = text(&d.radius) {
-        opts.radius = RadiusSampler::parse(s).map_err(|e| locate_param(cx, field, m, &e))?;
-    }
-    if let Some(q) = &d.rmax_quantile {
-        let v = cx.scalar(q, &f("rmax_quantile"))? as f64;
-        if !(v > 0.0 && v < 1.0) {
-            return Err(cx.err(
-                q.span(),
-                &f("rmax_quantile"),
-                format!("expected a number in (0, 1), found {v}"),
-            ));
+    let mut o = EstimatorOptions::default();
+    for row in &OPTIONS {
+        let Some((v, span)) = option_value(d, row.name) else {
+            continue;
+        };
+        let f = format!("{field}.{}", row.name);
+        if !row.research_in_scenes && row.is_research(&v) {
+            return Err(cx.err(span, &f, row.expected(&v).to_string()));
         }
-        opts.rmax_quantile = *q.get_ref();
+        check_number(cx, &f, d, row.name)?;
+        (row.set)(&mut o, &v).map_err(|e| match e {
+            OptionError::Param(e) => locate_param(cx, field, m, &e),
+            e => cx.err(span, &f, e.to_string()),
+        })?;
     }
-    if let Some((s, span)) = text(&d.axes) {
-        opts.axes = match ProbeAxes::parse(s) {
-            Some(a) => a,
-            None => {
+    Ok(o)
+}
+
+/// The scene's own range checks of the numeric options (finite, in their
+/// domain), located at their key.
+#[cfg(feature = "subsurface")]
+fn check_number(cx: &Cx, f: &str, d: &MaterialDef, key: &str) -> Res<()> {
+    match key {
+        "rmax_quantile" => {
+            let q = d.rmax_quantile.as_ref().expect("present");
+            let v = cx.scalar(q, f)? as f64;
+            if !(v > 0.0 && v < 1.0) {
                 return Err(cx.err(
-                    span,
-                    &f("axes"),
-                    format!("expected \"curvature\", \"normal\" or \"mis3\", found \"{s}\""),
-                ))
+                    q.span(),
+                    f,
+                    format!("expected a number in (0, 1), found {v}"),
+                ));
             }
-        };
-    }
-    if let Some((s, span)) = text(&d.channel) {
-        opts.channel = match s.to_ascii_lowercase().as_str() {
-            "single" => ChannelStrategy::Single,
-            "mis" => ChannelStrategy::Mis,
-            _ => {
+        }
+        "lod_threshold" => {
+            let t = d.lod_threshold.as_ref().expect("present");
+            let v = *t.get_ref();
+            if !(v.is_finite() && v > 0.0 && v <= f32::MAX as f64) {
                 return Err(cx.err(
-                    span,
-                    &f("channel"),
-                    format!("expected \"single\" or \"mis\", found \"{s}\""),
-                ))
+                    t.span(),
+                    f,
+                    format!("expected a finite number > 0 (footprint / Rmax), found {v}"),
+                ));
             }
-        };
+        }
+        _ => {}
     }
-    if let Some(b) = &d.renormalize {
-        opts.renormalize = *b.get_ref();
-    }
-    Ok(opts)
+    Ok(())
 }

@@ -318,7 +318,7 @@ impl Explanation {
                 #[cfg(feature = "subsurface")]
                 Material::Subsurface(ss) if walk => {
                     walk_material(ss, &mut mp);
-                    if ss.boundary == WalkBoundary::Dielectric && ss.params.medium.is_some() {
+                    if ss.boundary() == WalkBoundary::Dielectric && ss.params().medium.is_some() {
                         specular_materials.push(mname.clone());
                         specular_why.push(format!("{mname}: the walk's dielectric boundary"));
                     }
@@ -329,7 +329,7 @@ impl Explanation {
                     if active {
                         probes_needed.push(mname.clone());
                     }
-                    if ss.specular && ss.rough_coat().is_none() {
+                    if ss.specular() && ss.rough_coat().is_none() {
                         specular_materials.push(mname.clone());
                         specular_why.push(format!("{mname}: the mirror coat"));
                     }
@@ -483,15 +483,19 @@ fn diffusion_material(
     area_lights: bool,
     mp: &mut MaterialPlan,
 ) -> bool {
-    let pair_depth = if ss.probe_pair { opts.pair_depth } else { 0 };
-    let cv_depth = if ss.control_variate && area_lights {
+    let pair_depth = if ss.probe_pair() { opts.pair_depth } else { 0 };
+    let cv_depth = if ss.control_variate() && area_lights {
         opts.cv_depth
     } else {
         0
     };
-    let cv_asked = if ss.control_variate { opts.cv_depth } else { 0 };
-    let o = ss.probe.options();
-    let active: [bool; 3] = std::array::from_fn(|c| ss.params.active(c));
+    let cv_asked = if ss.control_variate() {
+        opts.cv_depth
+    } else {
+        0
+    };
+    let o = ss.probe().options();
+    let active: [bool; 3] = std::array::from_fn(|c| ss.params().active(c));
     let any = active.iter().any(|&a| a);
     let lod = ss.lod().decision();
     let every_hit_lod = any && lod.can_trigger && lod.min_width == Some(0.0);
@@ -524,19 +528,20 @@ fn diffusion_material(
     } else {
         "one chosen by Fr".to_string()
     };
-    mp.coat = Some(match (ss.rough_coat(), ss.specular) {
+    mp.coat = Some(match (ss.rough_coat(), ss.specular()) {
         (None, true) => choice(
             "smooth",
             format!(
                 "roughness {}: a mirror reflecting Fr, {split}",
-                ss.roughness
+                ss.roughness()
             ),
         ),
         (Some(c), true) => choice(
             "rough",
             format!(
                 "roughness {}: GGX α = {}, light-sampled at xo, chosen with probability E(μo)",
-                ss.roughness, c.ggx.alpha
+                ss.roughness(),
+                c.ggx.alpha
             ),
         ),
         (_, false) => choice(
@@ -544,7 +549,7 @@ fn diffusion_material(
             "specular = false: reflection not rendered, the medium weighted by 1 − Fr",
         ),
     });
-    mp.exit_lobe = Some(match (ss.exit_sw, ss.rough_coat().is_some()) {
+    mp.exit_lobe = Some(match (ss.exit_sw(), ss.rough_coat().is_some()) {
         (true, false) => choice("sw", "exit_sw: the normalized Fresnel lobe Sw at xi"),
         (true, true) => choice("sw-rough", "exit_sw: (1 − E(μi)) / ((1 − Ē) π) at xi"),
         (false, _) => choice("cosine", "exit_sw = false: 1/π at xi"),
@@ -570,17 +575,17 @@ fn diffusion_material(
 /// A used subsurface material under the random walk.
 #[cfg(feature = "subsurface")]
 fn walk_material(ss: &Subsurface, mp: &mut MaterialPlan) {
-    let Some(medium) = ss.params.medium else {
+    let Some(medium) = ss.params().medium else {
         mp.subsurface = vec![SubsurfaceMethod::None {
             reason: "no medium recorded: the path ends there (a black surface)".into(),
         }];
         return;
     };
     mp.subsurface = vec![SubsurfaceMethod::RandomWalk {
-        boundary: ss.boundary.name().into(),
+        boundary: ss.boundary().name().into(),
         reason: "--integrator randomwalk: the medium simulated event by event".into(),
     }];
-    mp.coat = Some(match ss.boundary {
+    mp.coat = Some(match ss.boundary() {
         WalkBoundary::Dielectric => choice(
             "dielectric",
             "the walk's exact Fresnel boundary replaces the coat (roughness, specular unused)",
@@ -590,7 +595,7 @@ fn walk_material(ss: &Subsurface, mp: &mut MaterialPlan) {
             "Fresnel probabilities, transmission forgets the direction",
         ),
     });
-    mp.exit_lobe = Some(match ss.boundary {
+    mp.exit_lobe = Some(match ss.boundary() {
         WalkBoundary::Dielectric => choice("refraction", "leaves along Snell's direction"),
         WalkBoundary::Diffuse { exit_nee: true } => {
             choice("diffuse-exit", "exit lobe at the exit point, light-sampled")

@@ -175,7 +175,7 @@ pub fn reference_overrides() -> Overrides {
 /// choices, which the baseline keeps and the Fresnel axes flip.
 fn scene_fresnel(scene: &Scene) -> Option<(bool, bool)> {
     scene.materials.iter().find_map(|m| match m {
-        Material::Subsurface(ss) => Some((ss.exit_sw, ss.specular)),
+        Material::Subsurface(ss) => Some((ss.exit_sw(), ss.specular())),
         _ => None,
     })
 }
@@ -186,7 +186,7 @@ fn scene_variance(scene: &Scene) -> (bool, bool) {
         .materials
         .iter()
         .find_map(|m| match m {
-            Material::Subsurface(ss) => Some((ss.control_variate, ss.probe_pair)),
+            Material::Subsurface(ss) => Some((ss.control_variate(), ss.probe_pair())),
             _ => None,
         })
         .unwrap_or((true, false))
@@ -198,7 +198,7 @@ fn scene_boundary(scene: &Scene) -> WalkBoundary {
         .materials
         .iter()
         .find_map(|m| match m {
-            Material::Subsurface(ss) => Some(ss.boundary),
+            Material::Subsurface(ss) => Some(ss.boundary()),
             _ => None,
         })
         .unwrap_or_default()

@@ -1,0 +1,234 @@
+//! Running a [`Request`]: load, resolve, render (resuming and keeping
+//! checkpoints), write the frame or the part.
+
+use std::ops::Range;
+use std::time::Instant;
+
+use super::checkpoint::{self, Checkpoints};
+use super::identity;
+use super::output::check_exr_output;
+use super::resume::resumable;
+use super::{overrides, Request, Split};
+use crate::accel;
+use crate::error::{Error, InputError};
+use crate::farm::part;
+use crate::film::exr_layers::{self, OutputOptions};
+use crate::film::region::Region;
+use crate::render::{self, Accumulated, RenderStats, Settings};
+use crate::scene::{self, Scene};
+
+/// What a finished render did (for its summary line).
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    pub region: Region,
+    pub frame: (u32, u32),
+    pub samples: Range<u32>,
+    pub spp: u32,
+    pub is_part: bool,
+    pub triangles: usize,
+    pub accel_name: String,
+    pub stats: RenderStats,
+    /// Ray queries the backend refused as out of range.
+    pub rejected_rays: u64,
+}
+
+impl Outcome {
+    /// The summary line of the render written to `output`.
+    pub fn summary(&self, output: &std::path::Path) -> String {
+        let (w, h) = self.frame;
+        format!(
+            "{}: {}{} of {w}×{h}, samples {}..{} of {}, {} triangles: {}",
+            output.display(),
+            if self.is_part { "part, " } else { "" },
+            self.region,
+            self.samples.start,
+            self.samples.end,
+            self.spp,
+            self.triangles,
+            self.stats.summary(&self.accel_name)
+        )
+    }
+}
+
+/// [`Error::Interrupted`] once a signal asked the process to stop.
+pub fn stop_if_interrupted() -> Result<(), Error> {
+    match crate::interrupt::requested() {
+        Some(sig) => Err(Error::Interrupted(sig)),
+        None => Ok(()),
+    }
+}
+
+/// `--spp` and `--threads` of at least 1.
+fn check_counts(r: &Request) -> Result<(), Error> {
+    for (argument, v) in [
+        ("--spp", r.opts.spp.map(|s| s as usize)),
+        ("--threads", r.opts.threads),
+    ] {
+        if v == Some(0) {
+            return Err(Error::Argument {
+                argument: argument.into(),
+                problem: "must be at least 1".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The pixels `split` asks for, inside the `w`×`h` frame.
+fn region_of(split: &Split, w: u32, h: u32) -> Result<Region, Error> {
+    Ok(match (split.crop, split.tile) {
+        (Some(c), _) if !c.within(&Region::full(w, h)) => {
+            return Err(Error::Argument {
+                argument: "--crop".into(),
+                problem: format!("{c} is not inside the {w}×{h} frame"),
+            })
+        }
+        (Some(c), _) => c,
+        (None, Some((i, n))) => Region::band(i, n, w, h).ok_or_else(|| Error::Argument {
+            argument: "--tile".into(),
+            problem: format!("{i}/{n}: the {w}×{h} frame splits into at most {h} bands"),
+        })?,
+        (None, None) => Region::full(w, h),
+    })
+}
+
+/// The sample indices `split` asks for, within `0..spp`.
+fn samples_of(split: &Split, spp: u32) -> Result<Range<u32>, Error> {
+    let samples = split.samples.clone().unwrap_or(0..spp);
+    if samples.end > spp {
+        return Err(Error::Argument {
+            argument: "--samples".into(),
+            problem: format!(
+                "{}..{} reaches beyond the {spp} samples per pixel",
+                samples.start, samples.end
+            ),
+        });
+    }
+    Ok(samples)
+}
+
+/// The scene of `r` with its overrides applied, its text, and the
+/// overrides' canonical text.
+fn load(r: &Request) -> Result<(Scene, String, String), Error> {
+    let mut scene = scene::load(&r.scene)?;
+    let text = scene::load::read_regular_file(&r.scene, scene::load::MAX_SCENE_BYTES)
+        .map_err(|e| InputError::new(&r.scene, format!("cannot read scene file: {e}")))?;
+    let options = overrides::apply(&r.overrides, &mut scene.materials)?;
+    Ok((scene, text, options))
+}
+
+/// Renders `r` and writes its frame or part; a signal keeps the finished
+/// samples as a part to resume from ([`Error::InterruptedKept`]).
+pub fn run(r: &Request) -> Result<Outcome, Error> {
+    check_exr_output(&r.output)?;
+    check_counts(r)?;
+    let (scene, text, options) = load(r)?;
+    let settings = Settings::resolved(&scene, &r.opts);
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let region = region_of(&r.split, w, h)?;
+    let samples = samples_of(&r.split, settings.spp)?;
+    let passes = r.aov.unwrap_or(scene.output.aovs);
+    let layout = (!passes.is_empty()).then(|| crate::integrator::aov::layout(&scene, passes));
+    let mut out = r
+        .file
+        .over(scene.output.file.over(OutputOptions::default()));
+    let identity = identity::identity(
+        text.as_bytes(),
+        &scene,
+        &settings,
+        r.backend,
+        &options,
+        layout.as_ref(),
+        &out,
+    );
+    let scene_name = r
+        .scene
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let header = |sums: &Accumulated| part::Header {
+        identity: identity.clone(),
+        scene: scene_name.clone(),
+        region,
+        samples: sums.start..sums.done,
+        requested: samples.clone(),
+        layers: part::layers_of(layout.as_ref()),
+        counters: sums.counters,
+    };
+    let job = render::Job {
+        region,
+        samples: samples.clone(),
+        pass_seconds: r.split.checkpoint.map_or(2.0, |c| (c / 2.0).min(2.0)),
+        passes,
+    };
+    let resume = match &r.split.resume {
+        Some(p) => Some(resumable(p, &identity, &job)?),
+        None => None,
+    };
+    stop_if_interrupted()?;
+    let traversal = settings.integrator.traversal(scene.settings.traversal);
+    let accel = accel::build_with(&scene.meshes, r.backend, traversal)?;
+    stop_if_interrupted()?;
+    out.preview = Some(r.preview);
+    let keep = checkpoint::checkpoint_path(&r.output);
+    let mut checkpoints = Checkpoints {
+        path: &keep,
+        every: r.split.checkpoint,
+        end: samples.end,
+        last: Instant::now(),
+    };
+    let mut after_pass = |sums: &Accumulated| checkpoints.after_pass(sums, &header(sums));
+    let done = render::render_job(
+        &scene,
+        accel.as_ref(),
+        &r.opts,
+        &job,
+        resume,
+        &mut after_pass,
+    )?;
+    if let Some(signal) = done.interrupted {
+        if done.sums.count() == 0 {
+            return Err(Error::Interrupted(signal));
+        }
+        let staged = part::stage(&keep, &header(&done.sums), &done.sums)?;
+        crate::film::commit_even_if_interrupted(vec![staged])?;
+        return Err(Error::InterruptedKept {
+            signal,
+            part: keep,
+            samples: done.sums.start..done.sums.done,
+            requested: samples,
+        });
+    }
+    if r.split.is_part() {
+        crate::film::commit_all(vec![part::stage(
+            &r.output,
+            &header(&done.sums),
+            &done.sums,
+        )?])?;
+    } else {
+        let header = identity::frame_header(
+            &r.scene,
+            &text,
+            &scene,
+            accel.name(),
+            r.backend,
+            &settings,
+            done.stats.seconds,
+        )?;
+        let (layers, coverage) = done.sums.layers()?;
+        let film = done.sums.film()?;
+        exr_layers::write_frame(&r.output, &film, &layers, &coverage, &header, &out)?;
+    }
+    checkpoint::clean(&keep);
+    Ok(Outcome {
+        region,
+        frame: (w, h),
+        samples,
+        spp: settings.spp,
+        is_part: r.split.is_part(),
+        triangles: scene.triangle_count(),
+        accel_name: accel.name().into(),
+        stats: done.stats,
+        rejected_rays: accel.rejected_rays(),
+    })
+}
