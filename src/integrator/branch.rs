@@ -3,7 +3,8 @@
 //! §13.1.1).
 
 use super::aov::Event;
-use super::lobe::PrevVertex;
+use super::lobe::{Bounce, PrevVertex};
+use super::Interaction;
 use crate::geometry::{Ray, Vec3};
 use crate::materials::lod::Cone;
 use crate::sampling::{Draw, SampleRng};
@@ -34,6 +35,30 @@ pub(crate) struct Branch {
     pub(crate) depth: u32,
     pub(crate) event: Event,
     pub(crate) cone: Cone,
+}
+
+impl Branch {
+    /// Goes on along `b`, which leaves the object `from` (if it cannot
+    /// meet it), with the footprint `cone`.
+    #[inline(always)]
+    pub(crate) fn go_on(&mut self, b: Bounce, from: Option<u32>, cone: Cone) {
+        (self.ray, self.beta, self.prev) = (b.ray, b.beta, b.prev);
+        self.from = from;
+        self.cone = cone;
+    }
+}
+
+/// Where a path is at a hit: the interaction, ωo, the distance along the
+/// ray, the depth, whether it is the first hit of a recorded path, and the
+/// footprint a specular or a lobe continuation has from there.
+pub(crate) struct At<'a> {
+    pub(crate) si: &'a Interaction,
+    pub(crate) wo: Vec3,
+    pub(crate) t: f32,
+    pub(crate) depth: u32,
+    pub(crate) first: bool,
+    pub(crate) cone_specular: Cone,
+    pub(crate) cone_rough: Cone,
 }
 
 /// A fixed-capacity stack of [`Branch`]es (no allocation per sample).

@@ -11,8 +11,8 @@
 //! "The coat", §11.
 
 use super::aov::{self, Event, Recorder, Source};
-use super::branch::{roulette, Branch, Branches};
-use super::lobe::Vertex;
+use super::branch::{roulette, At, Branch, Branches};
+use super::lobe::{Bounce, Vertex};
 use super::nee::{emission_weight, record_direct, NeeAt};
 use super::scatter::{Scatter, SubsurfaceScatter};
 use super::state::PathState;
@@ -31,13 +31,13 @@ pub(crate) use super::subsurface::COAT_SPLIT_DEPTH;
 #[cfg(feature = "subsurface")]
 use super::{
     scatter::SubsurfaceHit,
-    subsurface::{At, Resolved},
+    subsurface::{resolve, Resolved},
 };
 
 /// Subsurface hits at depths below this, on materials with `probe_pair`
 /// on (off by default), sample two entry points from one probe's randoms,
 /// the second at the opposite angle φ + π, and light at both
-/// (`docs/bssrdf.md` §5, "The antithetic pair"). 1: the camera vertex (the
+/// (`docs/bssrdf.md` §5, "Along a path"). 1: the camera vertex (the
 /// default of [`Context::pair_depth`]).
 pub const PAIR_DEPTH: u32 = 1;
 
@@ -118,64 +118,38 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
         };
         let object = &ctx.scene.objects[hit.geom as usize];
         let si = ctx.interaction(&path.ray, &hit);
-        let wo = -path.ray.d;
+        let at = at::<R>(&si, &path, &hit, depth);
         if R::ON && depth == 0 {
             st.rec.camera_hit(hit.geom, si.p);
         }
         // Le, MIS-weighted against next-event estimation.
         if let (Some(le), true) = (object.emission, si.front) {
-            let c = path.beta * le * emission_weight(ctx, &si, wo, path.prev);
-            l += c;
-            let found = aov::found(path.event, depth, Pass::Emission);
-            st.rec.light(c, found, Source::Object(hit.geom));
+            l += emitted(ctx, &path, le, &at, hit.geom, st.rec);
         }
         if depth == max_depth {
             break;
         }
-        // The object a ray the material continues with leaves, where known.
-        let mut continue_from = None;
-        let scatter = match &ctx.scene.materials[object.material] {
-            Material::Diffuse { albedo } => {
-                Scatter::Vertex(diffuse_vertex(ctx, &si, wo, *albedo, st.rec))
-            }
-            Material::Dielectric { eta } => {
-                let (next, e) = dielectric_bounce(ctx, *eta, &si, wo, &mut path.beta, st.rng);
-                continue_from = ctx.leaving_towards(&si, next.d);
-                Scatter::Continue(next, e)
-            }
-            #[cfg(feature = "subsurface")]
-            Material::Subsurface(ss) => {
-                let h = SubsurfaceHit {
-                    ss,
-                    si: &si,
-                    wo,
-                    depth,
-                    width: path.cone.width_at(hit.t),
-                };
-                subsurface_hit::<R, T, S>(ctx, &h, &mut path.beta, st, subsurface)
-            }
-        };
-        // The footprint after this vertex: specular continuations keep the
-        // cone's spread, lobes widen it.
-        let (cone_specular, cone_rough) = (path.cone.specular(hit.t), path.cone.rough(hit.t));
-        // At the first hit the path's class becomes that of what scattered.
-        let first = R::ON && depth == 0;
+        let material = &ctx.scene.materials[object.material];
+        let scatter = scatter_at::<R, T, S>(ctx, material, &at, &mut path, st, subsurface);
         // Borrowed, not moved out: the vertex stays where it was built.
         let (vertex, nee) = match &scatter {
             Scatter::Vertex(v) => {
-                if first {
+                if at.first {
                     path.event = v.lobe.event();
                 }
                 (v, NeeAt::PLAIN)
             }
             Scatter::Continue(next, e) => {
-                if first {
+                if at.first {
                     path.event = *e;
                 }
-                path.prev = None;
-                path.ray = *next;
-                path.from = continue_from;
-                path.cone = cone_specular;
+                let from = continued_from(ctx, material, &si, next);
+                let b = Bounce {
+                    ray: *next,
+                    beta: path.beta,
+                    prev: None,
+                };
+                path.go_on(b, from, at.cone_specular);
                 if !roulette(depth, &mut path.beta, st.rng) {
                     break;
                 }
@@ -185,14 +159,7 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
             Scatter::Absorbed => break,
             #[cfg(feature = "subsurface")]
             Scatter::Coated(c) => {
-                let at = At {
-                    si: &si,
-                    depth,
-                    first,
-                    cone_specular,
-                };
-                match super::subsurface::resolve::<R, T>(ctx, c, &at, &mut path, &mut l, st, stack)
-                {
+                match resolve::<R, T>(ctx, c, &at, &mut path, &mut l, st, stack) {
                     Resolved::Vertex(v, nee) => (v, nee),
                     Resolved::Bounce => {
                         if !roulette(depth, &mut path.beta, st.rng) {
@@ -214,14 +181,88 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
         let Some(b) = vertex.bounce(ctx.ray_epsilon, path.beta, st.rng.uniform2_packed()) else {
             break;
         };
-        (path.ray, path.beta, path.prev) = (b.ray, b.beta, b.prev);
-        path.from = vertex.outside_of;
-        path.cone = cone_rough;
+        path.go_on(b, vertex.outside_of, at.cone_rough);
         if !roulette(depth, &mut path.beta, st.rng) {
             break;
         }
     }
     l
+}
+
+/// Where `path` is at `hit`. The footprint after the vertex: specular
+/// continuations keep the cone's spread, lobes widen it. At the first hit
+/// of a recorded path its class becomes that of what scattered.
+#[inline(always)]
+fn at<'a, R: Recorder>(si: &'a Interaction, path: &Branch, hit: &Hit, depth: u32) -> At<'a> {
+    At {
+        si,
+        wo: -path.ray.d,
+        t: hit.t,
+        depth,
+        first: R::ON && depth == 0,
+        cone_specular: path.cone.specular(hit.t),
+        cone_rough: path.cone.rough(hit.t),
+    }
+}
+
+/// The emission of the object `geom` hit at `at`, MIS-weighted, recorded.
+#[inline(always)]
+fn emitted<R: Recorder>(
+    ctx: &Context,
+    path: &Branch,
+    le: Vec3,
+    at: &At,
+    geom: u32,
+    rec: &mut R,
+) -> Vec3 {
+    let c = path.beta * le * emission_weight(ctx, at.si, at.wo, path.prev);
+    let found = aov::found(path.event, at.depth, Pass::Emission);
+    rec.light(c, found, Source::Object(geom));
+    c
+}
+
+/// What the material at `at` scatters into (`path.beta` scaled by it).
+#[inline(always)]
+fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
+    ctx: &'s Context,
+    material: &'s Material,
+    at: &At,
+    path: &mut Branch,
+    st: &mut PathState<R>,
+    subsurface: &mut S,
+) -> Scatter<'s> {
+    match material {
+        Material::Diffuse { albedo } => {
+            Scatter::Vertex(diffuse_vertex(ctx, at.si, at.wo, *albedo, st.rec))
+        }
+        Material::Dielectric { eta } => {
+            let (next, e) = dielectric_bounce(ctx, *eta, at.si, at.wo, &mut path.beta, st.rng);
+            Scatter::Continue(next, e)
+        }
+        #[cfg(feature = "subsurface")]
+        Material::Subsurface(ss) => {
+            let width = path.cone.width_at(at.t);
+            let (si, wo, depth) = (at.si, at.wo, at.depth);
+            let h = SubsurfaceHit {
+                ss,
+                si,
+                wo,
+                depth,
+                width,
+            };
+            subsurface_hit::<R, T, S>(ctx, &h, &mut path.beta, st, subsurface)
+        }
+    }
+}
+
+/// The object a ray the material at `si` continues with leaves, where
+/// known (through a dielectric; a medium's exit is not culled from).
+#[inline(always)]
+fn continued_from(ctx: &Context, material: &Material, si: &Interaction, next: &Ray) -> Option<u32> {
+    match material {
+        Material::Dielectric { .. } => ctx.leaving_towards(si, next.d),
+        _ => None,
+    }
 }
 
 /// The nearest hit along the path's ray, timed as the camera's (depth 0)

@@ -9,7 +9,7 @@ mod cv_model;
 mod entries;
 mod split;
 
-pub(crate) use split::{resolve, At, Resolved};
+pub(crate) use split::{resolve, Resolved};
 
 use super::aov::Recorder;
 use super::branch::MAX_BRANCHES;
@@ -23,7 +23,7 @@ use crate::materials::Subsurface;
 
 /// Smooth-coated subsurface hits at depths below this split into the
 /// mirror reflection and the medium (both followed); deeper ones choose
-/// one. 1: the camera vertex only (`docs/bssrdf.md` §6, "Splitting").
+/// one. 1: the camera vertex only (`docs/bssrdf.md` §6, "The coat").
 pub(crate) const COAT_SPLIT_DEPTH: u32 = 1;
 const _: () = assert!(COAT_SPLIT_DEPTH as usize <= MAX_BRANCHES);
 

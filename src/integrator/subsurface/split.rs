@@ -6,23 +6,12 @@
 
 use crate::geometry::Vec3;
 use crate::integrator::aov::{self, Event, Recorder, Source};
-use crate::integrator::branch::{roulette, Branch, Branches};
+use crate::integrator::branch::{roulette, At, Branch, Branches};
 use crate::integrator::coated::Coated;
 use crate::integrator::lobe::{Bounce, Vertex};
 use crate::integrator::nee::{direct_lighting, direct_lighting_ahead, record_direct, NeeAt};
 use crate::integrator::state::PathState;
-use crate::integrator::{Clock, Context, Interaction};
-use crate::materials::lod::Cone;
-
-/// The path vertex a coated hit happened at: the interaction, the depth,
-/// whether it is the first hit of a recorded path, and the footprint a
-/// specular continuation has.
-pub(crate) struct At<'a> {
-    pub(crate) si: &'a Interaction,
-    pub(crate) depth: u32,
-    pub(crate) first: bool,
-    pub(crate) cone_specular: Cone,
-}
+use crate::integrator::{Clock, Context};
 
 /// Where the path goes from a coated hit.
 pub(crate) enum Resolved<'v, 's> {
@@ -71,9 +60,8 @@ pub(crate) fn resolve<'v, 's, R: Recorder, T: Clock>(
     match (next, follow_reflected) {
         (Some(v), _) => Resolved::Vertex(v, entry::<R, T>(ctx, c, v, at, path, l, st)),
         (None, Some(r)) => {
-            (path.ray, path.beta, path.prev, path.event) = (r.ray, r.beta, r.prev, coat_event);
-            path.from = ctx.leaving_towards(at.si, r.ray.d);
-            path.cone = at.cone_specular;
+            path.event = coat_event;
+            path.go_on(r, ctx.leaving_towards(at.si, r.ray.d), at.cone_specular);
             Resolved::Bounce
         }
         (None, None) => Resolved::End,
