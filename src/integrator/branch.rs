@@ -3,7 +3,8 @@
 //! §13.1.1).
 
 use super::aov::Event;
-use super::lobe::{Bounce, PrevVertex};
+use super::lobe::{Bounce, PrevVertex, Vertex};
+use super::nee::NeeAt;
 use super::Interaction;
 use crate::geometry::{Ray, Vec3};
 use crate::materials::lod::Cone;
@@ -59,6 +60,16 @@ pub(crate) struct At<'a> {
     pub(crate) first: bool,
     pub(crate) cone_specular: Cone,
     pub(crate) cone_rough: Cone,
+}
+
+/// Where a path goes from a hit.
+pub(crate) enum Next<'v, 's> {
+    /// On from a vertex, with light sampled there as `NeeAt` asks.
+    Vertex(&'v Vertex<'s>, NeeAt),
+    /// Along the path's ray, already set (after roulette).
+    Bounce,
+    /// Nowhere: the path ends.
+    End,
 }
 
 /// A fixed-capacity stack of [`Branch`]es (no allocation per sample).

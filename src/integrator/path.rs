@@ -11,7 +11,7 @@
 //! "The coat", §11.
 
 use super::aov::{self, Event, Recorder, Source};
-use super::branch::{roulette, At, Branch, Branches};
+use super::branch::{roulette, At, Branch, Branches, Next};
 use super::lobe::{Bounce, Vertex};
 use super::nee::{emission_weight, record_direct, NeeAt};
 use super::scatter::{Scatter, SubsurfaceScatter};
@@ -29,10 +29,7 @@ pub use super::state::Scratch;
 #[cfg(feature = "subsurface")]
 pub(crate) use super::subsurface::COAT_SPLIT_DEPTH;
 #[cfg(feature = "subsurface")]
-use super::{
-    scatter::SubsurfaceHit,
-    subsurface::{resolve, Resolved},
-};
+use super::{scatter::SubsurfaceHit, subsurface::resolve};
 
 /// Subsurface hits at depths below this, on materials with `probe_pair`
 /// on (off by default), sample two entry points from one probe's randoms,
@@ -132,44 +129,15 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
         let material = &ctx.scene.materials[object.material];
         let scatter = scatter_at::<R, T, S>(ctx, material, &at, &mut path, st, subsurface);
         // Borrowed, not moved out: the vertex stays where it was built.
-        let (vertex, nee) = match &scatter {
-            Scatter::Vertex(v) => {
-                if at.first {
-                    path.event = v.lobe.event();
-                }
-                (v, NeeAt::PLAIN)
-            }
-            Scatter::Continue(next, e) => {
-                if at.first {
-                    path.event = *e;
-                }
-                let from = continued_from(ctx, material, &si, next);
-                let b = Bounce {
-                    ray: *next,
-                    beta: path.beta,
-                    prev: None,
-                };
-                path.go_on(b, from, at.cone_specular);
+        let (vertex, nee) = match next::<R, T>(ctx, &scatter, &at, &mut path, &mut l, st, stack) {
+            Next::Vertex(v, nee) => (v, nee),
+            Next::Bounce => {
                 if !roulette(depth, &mut path.beta, st.rng) {
                     break;
                 }
                 continue;
             }
-            #[cfg(feature = "subsurface")]
-            Scatter::Absorbed => break,
-            #[cfg(feature = "subsurface")]
-            Scatter::Coated(c) => {
-                match resolve::<R, T>(ctx, c, &at, &mut path, &mut l, st, stack) {
-                    Resolved::Vertex(v, nee) => (v, nee),
-                    Resolved::Bounce => {
-                        if !roulette(depth, &mut path.beta, st.rng) {
-                            break;
-                        }
-                        continue;
-                    }
-                    Resolved::End => break,
-                }
-            }
+            Next::End => break,
         };
         // Next-event estimation, then continue by sampling the lobe.
         if ctx.plan.area_lights {
@@ -187,6 +155,45 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
         }
     }
     l
+}
+
+/// Where the path goes from what the hit scattered into: on from a
+/// vertex, along a ray already set in `path`, or nowhere.
+#[inline(always)]
+#[cfg_attr(not(feature = "subsurface"), allow(unused_variables))]
+fn next<'v, 's, R: Recorder, T: Clock>(
+    ctx: &Context,
+    scatter: &'v Scatter<'s>,
+    at: &At,
+    path: &mut Branch,
+    l: &mut Vec3,
+    st: &mut PathState<R>,
+    stack: &mut Branches,
+) -> Next<'v, 's> {
+    match scatter {
+        Scatter::Vertex(v) => {
+            if at.first {
+                path.event = v.lobe.event();
+            }
+            Next::Vertex(v, NeeAt::PLAIN)
+        }
+        Scatter::Continue(ray, e) => {
+            if at.first {
+                path.event = *e;
+            }
+            let b = Bounce {
+                ray: *ray,
+                beta: path.beta,
+                prev: None,
+            };
+            path.go_on(b, path.from, at.cone_specular);
+            Next::Bounce
+        }
+        #[cfg(feature = "subsurface")]
+        Scatter::Absorbed => Next::End,
+        #[cfg(feature = "subsurface")]
+        Scatter::Coated(c) => resolve::<R, T>(ctx, c, at, path, l, st, stack),
+    }
 }
 
 /// Where `path` is at `hit`. The footprint after the vertex: specular
@@ -221,7 +228,9 @@ fn emitted<R: Recorder>(
     c
 }
 
-/// What the material at `at` scatters into (`path.beta` scaled by it).
+/// What the material at `at` scatters into (`path.beta` scaled by it);
+/// `path.from` becomes the object a continuation leaves, where known
+/// (through a dielectric; a medium's exit is not culled from).
 #[inline(always)]
 fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
     ctx: &'s Context,
@@ -237,10 +246,12 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
         }
         Material::Dielectric { eta } => {
             let (next, e) = dielectric_bounce(ctx, *eta, at.si, at.wo, &mut path.beta, st.rng);
+            path.from = ctx.leaving_towards(at.si, next.d);
             Scatter::Continue(next, e)
         }
         #[cfg(feature = "subsurface")]
         Material::Subsurface(ss) => {
+            path.from = None;
             let width = path.cone.width_at(at.t);
             let (si, wo, depth) = (at.si, at.wo, at.depth);
             let h = SubsurfaceHit {
@@ -252,16 +263,6 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
             };
             subsurface_hit::<R, T, S>(ctx, &h, &mut path.beta, st, subsurface)
         }
-    }
-}
-
-/// The object a ray the material at `si` continues with leaves, where
-/// known (through a dielectric; a medium's exit is not culled from).
-#[inline(always)]
-fn continued_from(ctx: &Context, material: &Material, si: &Interaction, next: &Ray) -> Option<u32> {
-    match material {
-        Material::Dielectric { .. } => ctx.leaving_towards(si, next.d),
-        _ => None,
     }
 }
 

@@ -9,7 +9,7 @@ mod cv_model;
 mod entries;
 mod split;
 
-pub(crate) use split::{resolve, Resolved};
+pub(crate) use split::resolve;
 
 use super::aov::Recorder;
 use super::branch::MAX_BRANCHES;

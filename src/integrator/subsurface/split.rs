@@ -6,22 +6,12 @@
 
 use crate::geometry::Vec3;
 use crate::integrator::aov::{self, Event, Recorder, Source};
-use crate::integrator::branch::{roulette, At, Branch, Branches};
+use crate::integrator::branch::{roulette, At, Branch, Branches, Next};
 use crate::integrator::coated::Coated;
 use crate::integrator::lobe::{Bounce, Vertex};
 use crate::integrator::nee::{direct_lighting, direct_lighting_ahead, record_direct, NeeAt};
 use crate::integrator::state::PathState;
 use crate::integrator::{Clock, Context};
-
-/// Where the path goes from a coated hit.
-pub(crate) enum Resolved<'v, 's> {
-    /// On from the entry vertex, with light sampled there as `NeeAt` asks.
-    Vertex(&'v Vertex<'s>, NeeAt),
-    /// Along the coat's reflection, now the path's ray (after roulette).
-    Bounce,
-    /// Nowhere: the path ends.
-    End,
-}
 
 /// Reads the coated hit `c` at `at` into `path`, adding the light it
 /// sampled to `l`; a reflection that waits is pushed on `stack`.
@@ -34,7 +24,7 @@ pub(crate) fn resolve<'v, 's, R: Recorder, T: Clock>(
     l: &mut Vec3,
     st: &mut PathState<R>,
     stack: &mut Branches,
-) -> Resolved<'v, 's> {
+) -> Next<'v, 's> {
     // The coat's reflections are specular.
     let coat_event = if at.first {
         Event::Specular
@@ -58,13 +48,13 @@ pub(crate) fn resolve<'v, 's, R: Recorder, T: Clock>(
     };
     add_terms(c, at, path.event, l, st.rec);
     match (next, follow_reflected) {
-        (Some(v), _) => Resolved::Vertex(v, entry::<R, T>(ctx, c, v, at, path, l, st)),
+        (Some(v), _) => Next::Vertex(v, entry::<R, T>(ctx, c, v, at, path, l, st)),
         (None, Some(r)) => {
             path.event = coat_event;
             path.go_on(r, ctx.leaving_towards(at.si, r.ray.d), at.cone_specular);
-            Resolved::Bounce
+            Next::Bounce
         }
-        (None, None) => Resolved::End,
+        (None, None) => Next::End,
     }
 }
 
