@@ -55,6 +55,7 @@ impl Branch {
 pub(crate) struct At<'a> {
     pub(crate) si: &'a Interaction,
     pub(crate) wo: Vec3,
+    #[cfg_attr(not(feature = "subsurface"), allow(dead_code))]
     pub(crate) t: f32,
     pub(crate) depth: u32,
     pub(crate) first: bool,
@@ -69,6 +70,7 @@ pub(crate) enum Next<'v, 's> {
     /// Along the path's ray, already set (after roulette).
     Bounce,
     /// Nowhere: the path ends.
+    #[cfg_attr(not(feature = "subsurface"), allow(dead_code))]
     End,
 }
 

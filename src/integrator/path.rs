@@ -160,7 +160,10 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
 /// Where the path goes from what the hit scattered into: on from a
 /// vertex, along a ray already set in `path`, or nowhere.
 #[inline(always)]
-#[cfg_attr(not(feature = "subsurface"), allow(unused_variables))]
+#[cfg_attr(
+    not(feature = "subsurface"),
+    allow(unused_variables, clippy::extra_unused_type_parameters)
+)]
 fn next<'v, 's, R: Recorder, T: Clock>(
     ctx: &Context,
     scatter: &'v Scatter<'s>,
@@ -232,6 +235,10 @@ fn emitted<R: Recorder>(
 /// `path.from` becomes the object a continuation leaves, where known
 /// (through a dielectric; a medium's exit is not culled from).
 #[inline(always)]
+#[cfg_attr(
+    not(feature = "subsurface"),
+    allow(unused_variables, clippy::extra_unused_type_parameters)
+)]
 fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
     ctx: &'s Context,
     material: &'s Material,

@@ -45,7 +45,7 @@
 //! a refracted direction is a delta, so no light can be sampled there, and
 //! small lights are noisy (relMSE×spp ≈ 87 on a 10 mm marble sphere under
 //! an 8 mm light, `docs/bssrdf.md` §7). Through the diffuse boundary the
-//! exit point is a path vertex with the exit lobe (`Lobe::WalkExit`),
+//! exit point is a path vertex with the exit lobe (`SubsurfaceLobe::WalkExit`),
 //! where the shared bounce loop samples the lights with MIS (≈ 0.5 on the
 //! same scene, for its own model, at the same cost per sample). Inside, Russian
 //! roulette on the walk's throughput ends absorbed walks early; walks longer
@@ -58,7 +58,7 @@
 use super::aov::{Event, Recorder};
 use super::diffuse_boundary::DiffuseBoundary;
 use super::interaction::offset_along;
-use super::lobe::{Lobe, Vertex};
+use super::lobe::{Lobe, SubsurfaceLobe, Vertex};
 use super::path::trace;
 use super::scatter::{Scatter, SubsurfaceHit, SubsurfaceScatter};
 use super::state::{PathState, Scratch};
@@ -215,7 +215,7 @@ fn diffuse_hit<'s>(
             ng: n_out,
             frame,
             wo_local: Vec3::Z,
-            lobe: Lobe::WalkExit(lobe),
+            lobe: Lobe::Subsurface(SubsurfaceLobe::WalkExit(lobe)),
             // The walk's exit is not culled from (the reference stays as
             // it was).
             outside_of: None,

@@ -7,7 +7,7 @@ use crate::fresnel;
 use crate::geometry::{Ray, Vec3};
 use crate::integrator::aov::{Event, Recorder};
 use crate::integrator::coated::Weighted;
-use crate::integrator::lobe::{Bounce, Lobe, Vertex};
+use crate::integrator::lobe::{Bounce, Lobe, SubsurfaceLobe, Vertex};
 use crate::integrator::scatter::{Scatter, SubsurfaceHit};
 use crate::integrator::state::PathState;
 use crate::integrator::{Context, Interaction};
@@ -99,10 +99,10 @@ fn rough<'s, R: Recorder>(
         ng: n_out,
         frame,
         wo_local,
-        lobe: Lobe::Coat {
+        lobe: Lobe::Subsurface(SubsurfaceLobe::Coat {
             coat: rc,
             select: e,
-        },
+        }),
         outside_of: ctx.leaving(si.geom, si.front),
     };
     if st.rng.uniform() < e {

@@ -9,7 +9,7 @@ use crate::geometry::{Frame, Vec3};
 use crate::integrator::aov::Recorder;
 use crate::integrator::coated::{Ahead, Coated, Weighted};
 use crate::integrator::control_variate;
-use crate::integrator::lobe::{Bounce, Lobe, Vertex};
+use crate::integrator::lobe::{Bounce, Lobe, SubsurfaceLobe, Vertex};
 use crate::integrator::nee::draw_light;
 use crate::integrator::probe::{entry_on_segment, ProbeTarget};
 use crate::integrator::scatter::{Scatter, SubsurfaceHit};
@@ -236,7 +236,7 @@ fn lod_entry<'s>(
         ng: if si.front { si.ng } else { -si.ng },
         frame: frame_o,
         wo_local: Vec3::Z,
-        lobe: Lobe::SubsurfaceEntry(ss),
+        lobe: Lobe::Subsurface(SubsurfaceLobe::Entry(ss)),
         outside_of: ctx.leaving(si.geom, si.front),
     }
 }
@@ -274,7 +274,7 @@ fn probe_entry<'s, R: Recorder>(
         ng: n_in,
         frame: Frame::from_normal(n_in),
         wo_local: Vec3::Z,
-        lobe: Lobe::SubsurfaceEntry(ss),
+        lobe: Lobe::Subsurface(SubsurfaceLobe::Entry(ss)),
         // n_in faces the side xo was seen from, as ng does at xo.
         outside_of: ctx.leaving(si.geom, si.front),
     };

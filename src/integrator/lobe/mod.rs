@@ -2,16 +2,15 @@
 //! itself: pbrt-v4's BSDF at a surface interaction, reduced to the lobes
 //! this renderer has (`docs/bssrdf.md` §1, §6 "The coat").
 
+#[cfg(feature = "subsurface")]
+mod subsurface;
+
 use super::aov::Event;
 use super::interaction::offset_along;
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::materials::diffuse;
 #[cfg(feature = "subsurface")]
-use crate::materials::microfacet::RoughCoat;
-#[cfg(feature = "subsurface")]
-use crate::materials::Subsurface;
-#[cfg(feature = "subsurface")]
-use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf};
+pub(crate) use subsurface::SubsurfaceLobe;
 
 /// A build without the `subsurface` feature has no subsurface material:
 /// the bounce loop's handler of subsurface hits takes this uninhabited
@@ -21,29 +20,37 @@ use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf};
 #[derive(Clone, Copy)]
 pub(crate) enum Subsurface {}
 
+/// Without the `subsurface` feature: no subsurface lobe (it borrows the
+/// uninhabited [`Subsurface`]).
+#[cfg(not(feature = "subsurface"))]
+#[derive(Clone, Copy)]
+pub(crate) struct SubsurfaceLobe<'a>(&'a Subsurface);
+
+#[cfg(not(feature = "subsurface"))]
+impl SubsurfaceLobe<'_> {
+    fn event(&self) -> Event {
+        match *self.0 {}
+    }
+    fn eval(&self, _: Vec3, _: Vec3) -> Vec3 {
+        match *self.0 {}
+    }
+    fn pdf(&self, _: Vec3, _: Vec3) -> f32 {
+        match *self.0 {}
+    }
+    fn sample(&self, _: Vec3, _: [f32; 2]) -> Option<LobeSample> {
+        match *self.0 {}
+    }
+}
+
 /// A non-specular lobe at a path vertex, in a local frame whose z axis is
 /// the normal on the side light leaves towards.
 #[derive(Clone, Copy)]
 pub(crate) enum Lobe<'a> {
     /// Lambertian reflection, ρ/π.
     Diffuse(Vec3),
-    /// The entry-point lobe of a subsurface material (Sw or 1/π), outward
-    /// side only; its spectral weight was already applied by the probe.
-    #[cfg(feature = "subsurface")]
-    SubsurfaceEntry(&'a Subsurface),
-    /// Where a random walk left the medium through a diffuse Fresnel
-    /// boundary ([`super::diffuse_boundary::ExitLobe`]).
-    #[cfg(feature = "subsurface")]
-    WalkExit(super::diffuse_boundary::ExitLobe),
-    /// A subsurface material's rough coat at xo, sampled with probability
-    /// `select` (its pdf, for MIS, is select × the visible-normal pdf).
-    #[cfg(feature = "subsurface")]
-    Coat { coat: &'a RoughCoat, select: f32 },
-    /// Without the `subsurface` feature: no lobe (uninhabited), keeping
-    /// the lifetime the subsurface lobes borrow with.
-    #[cfg(not(feature = "subsurface"))]
-    #[allow(dead_code)]
-    Absent(&'a Subsurface),
+    /// A subsurface material's or medium's lobe.
+    #[cfg_attr(not(feature = "subsurface"), allow(dead_code))]
+    Subsurface(SubsurfaceLobe<'a>),
 }
 
 /// A direction sampled from a lobe (local frame), with f |cos θ| / pdf
@@ -56,7 +63,7 @@ pub(crate) struct LobeSample {
 }
 
 impl LobeSample {
-    fn new((wi, weight, pdf): (Vec3, Vec3, f32)) -> Self {
+    pub(crate) fn new((wi, weight, pdf): (Vec3, Vec3, f32)) -> Self {
         LobeSample { wi, weight, pdf }
     }
 }
@@ -66,12 +73,7 @@ impl Lobe<'_> {
     pub(crate) fn event(&self) -> Event {
         match self {
             Lobe::Diffuse(_) => Event::Diffuse,
-            #[cfg(feature = "subsurface")]
-            Lobe::SubsurfaceEntry(_) | Lobe::WalkExit(_) => Event::Subsurface,
-            #[cfg(feature = "subsurface")]
-            Lobe::Coat { .. } => Event::Specular,
-            #[cfg(not(feature = "subsurface"))]
-            Lobe::Absent(s) => match **s {},
+            Lobe::Subsurface(s) => s.event(),
         }
     }
 
@@ -79,14 +81,7 @@ impl Lobe<'_> {
     pub(crate) fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             Lobe::Diffuse(albedo) => diffuse::eval(*albedo, wo, wi),
-            #[cfg(feature = "subsurface")]
-            Lobe::SubsurfaceEntry(ss) => Vec3::splat(ss.lobe(wi.z)),
-            #[cfg(feature = "subsurface")]
-            Lobe::WalkExit(exit) => Vec3::splat(exit.eval(wi)),
-            #[cfg(feature = "subsurface")]
-            Lobe::Coat { coat, .. } => Vec3::splat(coat.eval(wo, wi)),
-            #[cfg(not(feature = "subsurface"))]
-            Lobe::Absent(s) => match **s {},
+            Lobe::Subsurface(s) => s.eval(wo, wi),
         }
     }
 
@@ -94,14 +89,7 @@ impl Lobe<'_> {
     pub(crate) fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             Lobe::Diffuse(_) => diffuse::pdf(wo, wi),
-            #[cfg(feature = "subsurface")]
-            Lobe::SubsurfaceEntry(_) => cosine_hemisphere_pdf(wi.z),
-            #[cfg(feature = "subsurface")]
-            Lobe::WalkExit(exit) => exit.pdf(wi),
-            #[cfg(feature = "subsurface")]
-            Lobe::Coat { coat, select } => select * coat.pdf(wo, wi),
-            #[cfg(not(feature = "subsurface"))]
-            Lobe::Absent(s) => match **s {},
+            Lobe::Subsurface(s) => s.pdf(wo, wi),
         }
     }
 
@@ -110,25 +98,7 @@ impl Lobe<'_> {
     pub(crate) fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<LobeSample> {
         match self {
             Lobe::Diffuse(albedo) => diffuse::sample(*albedo, wo, u).map(LobeSample::new),
-            #[cfg(feature = "subsurface")]
-            Lobe::SubsurfaceEntry(ss) => {
-                let wi = cosine_hemisphere(u);
-                let pdf = cosine_hemisphere_pdf(wi.z);
-                (pdf > 0.0)
-                    .then(|| LobeSample::new((wi, Vec3::splat(ss.lobe(wi.z) * wi.z / pdf), pdf)))
-            }
-            #[cfg(feature = "subsurface")]
-            Lobe::WalkExit(exit) => exit
-                .sample(u)
-                .map(|(wi, w, pdf)| LobeSample::new((wi, Vec3::splat(w), pdf))),
-            #[cfg(feature = "subsurface")]
-            Lobe::Coat { coat, select } => {
-                let (wi, w, pdf) = coat.sample(wo, u)?;
-                (*select > 0.0)
-                    .then(|| LobeSample::new((wi, Vec3::splat(w / select), select * pdf)))
-            }
-            #[cfg(not(feature = "subsurface"))]
-            Lobe::Absent(s) => match **s {},
+            Lobe::Subsurface(s) => s.sample(wo, u),
         }
     }
 }
