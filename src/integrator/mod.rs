@@ -16,6 +16,9 @@
 //! only with the `subsurface` feature (the default).
 
 pub mod aov;
+mod branch;
+#[cfg(feature = "subsurface")]
+mod coated;
 #[cfg(feature = "subsurface")]
 pub mod control_variate;
 pub mod convex;
@@ -24,14 +27,20 @@ pub mod culling;
 pub mod diffuse_boundary;
 pub mod effects;
 pub mod interaction;
+mod lobe;
+mod nee;
 pub mod path;
 pub mod plan;
 #[cfg(feature = "subsurface")]
 pub mod probe;
 #[cfg(feature = "subsurface")]
 pub mod randomwalk;
+mod scatter;
 #[cfg(feature = "subsurface")]
 pub mod sharp_edges;
+mod state;
+#[cfg(feature = "subsurface")]
+mod subsurface;
 
 use crate::accel::{Accel, Traversal};
 use crate::lights::LightSet;

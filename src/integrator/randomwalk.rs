@@ -45,7 +45,7 @@
 //! a refracted direction is a delta, so no light can be sampled there, and
 //! small lights are noisy (relMSE×spp ≈ 87 on a 10 mm marble sphere under
 //! an 8 mm light, `docs/bssrdf.md` §7). Through the diffuse boundary the
-//! exit point is a path vertex with the exit lobe (`path::Lobe::WalkExit`),
+//! exit point is a path vertex with the exit lobe (`SubsurfaceLobe::WalkExit`),
 //! where the shared bounce loop samples the lights with MIS (≈ 0.5 on the
 //! same scene, for its own model, at the same cost per sample). Inside, Russian
 //! roulette on the walk's throughput ends absorbed walks early; walks longer
@@ -58,7 +58,10 @@
 use super::aov::{Event, Recorder};
 use super::diffuse_boundary::DiffuseBoundary;
 use super::interaction::offset_along;
-use super::path::{trace, Lobe, Scatter, Scratch, Vertex};
+use super::lobe::{Lobe, SubsurfaceLobe, Vertex};
+use super::path::trace;
+use super::scatter::{Scatter, SubsurfaceHit, SubsurfaceScatter};
+use super::state::{PathState, Scratch};
 use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
@@ -84,23 +87,35 @@ pub fn radiance<R: Recorder, T: Clock>(
     ctx: &Context,
     camera_ray: Ray,
     rng: &mut SampleRng,
-    _scratch: &mut Scratch,
+    scratch: &mut Scratch,
     counters: &mut Counters,
     rec: &mut R,
 ) -> Vec3 {
-    trace::<R, T>(
-        ctx,
-        camera_ray,
+    let mut st = PathState {
         rng,
+        scratch,
         counters,
         rec,
-        |ss, si, wo, beta, rng, counters| {
-            let t0 = T::now();
-            let s = walk_hit(ctx, ss, si, wo, beta, rng, counters);
-            T::lap(counters, Effect::Walk, t0);
-            s
-        },
-    )
+    };
+    trace::<R, T, _>(ctx, camera_ray, &mut st, &mut RandomWalk)
+}
+
+/// The random walk as the bounce loop's estimator of subsurface hits.
+struct RandomWalk;
+
+impl SubsurfaceScatter for RandomWalk {
+    const EFFECT: Effect = Effect::Walk;
+
+    #[inline(always)]
+    fn scatter<'s, R: Recorder>(
+        &mut self,
+        ctx: &'s Context,
+        hit: &SubsurfaceHit<'_, 's>,
+        beta: &mut Vec3,
+        st: &mut PathState<R>,
+    ) -> Scatter<'s> {
+        walk_hit(ctx, hit.ss, hit.si, hit.wo, beta, st.rng, st.counters)
+    }
 }
 
 /// A subsurface hit under the random walk: the boundary at the hit, the
@@ -200,7 +215,7 @@ fn diffuse_hit<'s>(
             ng: n_out,
             frame,
             wo_local: Vec3::Z,
-            lobe: Lobe::WalkExit(lobe),
+            lobe: Lobe::Subsurface(SubsurfaceLobe::WalkExit(lobe)),
             // The walk's exit is not culled from (the reference stays as
             // it was).
             outside_of: None,

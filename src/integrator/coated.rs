@@ -1,0 +1,46 @@
+//! A subsurface hit with more than one vertex: the coat's lobe at xo, the
+//! path the coat reflects, the entry point(s) xi and the plane control
+//! variate's terms (`docs/bssrdf.md` §5, §6 "The coat").
+
+use super::lobe::{Bounce, Vertex};
+use crate::geometry::Vec3;
+use crate::lights::LightSample;
+
+/// What a coated subsurface hit at xo turns into: the coat's lobe at xo
+/// (next-event estimation there), a path the coat reflected, and the
+/// entry vertex xi where this path goes on.
+pub(crate) struct Coated<'a> {
+    /// The rough coat's vertex at xo, lit with the throughput before the hit.
+    pub(crate) coat: Option<Weighted<'a>>,
+    /// The coat's reflected path.
+    pub(crate) reflected: Option<Bounce>,
+    /// The entry vertex xi (its throughput already in β): this path goes on
+    /// there and `reflected` waits on the stack; None: this path goes on
+    /// along `reflected`, or ends.
+    pub(crate) entry: Option<Vertex<'a>>,
+    /// The other entry point of an antithetic pair
+    /// ([`super::path::PAIR_DEPTH`]); when Some, light sampled at `entry`
+    /// counts ½ too.
+    pub(crate) pair: Option<Weighted<'a>>,
+    /// What the plane control variate drew and adds ([`Ahead`]).
+    pub(crate) ahead: Ahead,
+}
+
+/// A vertex lit by next-event estimation only, with the throughput its
+/// light sample is weighted by.
+pub(crate) struct Weighted<'a> {
+    pub(crate) vertex: Vertex<'a>,
+    pub(crate) beta: Vec3,
+}
+
+/// The plane control variate's part of a subsurface hit
+/// ([`super::control_variate`]): when it applies, the light samples drawn
+/// ahead for next-event estimation at the entry point (and at its pair's
+/// twin), which its model used, and its terms, each × the throughput, with
+/// the light they sampled ([`super::aov::NO_LIGHT`]: none). The terms count
+/// whether or not the probes found an entry point.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Ahead {
+    pub(crate) lights: Option<[Option<LightSample>; 2]>,
+    pub(crate) terms: [(Vec3, u32); 2],
+}

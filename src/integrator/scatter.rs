@@ -1,0 +1,81 @@
+//! What a subsurface hit turns into, and the trait by which the bounce
+//! loop asks an estimator for it: the diffusion BSSRDF's probes
+//! ([`super::subsurface`]) or the random walk ([`super::randomwalk`])
+//! (`docs/bssrdf.md` §1, §5, §7). Without the `subsurface` feature no
+//! material calls for it.
+#![cfg_attr(not(feature = "subsurface"), allow(dead_code))]
+
+use super::aov::{Event, Recorder};
+#[cfg(not(feature = "subsurface"))]
+use super::lobe::Subsurface;
+use super::lobe::Vertex;
+use super::state::PathState;
+use super::{Context, Effect, Interaction};
+use crate::geometry::{Ray, Vec3};
+#[cfg(feature = "subsurface")]
+use crate::materials::Subsurface;
+
+/// A hit on a subsurface object at xo: its material, the interaction, ωo,
+/// the path's depth there and the width of its footprint
+/// ([`crate::materials::lod`]).
+pub(crate) struct SubsurfaceHit<'h, 's> {
+    pub(crate) ss: &'s Subsurface,
+    pub(crate) si: &'h Interaction,
+    pub(crate) wo: Vec3,
+    pub(crate) depth: u32,
+    pub(crate) width: f32,
+}
+
+/// An estimator of light transport through subsurface objects. The bounce
+/// loop is generic over it, so each implementation gets its own
+/// monomorphised loop.
+pub(crate) trait SubsurfaceScatter {
+    /// The effect whose time the loop charges a call with.
+    const EFFECT: Effect;
+    /// What `hit` turns into; may scale the throughput `beta`.
+    fn scatter<'s, R: Recorder>(
+        &mut self,
+        ctx: &'s Context,
+        hit: &SubsurfaceHit<'_, 's>,
+        beta: &mut Vec3,
+        st: &mut PathState<R>,
+    ) -> Scatter<'s>;
+}
+
+/// Without the `subsurface` feature there are no subsurface hits: the
+/// material type is uninhabited, so this handler is never called.
+#[cfg(not(feature = "subsurface"))]
+pub(crate) struct NoSubsurface;
+
+#[cfg(not(feature = "subsurface"))]
+impl SubsurfaceScatter for NoSubsurface {
+    const EFFECT: Effect = Effect::Probe;
+    fn scatter<'s, R: Recorder>(
+        &mut self,
+        _: &'s Context,
+        hit: &SubsurfaceHit<'_, 's>,
+        _: &mut Vec3,
+        _: &mut PathState<R>,
+    ) -> Scatter<'s> {
+        match *hit.ss {}
+    }
+}
+
+/// What a subsurface hit turns into: a vertex that scatters light with a
+/// lobe (next-event estimation, then lobe sampling), a ray that continues
+/// without one (a specular bounce, or leaving a medium; with the class of
+/// that event for the light-path passes, [`super::aov`]), or the end of the
+/// path.
+// Returned by value once per subsurface hit and read in place (the loop
+// borrows the vertex from it); boxing the large variant would allocate in
+// the hot path.
+#[allow(clippy::large_enum_variant)]
+pub(crate) enum Scatter<'a> {
+    Vertex(Vertex<'a>),
+    Continue(Ray, Event),
+    #[cfg(feature = "subsurface")]
+    Absorbed,
+    /// A subsurface hit under a coat, or with more than one vertex.
+    #[cfg(feature = "subsurface")]
+    Coated(super::coated::Coated<'a>),
+}

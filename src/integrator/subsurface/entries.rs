@@ -1,0 +1,282 @@
+//! The entry points xi of a subsurface hit: one probe, or an antithetic
+//! pair, each with the control variate's part where it applies; or, where
+//! the footprint is wide, xo itself (`docs/bssrdf.md` §5, §10, §11).
+
+use super::cv_model::{one_probe_ahead, pair_ahead, Lights};
+use super::ProbeAt;
+use crate::bssrdf::{ProbeRandoms, ProbeSegment};
+use crate::geometry::{Frame, Vec3};
+use crate::integrator::aov::Recorder;
+use crate::integrator::coated::{Ahead, Coated, Weighted};
+use crate::integrator::control_variate;
+use crate::integrator::lobe::{Bounce, Lobe, SubsurfaceLobe, Vertex};
+use crate::integrator::nee::draw_light;
+use crate::integrator::probe::{entry_on_segment, ProbeTarget};
+use crate::integrator::scatter::{Scatter, SubsurfaceHit};
+use crate::integrator::state::PathState;
+use crate::integrator::{Context, Effect, Interaction};
+use crate::materials::Subsurface;
+use crate::sampling::Draw;
+
+/// What the probes of a hit found: the entry vertex (the path's throughput
+/// already scaled by its weight), its pair's twin, and the control
+/// variate's part.
+pub(super) struct Entries<'s> {
+    entry: Option<Vertex<'s>>,
+    pair: Option<Weighted<'s>>,
+    ahead: Ahead,
+}
+
+impl<'s> Entries<'s> {
+    /// No entry point and no control variate.
+    pub(super) fn none() -> Self {
+        Entries::new(None, Ahead::default())
+    }
+
+    fn new(entry: Option<Vertex<'s>>, ahead: Ahead) -> Self {
+        Entries {
+            entry,
+            pair: None,
+            ahead,
+        }
+    }
+
+    /// As what the hit turns into, with no coat: the entry vertex, or the
+    /// end of the path, unless a pair or the control variate adds more.
+    pub(super) fn into_scatter(self) -> Scatter<'s> {
+        match self {
+            Entries {
+                entry: Some(v),
+                pair: None,
+                ahead,
+            } if ahead.lights.is_none() => Scatter::Vertex(v),
+            Entries {
+                entry: None, ahead, ..
+            } if ahead.lights.is_none() => Scatter::Absorbed,
+            e => Scatter::Coated(e.under(None, None)),
+        }
+    }
+
+    /// Under a coat with the lit vertex `coat` and the reflection
+    /// `reflected`.
+    pub(super) fn under(self, coat: Option<Weighted<'s>>, reflected: Option<Bounce>) -> Coated<'s> {
+        Coated {
+            coat,
+            reflected,
+            entry: self.entry,
+            pair: self.pair,
+            ahead: self.ahead,
+        }
+    }
+}
+
+/// The entry vertices the path goes on from at a subsurface hit, `beta`
+/// scaled by the chosen one's probe weight: one probe, or below
+/// `ctx.pair_depth` where the material asks for it an antithetic pair;
+/// below `ctx.cv_depth` where the material asks for it with the plane
+/// control variate's light samples and terms. Where the material's
+/// level-of-detail rule applies to the footprint, no probe: xo itself.
+pub(super) fn entries<'s, R: Recorder>(
+    ctx: &Context,
+    hit: &SubsurfaceHit<'_, 's>,
+    beta: &mut Vec3,
+    st: &mut PathState<R>,
+) -> Entries<'s> {
+    let (ss, si) = (hit.ss, hit.si);
+    let frame_o = si.shading_frame_facing(hit.wo);
+    let (kappa, k_mean) = ctx.curvatures(si.geom, si.prim);
+    if ss.lod().applies(hit.width, kappa) {
+        return Entries::new(
+            Some(lod_entry(ctx, ss, si, frame_o, beta)),
+            Ahead::default(),
+        );
+    }
+    // The probe axes also see sharp edges near xo (`sharp_edges`); level
+    // of detail above and the curvature correction read the triangle's.
+    let kappa = ctx.axes_curvature(si.geom, si.prim, si.p);
+    let cv = ss.control_variate()
+        && control_variate::applies(ctx.cv_depth, ctx.plan.area_lights, hit.depth);
+    // The control variate's light samples, drawn before the probe's randoms.
+    let lights = cv.then(|| [draw_light(ctx, st.rng), None]);
+    let u = ProbeRandoms::from_rng(st.rng);
+    // The curvature correction's exit half, once for both probes of a pair.
+    let exit = ss.curvature_correction().map(|cc| {
+        (
+            cc,
+            cc.at_exit_with(k_mean, ctx.curvature_factor(si.geom, si.prim, cc)),
+        )
+    });
+    let at = ProbeAt {
+        ss,
+        si,
+        frame_o,
+        kappa,
+        k_mean,
+        u,
+        exit,
+    };
+    if !(ss.probe_pair() && hit.depth < ctx.pair_depth) {
+        return one_probe(ctx, &at, cv, lights, beta, st);
+    }
+    // The pair: with the control variate, a light sample for the twin too.
+    let lights = lights.map(|[a, _]| [a, draw_light(ctx, st.rng)]);
+    pair(ctx, &at, cv, lights, beta, st)
+}
+
+/// One probe from xo: its entry vertex, with the control variate's part.
+fn one_probe<'s, R: Recorder>(
+    ctx: &Context,
+    at: &ProbeAt<'_, 's>,
+    cv: bool,
+    lights: Lights,
+    beta: &mut Vec3,
+    st: &mut PathState<R>,
+) -> Entries<'s> {
+    let (p, frame_o, kappa, u) = (at.si.p, &at.frame_o, at.kappa, &at.u);
+    let probe = at.ss.probe();
+    let (seg, plane) = if cv {
+        match probe.sample_probe_and_plane(p, frame_o, kappa, u) {
+            Some(sp) => sp,
+            None => return Entries::new(None, Ahead::default()),
+        }
+    } else {
+        match probe.sample_probe(p, frame_o, kappa, u) {
+            Some(seg) => (seg, None),
+            None => return Entries::new(None, Ahead::default()),
+        }
+    };
+    let ahead = one_probe_ahead(at, lights, plane.as_ref(), *beta);
+    match probe_entry(ctx, at, &seg, st) {
+        Some((v, w)) => {
+            *beta *= w;
+            Entries::new(Some(v), ahead)
+        }
+        None => Entries::new(None, ahead),
+    }
+}
+
+/// The antithetic pair from xo: the twin's randoms are u's with the angle
+/// at φ + π (ProbeSampler::sample_probe_pair), which changes none of what
+/// entry_on_segment reads. The path goes on from one of the two, chosen
+/// with probability ½ (weight 2 × ½); light is sampled at both, each
+/// weighted ½.
+fn pair<'s, R: Recorder>(
+    ctx: &Context,
+    at: &ProbeAt<'_, 's>,
+    cv: bool,
+    lights: Lights,
+    beta: &mut Vec3,
+    st: &mut PathState<R>,
+) -> Entries<'s> {
+    let (p, frame_o, kappa, u) = (at.si.p, &at.frame_o, at.kappa, &at.u);
+    let probe = at.ss.probe();
+    let ([seg_a, seg_b], plane) = if cv {
+        match probe.sample_probe_pair_and_plane(p, frame_o, kappa, u) {
+            Some(sp) => sp,
+            None => return Entries::new(None, Ahead::default()),
+        }
+    } else {
+        match probe.sample_probe_pair(p, frame_o, kappa, u) {
+            Some(segs) => (segs, None),
+            None => return Entries::new(None, Ahead::default()),
+        }
+    };
+    let ahead = pair_ahead(at, lights, plane.as_ref(), *beta);
+    let a = probe_entry(ctx, at, &seg_a, st);
+    let b = probe_entry(ctx, at, &seg_b, st);
+    match (a, b) {
+        (Some((va, wa)), Some((vb, wb))) => {
+            let beta0 = *beta;
+            let (go, (other, w_other), w_go) = if st.rng.uniform() < 0.5 {
+                (va, (vb, wb), wa)
+            } else {
+                (vb, (va, wa), wb)
+            };
+            *beta = beta0 * w_go;
+            let twin = Weighted {
+                vertex: other,
+                beta: 0.5 * beta0 * w_other,
+            };
+            Entries {
+                entry: Some(go),
+                pair: Some(twin),
+                ahead,
+            }
+        }
+        (Some((v, w)), None) | (None, Some((v, w))) => {
+            *beta *= 0.5 * w;
+            Entries::new(Some(v), ahead)
+        }
+        (None, None) => Entries::new(None, ahead),
+    }
+}
+
+/// The level-of-detail entry vertex: xo itself with the entry lobe, `beta`
+/// scaled by the profile's plane integral A_plane and, on a convex surface
+/// with the curvature correction on, f(κo) — the full estimator's mean on
+/// a flat or spherical surface ([`crate::materials::lod`]).
+#[inline(never)]
+fn lod_entry<'s>(
+    ctx: &Context,
+    ss: &'s Subsurface,
+    si: &Interaction,
+    frame_o: Frame,
+    beta: &mut Vec3,
+) -> Vertex<'s> {
+    let mut w = ss.lod().albedo;
+    if let Some(cc) = ss.curvature_correction() {
+        let (_, k_o) = ctx.curvatures(si.geom, si.prim);
+        if let Some(f) = cc.weight(k_o, k_o) {
+            w *= f;
+        }
+    }
+    *beta *= w;
+    Vertex {
+        p: si.p,
+        ng: if si.front { si.ng } else { -si.ng },
+        frame: frame_o,
+        wo_local: Vec3::Z,
+        lobe: Lobe::Subsurface(SubsurfaceLobe::Entry(ss)),
+        outside_of: ctx.leaving(si.geom, si.front),
+    }
+}
+
+/// The area integral at xo: one entry point xi from the probe segment
+/// `seg`, and the probe's weight (with the curvature correction's, if
+/// the material has one); None when the probe finds nothing.
+fn probe_entry<'s, R: Recorder>(
+    ctx: &Context,
+    at: &ProbeAt<'_, 's>,
+    seg: &ProbeSegment,
+    st: &mut PathState<R>,
+) -> Option<(Vertex<'s>, Vec3)> {
+    let (ss, si) = (at.ss, at.si);
+    st.counters.ray(Effect::Probe);
+    let target = ProbeTarget {
+        accel: ctx.accel,
+        geom: si.geom,
+        mesh: &ctx.scene.meshes[si.geom as usize],
+    };
+    let ps = entry_on_segment(ss.probe(), seg, &at.u, &target, &mut st.scratch.probe_hits)?;
+    // The curvature correction (bssrdf::curvature_correction): None, and
+    // the weight untouched, on flat and concave surfaces.
+    let mut weight = ps.weight;
+    if let Some((cc, exit)) = &at.exit {
+        let (_, k_i) = ctx.curvatures(si.geom, ps.hit.prim);
+        let f_i = ctx.curvature_factor(si.geom, ps.hit.prim, cc);
+        if let Some(f) = cc.weight_from_factor(exit, k_i, f_i) {
+            weight *= f;
+        }
+    }
+    let n_in = if si.front { ps.normal } else { -ps.normal };
+    let vertex = Vertex {
+        p: ps.point,
+        ng: n_in,
+        frame: Frame::from_normal(n_in),
+        wo_local: Vec3::Z,
+        lobe: Lobe::Subsurface(SubsurfaceLobe::Entry(ss)),
+        // n_in faces the side xo was seen from, as ng does at xo.
+        outside_of: ctx.leaving(si.geom, si.front),
+    };
+    Some((vertex, weight))
+}

@@ -1,0 +1,131 @@
+//! How the bounce loop reads a subsurface hit with more than one vertex
+//! ([`Coated`]): light sampled at the rough coat, the coat's reflection
+//! kept on the stack or followed, the control variate's terms, light
+//! sampled at the pair's twin, and the entry vertex the path goes on from
+//! (`docs/bssrdf.md` §5, §6 "The coat").
+
+use crate::geometry::Vec3;
+use crate::integrator::aov::{self, Event, Recorder, Source};
+use crate::integrator::branch::{roulette, At, Branch, Branches, Next};
+use crate::integrator::coated::Coated;
+use crate::integrator::lobe::{Bounce, Vertex};
+use crate::integrator::nee::{direct_lighting, direct_lighting_ahead, record_direct, NeeAt};
+use crate::integrator::state::PathState;
+use crate::integrator::{Clock, Context};
+
+/// Reads the coated hit `c` at `at` into `path`, adding the light it
+/// sampled to `l`; a reflection that waits is pushed on `stack`.
+#[inline(always)]
+pub(crate) fn resolve<'v, 's, R: Recorder, T: Clock>(
+    ctx: &Context,
+    c: &'v Coated<'s>,
+    at: &At,
+    path: &mut Branch,
+    l: &mut Vec3,
+    st: &mut PathState<R>,
+    stack: &mut Branches,
+) -> Next<'v, 's> {
+    // The coat's reflections are specular.
+    let coat_event = if at.first {
+        Event::Specular
+    } else {
+        path.event
+    };
+    if let (Some(w), true) = (&c.coat, ctx.plan.area_lights) {
+        *l += record_direct::<R, T>(st, w.beta, coat_event, at.depth, |rng, counters| {
+            direct_lighting(ctx, &w.vertex, rng, counters)
+        });
+    }
+    let (next, follow_reflected) = match (&c.entry, c.reflected) {
+        // Both: this path enters the medium, the reflection waits on the
+        // stack (one branch per split depth).
+        (Some(v), Some(r)) => {
+            push_reflection(ctx, r, at, coat_event, st, stack);
+            (Some(v), None)
+        }
+        (Some(v), None) => (Some(v), None),
+        (None, reflected) => (None, reflected),
+    };
+    add_terms(c, at, path.event, l, st.rec);
+    match (next, follow_reflected) {
+        (Some(v), _) => Next::Vertex(v, entry::<R, T>(ctx, c, v, at, path, l, st)),
+        (None, Some(r)) => {
+            path.event = coat_event;
+            path.go_on(r, ctx.leaving_towards(at.si, r.ray.d), at.cone_specular);
+            Next::Bounce
+        }
+        (None, None) => Next::End,
+    }
+}
+
+/// The coat's reflection `r`, pushed on the stack if it survives roulette.
+#[inline(always)]
+fn push_reflection<R: Recorder>(
+    ctx: &Context,
+    r: Bounce,
+    at: &At,
+    event: Event,
+    st: &mut PathState<R>,
+    stack: &mut Branches,
+) {
+    let mut b = r.beta;
+    if roulette(at.depth, &mut b, st.rng) {
+        stack.push(Branch {
+            ray: r.ray,
+            from: ctx.leaving_towards(at.si, r.ray.d),
+            beta: b,
+            prev: r.prev,
+            depth: at.depth + 1,
+            event,
+            cone: at.cone_specular,
+        });
+    }
+}
+
+/// The control variate's terms, which count whether or not the probes
+/// found an entry point.
+#[inline(always)]
+fn add_terms<R: Recorder>(c: &Coated, at: &At, event: Event, l: &mut Vec3, rec: &mut R) {
+    if c.ahead.lights.is_some() {
+        let ev = if at.first { Event::Subsurface } else { event };
+        for (t, light) in c.ahead.terms {
+            if light != aov::NO_LIGHT {
+                *l += t;
+                rec.light(t, aov::sampled(ev, at.depth), Source::Light(light));
+            }
+        }
+    }
+}
+
+/// The path goes on from the entry vertex `v`: light is sampled at the
+/// pair's twin now, and at `v` as the returned `NeeAt` asks (½ each with
+/// a twin; with the light sample drawn ahead, if any).
+#[inline(always)]
+fn entry<R: Recorder, T: Clock>(
+    ctx: &Context,
+    c: &Coated,
+    v: &Vertex,
+    at: &At,
+    path: &mut Branch,
+    l: &mut Vec3,
+    st: &mut PathState<R>,
+) -> NeeAt {
+    if at.first {
+        path.event = v.lobe.event();
+    }
+    let lights = c.ahead.lights;
+    let mut nee = NeeAt {
+        scale: 1.0,
+        ahead: lights.map(|ls| ls[0]),
+    };
+    if let Some(twin) = &c.pair {
+        if ctx.plan.area_lights {
+            let ahead = lights.map(|ls| ls[1]);
+            *l += record_direct::<R, T>(st, twin.beta, path.event, at.depth, |rng, counters| {
+                direct_lighting_ahead(ctx, &twin.vertex, ahead, rng, counters)
+            });
+        }
+        nee.scale = 0.5;
+    }
+    nee
+}
