@@ -28,7 +28,7 @@
 //! let sampler = ProbeSampler::new(&params, &ProbeOptions::default())?;   // once
 //! let c = sw_normalization(params.eta);                                    // once
 //! // at exit point xo with shading frame `frame` on mesh `geom`, where the
-//! // surface's curvature is `kappa` (integrator::probe::curvature):
+//! // surface's curvature is `kappa` (geometry::curvature::exit_curvature):
 //! let u = ProbeRandoms::from_rng(rng);
 //! let seg = sampler.sample_probe(xo, &frame, kappa, &u)?;
 //! accel.hits_on_segment(&seg.ray, seg.t_max, geom, u.seed, &mut probe_hits); // the integrator's query

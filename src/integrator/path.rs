@@ -75,6 +75,7 @@
 use super::aov::{self, Event, Recorder, Source};
 #[cfg(feature = "subsurface")]
 use super::control_variate;
+use super::footprint::Cone;
 use super::interaction::offset_along;
 #[cfg(feature = "subsurface")]
 use super::probe::{entry_on_segment, ProbeTarget};
@@ -85,9 +86,10 @@ use crate::bssrdf::curvature_correction::{CurvatureCorrection, ExitFactor};
 #[cfg(feature = "subsurface")]
 use crate::bssrdf::{PlaneModel, ProbeRandoms, ProbeSegment};
 use crate::film::passes::Pass;
+#[cfg(feature = "subsurface")]
+use crate::geometry::curvature::TriangleCurvature;
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::lights::LightSample;
-use crate::materials::lod::Cone;
 use crate::materials::{dielectric, diffuse, Material};
 #[cfg(feature = "subsurface")]
 use crate::materials::{
@@ -127,15 +129,7 @@ pub(crate) const RR_START: u32 = 3;
 #[cfg(feature = "subsurface")]
 pub(crate) const COAT_SPLIT_DEPTH: u32 = 1;
 
-/// Subsurface hits at depths below this, on materials with `probe_pair`
-/// on (off by default: the plane control variate takes most of the same
-/// noise without the second probe, module docs), sample two entry points
-/// from one probe's randoms, the second at the opposite angle φ + π
-/// (antithetic), and sample light at both, each weighted ½; the path goes
-/// on from one of them, chosen with probability ½ (module docs). Light
-/// varying linearly across the profile cancels between the two. 1: the
-/// camera vertex (the default of [`Context::pair_depth`]).
-pub const PAIR_DEPTH: u32 = 1;
+pub use super::context::PAIR_DEPTH;
 
 /// Paths waiting to be traced after the current one ends. A path pushes
 /// at most one branch per depth below [`COAT_SPLIT_DEPTH`], and a branch
@@ -914,7 +908,10 @@ fn entries<'s>(
     width: f32,
 ) -> Entries<'s> {
     let frame_o = si.shading_frame_facing(wo);
-    let (kappa, k_mean) = ctx.curvatures(si.geom, si.prim);
+    let TriangleCurvature {
+        exit: kappa,
+        mean: k_mean,
+    } = ctx.curvatures(si.geom, si.prim);
     if ss.lod().applies(width, kappa) {
         return (
             Some(lod_entry(ctx, ss, si, frame_o, beta)),
@@ -1109,7 +1106,7 @@ fn lod_entry<'s>(
 ) -> Vertex<'s> {
     let mut w = ss.lod().albedo;
     if let Some(cc) = ss.curvature_correction() {
-        let (_, k_o) = ctx.curvatures(si.geom, si.prim);
+        let k_o = ctx.curvatures(si.geom, si.prim).mean;
         if let Some(f) = cc.weight(k_o, k_o) {
             w *= f;
         }
@@ -1170,7 +1167,7 @@ fn probe_entry<'s>(
     // the weight untouched, on flat and concave surfaces.
     let mut weight = ps.weight;
     if let Some((cc, exit)) = &exit {
-        let (_, k_i) = ctx.curvatures(si.geom, ps.hit.prim);
+        let k_i = ctx.curvatures(si.geom, ps.hit.prim).mean;
         let f_i = ctx.curvature_factor(si.geom, ps.hit.prim, cc);
         if let Some(f) = cc.weight_from_factor(exit, k_i, f_i) {
             weight *= f;
