@@ -74,26 +74,7 @@ impl<'a> Context<'a> {
             .map(interaction::MeshShading::new)
             .collect();
         #[cfg(feature = "subsurface")]
-        let curvature = scene
-            .meshes
-            .iter()
-            .zip(&scene.objects)
-            .map(|(m, o)| match &scene.materials[o.material] {
-                crate::materials::Material::Subsurface(ss) => {
-                    // only the `curvature` axis rule reads sharp edges
-                    let reads_edges =
-                        ss.probe.options().axes == crate::bssrdf::ProbeAxes::Curvature;
-                    let reach = if reads_edges {
-                        ss.probe.rmax() as f32
-                    } else {
-                        0.0
-                    };
-                    let c = MeshCurvature::new(m, reach);
-                    Some(SubsurfaceCurvature::new(c, ss.curvature_correction()))
-                }
-                _ => None,
-            })
-            .collect();
+        let curvature = subsurface_curvatures(scene);
         let ray_epsilon = extent * 1e-6;
         Context {
             scene,
@@ -229,6 +210,31 @@ impl<'a> Context<'a> {
     pub fn interaction(&self, ray: &crate::geometry::Ray, hit: &crate::accel::Hit) -> Interaction {
         Interaction::new(&self.shading[hit.geom as usize], ray, hit)
     }
+}
+
+/// Per mesh with a subsurface material, its [`SubsurfaceCurvature`];
+/// None for the others.
+#[cfg(feature = "subsurface")]
+fn subsurface_curvatures(scene: &Scene) -> Vec<Option<SubsurfaceCurvature>> {
+    scene
+        .meshes
+        .iter()
+        .zip(&scene.objects)
+        .map(|(m, o)| match &scene.materials[o.material] {
+            crate::materials::Material::Subsurface(ss) => {
+                // only the `curvature` axis rule reads sharp edges
+                let reads_edges = ss.probe.options().axes == crate::bssrdf::ProbeAxes::Curvature;
+                let reach = if reads_edges {
+                    ss.probe.rmax() as f32
+                } else {
+                    0.0
+                };
+                let c = MeshCurvature::new(m, reach);
+                Some(SubsurfaceCurvature::new(c, ss.curvature_correction()))
+            }
+            _ => None,
+        })
+        .collect()
 }
 
 fn scene_bounds(scene: &Scene) -> (glam::Vec3, glam::Vec3) {
