@@ -241,7 +241,7 @@ fn smooth_sphere_curvature_is_quieter_than_mis3() {
 fn marble_tile_default_sees_across_its_edges() {
     // A flat-shaded 20 × 4 × 20 mm marble box: its faces read no curvature,
     // but within Rmax of every edge part of the profile lies on the next
-    // face, parallel to N (integrator::sharp_edges). With the triangle's
+    // face, parallel to N (geometry::sharp_edges). With the triangle's
     // curvature alone the default sent 99 % of its probes along N: relMSE
     // 1.58 and 18 fireflies over this ladder against mis3's 0.09. The edge
     // rule and the weighted pick bring it to 0.028 (mis3 0.037). Normal-

@@ -2,7 +2,7 @@
 //! (`docs/bssrdf.md` §10): the profile Rd describes a half-space, and on a
 //! convex body it returns too little light. The weight of a probe hit from
 //! xo to xi is multiplied by √(f(κo)·f(κi)), f(κ) = A_sphere(ρ)/(A·g(R)) at
-//! the local mean curvature κ = 1/R ([`mean_curvature`]), A_sphere from
+//! the local mean curvature κ = 1/R ([`mean_curvature`](crate::geometry::curvature::mean_curvature)), A_sphere from
 //! [`super::curvature_table`]; f = 1 exactly where κ ≤ 0. f is clamped to
 //! [[`MIN_FACTOR`], [`MAX_FACTOR`]], so every weight bound of the probe
 //! estimator grows by at most [`MAX_FACTOR`]. Media without a recorded
@@ -17,7 +17,7 @@ use super::curvature_table::CurvatureTable;
 use super::params::{diffuse_mfp, SubsurfaceParams};
 use super::probe::ProbeSampler;
 use super::profile;
-use crate::geometry::{Mesh, Vec3};
+use crate::geometry::Vec3;
 
 /// The largest factor applied to a weight (on a body far smaller than the
 /// diffusion length, where the half-space profile has nothing left to
@@ -27,35 +27,6 @@ pub const MAX_FACTOR: f64 = 4.0;
 /// The smallest factor (h slightly above 1 within the table's noise on
 /// large bodies).
 pub const MIN_FACTOR: f64 = 0.9;
-
-/// The convex mean curvature of triangle `prim` of `mesh` (1/scene units)
-/// from its shading normals (module docs); 0 without shading normals, on
-/// flat or concave triangles, and for degenerate edges.
-pub fn mean_curvature(mesh: &Mesh, prim: u32) -> f32 {
-    let Some(normals) = &mesh.normals else {
-        return 0.0;
-    };
-    let idx = mesh.indices[prim as usize];
-    let p = mesh.vertices(idx);
-    let n = idx.map(|i| normals[i as usize]);
-    let (mut sum, mut edges) = (0.0f32, 0);
-    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
-        let e = p[i] - p[j];
-        let len2 = e.length_squared();
-        if len2 > 0.0 {
-            let k = (n[i] - n[j]).dot(e) / len2;
-            if k.is_finite() {
-                sum += k;
-                edges += 1;
-            }
-        }
-    }
-    if edges == 0 {
-        0.0
-    } else {
-        (sum / edges as f32).max(0.0)
-    }
-}
 
 /// The exit point's curvature κo and its factor f(κo)
 /// ([`CurvatureCorrection::at_exit`]).
@@ -404,32 +375,6 @@ mod tests {
         }
     }
 
-    #[test]
-    fn mean_curvature_of_a_sphere_and_a_flat_mesh() {
-        let r = 2.5f32;
-        // one triangle of a sphere of radius r, radial normals
-        let dirs = [
-            Vec3::new(1.0, 0.1, 0.0).normalize(),
-            Vec3::new(0.9, 0.3, 0.2).normalize(),
-            Vec3::new(0.95, 0.0, 0.3).normalize(),
-        ];
-        let mesh = Mesh::new(
-            dirs.map(|d| d * r).to_vec(),
-            vec![[0, 1, 2]],
-            Some(dirs.to_vec()),
-        );
-        assert!((mean_curvature(&mesh, 0) * r - 1.0).abs() < 1e-4);
-        // the same triangle seen from inside (normals flipped): concave, 0
-        let inside = Mesh::new(
-            dirs.map(|d| d * r).to_vec(),
-            vec![[0, 1, 2]],
-            Some(dirs.map(|d| -d).to_vec()),
-        );
-        assert_eq!(mean_curvature(&inside, 0), 0.0);
-        let flat = Mesh::new(dirs.map(|d| d * r).to_vec(), vec![[0, 1, 2]], None);
-        assert_eq!(mean_curvature(&flat, 0), 0.0);
-    }
-
     /// The exit half computed once gives the same weight as `weight`, bit
     /// for bit, including the flat and concave cases where it is None.
     #[test]
@@ -446,7 +391,7 @@ mod tests {
                 });
                 let got = cc.weight_from(&exit, ki);
                 assert_eq!(got, cc.weight(ko, ki));
-                // and from cached factors (integrator::probe::MeshCurvature)
+                // and from cached factors (the integrator's per-triangle cache)
                 let cached = cc.at_exit_with(ko, cc.factor(ko));
                 let from_cache = cc.weight_from_factor(&cached, ki, cc.factor(ki));
                 assert_eq!(

@@ -3,11 +3,11 @@
 //! §13.1.1).
 
 use super::aov::Event;
+use super::footprint::Cone;
 use super::lobe::{Bounce, PrevVertex, Vertex};
 use super::nee::NeeAt;
 use super::Interaction;
 use crate::geometry::{Ray, Vec3};
-use crate::materials::lod::Cone;
 use crate::sampling::{Draw, SampleRng};
 
 /// Bounces after which Russian roulette may end a path.

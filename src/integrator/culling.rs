@@ -7,7 +7,7 @@
 //!
 //! 1. the segment misses the object's bounding box, padded (below);
 //! 2. the ray starts on the object, on a convex-outside side of it
-//!    ([`super::convex`]) and leaves towards that side: its origin is
+//!    ([`crate::geometry::convex`]) and leaves towards that side: its origin is
 //!    offset from the triangle's plane by at least the scene's ray epsilon
 //!    ε_ray ([`offset_along`](super::interaction::offset_along)), more than
 //!    the convexity tolerance τ = ε_ray/4, and it moves away from the
@@ -75,7 +75,7 @@ impl Culling {
                 .collect(),
             outside: meshes
                 .iter()
-                .map(|m| super::convex::outside_sides(m, tol))
+                .map(|m| crate::geometry::convex::outside_sides(m, tol))
                 .collect(),
         })
     }

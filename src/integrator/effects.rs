@@ -14,7 +14,7 @@
 //! `--stats`, [`NoClock`] without), as the passes pick their recorder
 //! (`super::aov`). Under [`NoClock`] every reading is the constant 0 and
 //! every `if C::ON` is removed at compile time, so the instance without
-//! statistics is the code as it was before statistics existed. Under
+//! statistics runs no clock code at all. Under
 //! [`Stopwatch`] the clock is read around each effect's section: the
 //! nearest-hit query of a camera ray or of a continued path, the light
 //! sample with its shadow ray, and a subsurface hit (the coat and the
@@ -29,47 +29,7 @@
 //! elsewhere (`Instant`, nanoseconds). Shares are ratios of one clock's
 //! ticks, so its rate never needs to be known.
 
-use super::Counters;
-
-/// The effects ray queries and time are counted by.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Effect {
-    /// Nearest-hit queries of camera rays (one a sample).
-    Camera,
-    /// Nearest-hit queries of paths continued after a bounce (lobe,
-    /// dielectric, coat reflection, a medium's exit).
-    Indirect,
-    /// Light samples at vertices and their shadow rays.
-    Direct,
-    /// Subsurface hits under diffusion: the coat and the probe rays.
-    Probe,
-    /// Subsurface hits under the random walk: the walk's flights.
-    Walk,
-}
-
-/// How many [`Effect`]s there are.
-pub const EFFECTS: usize = 5;
-
-impl Effect {
-    pub const ALL: [Effect; EFFECTS] = [
-        Effect::Camera,
-        Effect::Indirect,
-        Effect::Direct,
-        Effect::Probe,
-        Effect::Walk,
-    ];
-
-    /// The name the summary and the docs use.
-    pub fn name(self) -> &'static str {
-        match self {
-            Effect::Camera => "camera rays",
-            Effect::Indirect => "indirect continuation",
-            Effect::Direct => "direct light (shadow rays)",
-            Effect::Probe => "subsurface probes (and coat)",
-            Effect::Walk => "random walk",
-        }
-    }
-}
+use super::counters::{Counters, Effect};
 
 /// A clock the tile loop and the integrators read around effect sections
 /// (module docs).

@@ -12,6 +12,7 @@
 
 use super::aov::{self, Event, Recorder, Source};
 use super::branch::{roulette, At, Branch, Branches, Next};
+use super::footprint::Cone;
 use super::lobe::{Bounce, Vertex};
 use super::nee::{emission_weight, record_direct, NeeAt};
 use super::scatter::{Scatter, SubsurfaceScatter};
@@ -20,7 +21,6 @@ use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
 use crate::film::passes::Pass;
 use crate::geometry::{Frame, Ray, Vec3};
-use crate::materials::lod::Cone;
 use crate::materials::{dielectric, Material};
 use crate::sampling::{Draw, SampleRng};
 
@@ -31,12 +31,7 @@ pub(crate) use super::subsurface::COAT_SPLIT_DEPTH;
 #[cfg(feature = "subsurface")]
 use super::{scatter::SubsurfaceHit, subsurface::resolve};
 
-/// Subsurface hits at depths below this, on materials with `probe_pair`
-/// on (off by default), sample two entry points from one probe's randoms,
-/// the second at the opposite angle φ + π, and light at both
-/// (`docs/bssrdf.md` §5, "Along a path"). 1: the camera vertex (the
-/// default of [`Context::pair_depth`]).
-pub const PAIR_DEPTH: u32 = 1;
+pub use super::context::PAIR_DEPTH;
 
 /// The diffusion BSSRDF's estimator of subsurface hits.
 #[cfg(feature = "subsurface")]

@@ -5,6 +5,7 @@
 use super::cv_model::{one_probe_ahead, pair_ahead, Lights};
 use super::ProbeAt;
 use crate::bssrdf::{ProbeRandoms, ProbeSegment};
+use crate::geometry::curvature::TriangleCurvature;
 use crate::geometry::{Frame, Vec3};
 use crate::integrator::aov::Recorder;
 use crate::integrator::coated::{Ahead, Coated, Weighted};
@@ -84,7 +85,10 @@ pub(super) fn entries<'s, R: Recorder>(
 ) -> Entries<'s> {
     let (ss, si) = (hit.ss, hit.si);
     let frame_o = si.shading_frame_facing(hit.wo);
-    let (kappa, k_mean) = ctx.curvatures(si.geom, si.prim);
+    let TriangleCurvature {
+        exit: kappa,
+        mean: k_mean,
+    } = ctx.curvatures(si.geom, si.prim);
     if ss.lod().applies(hit.width, kappa) {
         return Entries::new(
             Some(lod_entry(ctx, ss, si, frame_o, beta)),
@@ -225,7 +229,7 @@ fn lod_entry<'s>(
 ) -> Vertex<'s> {
     let mut w = ss.lod().albedo;
     if let Some(cc) = ss.curvature_correction() {
-        let (_, k_o) = ctx.curvatures(si.geom, si.prim);
+        let k_o = ctx.curvatures(si.geom, si.prim).mean;
         if let Some(f) = cc.weight(k_o, k_o) {
             w *= f;
         }
@@ -262,7 +266,7 @@ fn probe_entry<'s, R: Recorder>(
     // the weight untouched, on flat and concave surfaces.
     let mut weight = ps.weight;
     if let Some((cc, exit)) = &at.exit {
-        let (_, k_i) = ctx.curvatures(si.geom, ps.hit.prim);
+        let k_i = ctx.curvatures(si.geom, ps.hit.prim).mean;
         let f_i = ctx.curvature_factor(si.geom, ps.hit.prim, cc);
         if let Some(f) = cc.weight_from_factor(exit, k_i, f_i) {
             weight *= f;

@@ -1,61 +1,10 @@
 //! Sharp edges of a subsurface mesh, and how far an exit point is from the
 //! nearest one: what the probe-axis rule reads where shading normals cannot
-//! show the surface turning.
-//!
-//! **Why.** The default axis rule (`ProbeAxes::Curvature`, docs/bssrdf.md
-//! §5) sends probes along T and B with probability ε(κ·d) each, κ read from
-//! the triangle's shading normals ([`super::probe::curvature`]). Across a
-//! sharp edge — a box's, a tile's, a faceted OBJ's — the normals jump, but
-//! each triangle's own normals agree, so κ reads 0 (or the 1/R floor of a
-//! small mesh) and ε stays at ε_min = 0.005. Yet within Rmax of the edge
-//! part of the profile lies on the other face, nearly parallel to N, where
-//! only tangent probes can find it: a face lit only through the edge (a
-//! tile's shaded side) gets its light from one probe in a few hundred,
-//! weighed ×1/ε — fireflies. Measured on a marble tile (20 × 4 × 20 mm,
-//! docs/accuracy.md "Sharp edges and thin bodies"): in a quick study,
-//! relMSE 1.58 and 18 fireflies against mis3's 0.09.
-//!
-//! **The rule.** A sharp edge at distance s from the exit point bends the
-//! surface within s, as a curvature 1/s would; the probe axes read
-//!
-//! ```text
-//! κ_axes(xo) = max(κ(triangle), 1/s(xo)),
-//! ```
-//!
-//! s the distance from xo to the nearest sharp edge of its mesh (∞ beyond
-//! the reach, Rmax). ε is then ¼ within d of an edge and falls back to the
-//! curvature's value over a few d (the rule's exp ramp). κ_axes is a
-//! deterministic function of xo, so the axes' MIS density stays exact and
-//! the estimator unbiased; the weight bound of `ProbeAxes::weight_bound`
-//! holds as before (ε ≥ ε_min everywhere). The curvature correction, the
-//! control variate's model surface and subsurface level of detail keep
-//! reading the triangle's curvatures: only the probe axes change.
-//!
-//! **Which edges are sharp.** An edge shared by exactly two triangles
-//! whose shading normals (vertex normals, or the face normal on a mesh
-//! without them) differ by more than [`SHARP_ANGLE_DEG`] at either of its
-//! ends; an edge of three or more triangles (non-manifold) always. Edges
-//! are matched by their end points' positions, so faces that do not share
-//! vertex indices (the `box` shape, flat-shaded OBJ exports) still meet. A
-//! boundary edge (one triangle) is not sharp: beyond it there is no
-//! surface for any probe to find. A smooth-shaded mesh has no sharp edge
-//! unless its normals split at a crease, and its rule is unchanged.
-//!
-//! **The bound of s.** For xo on one face and an edge's other face meeting
-//! it at an interior angle of 90° or more (any convex edge, a concave one
-//! opening at least square), the nearest point of the other face is on the
-//! edge, so s is the distance to the face itself. A concave fold sharper
-//! than 90° leans its face over xo, nearer than its edge; the rule then
-//! reads that face as farther than it is (ε lower than the geometry
-//! warrants, never below ε_min, so the weight bound still holds).
-//!
-//! **The query.** A bounding-volume tree over the sharp edges' segments
-//! (leaves of up to [`LEAF`]); a query descends only into boxes nearer
-//! than the best distance so far, starting at the reach, so an exit point
-//! far from every edge costs a few box tests and a mesh without sharp
-//! edges costs nothing (no tree). Precision: distances are f32 in scene
-//! units, relative error ~1e-7 of the mesh's size; the rule's ramp is
-//! smooth in s, so an error that size moves ε by as little.
+//! show the surface turning. The rule κ_axes(xo) = max(κ(triangle),
+//! 1/s(xo)), s the distance to the nearest sharp edge within Rmax; which
+//! edges are sharp, the bound of s and the query: `docs/bssrdf.md` §5,
+//! "Sharp edges"; measurements: `docs/accuracy.md`, "Sharp edges and thin
+//! bodies".
 
 use crate::geometry::{Mesh, Vec3};
 

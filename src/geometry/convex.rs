@@ -1,35 +1,10 @@
 //! Which side of a mesh is the outside of a convex body: what
-//! [`super::culling`] needs to know that a ray leaving the mesh cannot
-//! meet it again.
-//!
-//! **The property.** A side s ∈ {front, back} of a mesh is *convex-outside*
-//! when every vertex of the mesh lies on or behind the plane of every
-//! triangle, "behind" meaning opposite the side's normal (the front-face
-//! normal n_f for the front side, −n_f for the back side), within a
-//! tolerance τ:
-//!
-//! ```text
-//! s·n_f · (v − a_f) ≤ τ   for every triangle f (vertex a_f) and vertex v.
-//! ```
-//!
-//! Then the whole mesh lies in the half-space s·n_f·(x − a_f) ≤ τ of each
-//! of its triangles (a triangle is the convex hull of its vertices, so
-//! what holds for the vertices holds for every point of every triangle).
-//! A ray that starts at height h > τ above triangle f's plane on side s
-//! and moves away from it (direction d with s·n_f·d > 0) stays above
-//! height h, so it never meets the mesh. That is the whole argument: no
-//! closedness, connectedness or orientation of the mesh is assumed, and a
-//! planar mesh (a quad light) is convex-outside on both sides.
-//!
-//! **The test.** Exact in f64 (the f32 positions convert exactly; the
-//! plane's normal and offset carry relative errors ~1e-16, far below τ):
-//! per side, per triangle, the largest s·n_f·v over the vertices, found in
-//! a tree of the vertices' bounding boxes that descends only where a box
-//! reaches above the plane — on a convex mesh only the boxes next to the
-//! triangle do, so a 20,480-triangle sphere is tested in milliseconds.
-//! Degenerate triangles (zero area) are skipped: no ray meets or leaves
-//! one. A side fails at its first violating vertex, so a non-convex mesh
-//! is rejected early. Meshes above [`MAX_TRIANGLES`] are not tested.
+//! `crate::integrator::culling` needs to know that a ray leaving the mesh
+//! cannot meet it again. A side is convex-outside when every vertex lies on
+//! or behind the plane of every triangle (seen from that side) within a
+//! tolerance τ; tested exactly, in f64, over a tree of the vertices' boxes.
+//! The property, why it suffices and the test: `docs/performance.md`,
+//! "Convex-outside sides".
 
 use crate::geometry::Mesh;
 use glam::DVec3;
@@ -38,9 +13,8 @@ use glam::DVec3;
 const LEAF: usize = 8;
 
 /// Meshes with more triangles than this are not tested (reported convex
-/// on neither side): the test costs ~10,000 instructions a triangle on a
-/// convex mesh (measured: 202 M for the 20,480-triangle sphere), so this
-/// bounds it at about a quarter of a second.
+/// on neither side): this bounds the test's time
+/// (`docs/performance.md`, "Convex-outside sides").
 pub const MAX_TRIANGLES: usize = 100_000;
 
 /// Which sides of a mesh are convex-outside (module docs), with tolerance

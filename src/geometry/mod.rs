@@ -1,0 +1,21 @@
+//! Rays, orthonormal frames and triangle meshes: the geometric vocabulary
+//! shared by the scene loader, both ray-query backends and the integrators;
+//! and what is learned from a mesh's shape alone: its per-triangle
+//! curvature ([`curvature`]), its sharp edges ([`sharp_edges`]) and which
+//! of its sides is the outside of a convex body ([`convex`]). Nothing here
+//! knows of ray-query backends, materials or the BSSRDF.
+//! `curvature` and `sharp_edges` exist only with the `subsurface` feature.
+
+pub mod convex;
+#[cfg(feature = "subsurface")]
+pub mod curvature;
+mod frame;
+mod mesh;
+mod ray;
+#[cfg(feature = "subsurface")]
+pub mod sharp_edges;
+
+pub use frame::Frame;
+pub use glam::Vec3;
+pub use mesh::Mesh;
+pub use ray::Ray;
