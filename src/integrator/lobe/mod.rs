@@ -2,6 +2,7 @@
 //! itself: pbrt-v4's BSDF at a surface interaction, reduced to the lobes
 //! this renderer has (`docs/bssrdf.md` §1, §6 "The coat").
 
+mod sample;
 #[cfg(feature = "subsurface")]
 mod subsurface;
 
@@ -9,6 +10,7 @@ use super::aov::Event;
 use super::interaction::offset_along;
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::materials::diffuse;
+pub(crate) use sample::LobeSample;
 #[cfg(feature = "subsurface")]
 pub(crate) use subsurface::SubsurfaceLobe;
 
@@ -51,21 +53,6 @@ pub(crate) enum Lobe<'a> {
     /// A subsurface material's or medium's lobe.
     #[cfg_attr(not(feature = "subsurface"), allow(dead_code))]
     Subsurface(SubsurfaceLobe<'a>),
-}
-
-/// A direction sampled from a lobe (local frame), with f |cos θ| / pdf
-/// and the solid-angle pdf.
-#[derive(Clone, Copy)]
-pub(crate) struct LobeSample {
-    pub(crate) wi: Vec3,
-    pub(crate) weight: Vec3,
-    pub(crate) pdf: f32,
-}
-
-impl LobeSample {
-    pub(crate) fn new((wi, weight, pdf): (Vec3, Vec3, f32)) -> Self {
-        LobeSample { wi, weight, pdf }
-    }
 }
 
 impl Lobe<'_> {

@@ -2,7 +2,7 @@
 //! entry lobe at xi, the random walk's exit lobe and the rough coat at xo
 //! (`docs/bssrdf.md` §6).
 
-use super::LobeSample;
+use super::sample::LobeSample;
 use crate::geometry::Vec3;
 use crate::integrator::aov::Event;
 use crate::integrator::diffuse_boundary::ExitLobe;

@@ -6,6 +6,7 @@ use super::entries::{entries, Entries};
 use crate::fresnel;
 use crate::geometry::{Ray, Vec3};
 use crate::integrator::aov::{Event, Recorder};
+use crate::integrator::branch::MAX_BRANCHES;
 use crate::integrator::coated::Weighted;
 use crate::integrator::lobe::{Bounce, Lobe, SubsurfaceLobe, Vertex};
 use crate::integrator::scatter::{Scatter, SubsurfaceHit};
@@ -13,6 +14,12 @@ use crate::integrator::state::PathState;
 use crate::integrator::{Context, Interaction};
 use crate::materials::microfacet::{reflect, RoughCoat};
 use crate::sampling::Draw;
+
+/// Smooth-coated subsurface hits at depths below this split into the
+/// mirror reflection and the medium (both followed); deeper ones choose
+/// one. 1: the camera vertex only (`docs/bssrdf.md` §6, "The coat").
+pub(crate) const COAT_SPLIT_DEPTH: u32 = 1;
+const _: () = assert!(COAT_SPLIT_DEPTH as usize <= MAX_BRANCHES);
 
 /// A subsurface hit at xo under the diffusion model: the coat at xo, then
 /// the probe(s) for the entry point xi, where the path continues with the
@@ -32,7 +39,7 @@ pub(super) fn scatter<'s, R: Recorder>(
 }
 
 /// The smooth coat, a mirror reflecting Fr: at depths below
-/// [`super::COAT_SPLIT_DEPTH`] both the reflection and the medium are
+/// [`COAT_SPLIT_DEPTH`] both the reflection and the medium are
 /// followed; deeper, the reflection is taken with probability Fr (weight
 /// 1) and the medium otherwise (weight 1).
 #[inline(always)]
@@ -47,7 +54,7 @@ fn smooth<'s, R: Recorder>(
     // (a mesh wound inside-out is read consistently the other way).
     let n_out = if si.front { si.ng } else { -si.ng };
     let beta_in = *beta;
-    let split = hit.depth < super::COAT_SPLIT_DEPTH;
+    let split = hit.depth < COAT_SPLIT_DEPTH;
     let fr = fresnel::dielectric(wo.dot(n_out).max(0.0), ss.eta());
     if !ss.specular() {
         *beta *= 1.0 - fr;

@@ -3,7 +3,7 @@
 //! g, the light a sample brings through the entry lobe at a model point,
 //! unshadowed, and the terms it adds at one probe or a pair.
 
-use super::ProbeAt;
+use super::probe_at::ProbeAt;
 use crate::bssrdf::PlaneModel;
 use crate::geometry::Vec3;
 use crate::integrator::coated::Ahead;

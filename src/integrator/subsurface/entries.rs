@@ -3,7 +3,7 @@
 //! the footprint is wide, xo itself (`docs/bssrdf.md` §5, §10, §11).
 
 use super::cv_model::{one_probe_ahead, pair_ahead, Lights};
-use super::ProbeAt;
+use super::probe_at::ProbeAt;
 use crate::bssrdf::{ProbeRandoms, ProbeSegment};
 use crate::geometry::curvature::TriangleCurvature;
 use crate::geometry::{Frame, Vec3};
