@@ -22,6 +22,7 @@ pub mod materials;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod stats;
 pub mod tools;
 
 pub use error::Error;

@@ -29,47 +29,9 @@
 //! elsewhere (`Instant`, nanoseconds). Shares are ratios of one clock's
 //! ticks, so its rate never needs to be known.
 
+pub use crate::stats::{Effect, EFFECTS};
+
 use super::Counters;
-
-/// The effects ray queries and time are counted by.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Effect {
-    /// Nearest-hit queries of camera rays (one a sample).
-    Camera,
-    /// Nearest-hit queries of paths continued after a bounce (lobe,
-    /// dielectric, coat reflection, a medium's exit).
-    Indirect,
-    /// Light samples at vertices and their shadow rays.
-    Direct,
-    /// Subsurface hits under diffusion: the coat and the probe rays.
-    Probe,
-    /// Subsurface hits under the random walk: the walk's flights.
-    Walk,
-}
-
-/// How many [`Effect`]s there are.
-pub const EFFECTS: usize = 5;
-
-impl Effect {
-    pub const ALL: [Effect; EFFECTS] = [
-        Effect::Camera,
-        Effect::Indirect,
-        Effect::Direct,
-        Effect::Probe,
-        Effect::Walk,
-    ];
-
-    /// The name the summary and the docs use.
-    pub fn name(self) -> &'static str {
-        match self {
-            Effect::Camera => "camera rays",
-            Effect::Indirect => "indirect continuation",
-            Effect::Direct => "direct light (shadow rays)",
-            Effect::Probe => "subsurface probes (and coat)",
-            Effect::Walk => "random walk",
-        }
-    }
-}
 
 /// A clock the tile loop and the integrators read around effect sections
 /// (module docs).

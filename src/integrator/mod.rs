@@ -37,6 +37,7 @@ use crate::accel::{Accel, Traversal};
 use crate::lights::LightSet;
 use crate::scene::Scene;
 
+pub use crate::stats::Counters;
 pub use effects::{Clock, Effect, NoClock, Stopwatch, EFFECTS};
 pub use interaction::Interaction;
 pub use plan::Plan;
@@ -308,72 +309,6 @@ impl IntegratorKind {
                 randomwalk::radiance::<R, T>(ctx, ray, rng, scratch, counters, rec)
             }
         }
-    }
-}
-
-/// Per-thread tallies, summed after rendering (no shared atomics in the
-/// hot loop).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Counters {
-    /// Ray queries issued: nearest, shadow and probe.
-    pub rays: u64,
-    /// Samples whose radiance was not finite and was discarded.
-    pub nonfinite: u64,
-    /// Sample channels beyond the accumulator's range, clamped to it
-    /// (`crate::film::accumulate`).
-    pub clamped: u64,
-    /// Random walks stopped at the cap on events inside a medium.
-    pub walks_capped: u64,
-    /// Random walks that left an open mesh through a hole (no boundary hit).
-    pub walks_escaped: u64,
-    /// Of `rays`, those answered without the accelerator: proven to meet
-    /// nothing ([`culling`]).
-    pub culled: u64,
-    /// Ray queries by [`Effect`]: they sum to `rays`.
-    pub effect_rays: [u64; EFFECTS],
-    /// Clock ticks by [`Effect`] (0 unless timed, [`effects`]).
-    pub effect_ticks: [u64; EFFECTS],
-    /// Clock ticks of whole samples (0 unless timed).
-    pub sample_ticks: u64,
-}
-
-impl Counters {
-    /// Probe queries made (subsurface probes; none under level of detail).
-    pub fn probes(&self) -> u64 {
-        self.effect_rays[Effect::Probe as usize]
-    }
-
-    /// One ray query made for `effect`.
-    #[inline(always)]
-    pub fn ray(&mut self, effect: Effect) {
-        self.rays += 1;
-        self.effect_rays[effect as usize] += 1;
-    }
-
-    /// `samples` samples traced their camera ray. The bounce loop counts
-    /// every nearest-hit query as [`Effect::Indirect`] (so it does not test
-    /// which is the camera's: one add a ray, as before the counts); every
-    /// sample makes exactly one camera query, so the tile loop moves one a
-    /// sample to [`Effect::Camera`].
-    pub fn camera_rays(&mut self, samples: u64) {
-        self.effect_rays[Effect::Camera as usize] += samples;
-        self.effect_rays[Effect::Indirect as usize] -= samples;
-    }
-}
-
-impl std::ops::AddAssign for Counters {
-    fn add_assign(&mut self, o: Self) {
-        self.rays += o.rays;
-        self.nonfinite += o.nonfinite;
-        self.clamped += o.clamped;
-        self.walks_capped += o.walks_capped;
-        self.walks_escaped += o.walks_escaped;
-        self.culled += o.culled;
-        for e in 0..EFFECTS {
-            self.effect_rays[e] += o.effect_rays[e];
-            self.effect_ticks[e] += o.effect_ticks[e];
-        }
-        self.sample_ticks += o.sample_ticks;
     }
 }
 
