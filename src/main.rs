@@ -677,7 +677,7 @@ fn run_render(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let header = |sums: &render::Accumulated| part::Header {
+    let header = |sums: &lucent::film::Sums| part::Header {
         identity: identity.clone(),
         scene: scene_name.clone(),
         region,
@@ -703,7 +703,7 @@ fn run_render(
     out.preview = Some(preview);
     let keep = checkpoint_path(output);
     let mut last = std::time::Instant::now();
-    let mut checkpoint = |sums: &render::Accumulated| -> Result<(), Error> {
+    let mut checkpoint = |sums: &lucent::film::Sums| -> Result<(), Error> {
         match split.checkpoint {
             Some(every) if last.elapsed().as_secs_f64() >= every && sums.done < samples.end => {
                 lucent::film::commit_all(vec![part::stage(&keep, &header(sums), sums)?])?;
@@ -883,7 +883,7 @@ fn resumable(
     path: &Path,
     identity: &Identity,
     job: &render::Job,
-) -> Result<render::Accumulated, Error> {
+) -> Result<lucent::film::Sums, Error> {
     let (h, sums) = part::read(path)?;
     let located = |field: &str, problem: String| -> Error {
         InputError::new(path, problem).in_field(field).into()

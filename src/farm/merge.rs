@@ -6,12 +6,12 @@
 //! and cover the frame's pixels × sample indices exactly once
 //! ([`super::cover`]). Then each part's integer sums are added into the
 //! frame's (exactly: integer addition, in any order), and the frame is the
-//! sums divided by spp, the same [`crate::render::Accumulated::film`] a
+//! sums divided by spp, the same [`crate::film::Sums::film`] a
 //! single-machine render ends with — so the merged frame is bitwise the
 //! uncut render. The passes' sums merge the same way (integer sums added,
 //! nearest hits by their unique (Z, sample) minimum, ID coverage by adding
 //! sample counts), and their layers and Cryptomatte come from the merged
-//! sums by [`crate::render::Accumulated::layers`], as in the uncut render.
+//! sums by [`crate::film::Sums::layers`], as in the uncut render.
 
 use std::path::{Path, PathBuf};
 
@@ -21,8 +21,8 @@ use crate::error::{Error, InputError};
 use crate::film::exr_layers::OutputOptions;
 use crate::film::layers::{Coverage, Layer};
 use crate::film::region::Region;
-use crate::film::Film;
-use crate::render::Accumulated;
+use crate::film::{Film, Sums};
+use crate::stats::Counters;
 
 /// A merged frame and what its parts say about it.
 #[derive(Debug)]
@@ -36,7 +36,7 @@ pub struct Merged {
     pub output: OutputOptions,
     pub identity: Identity,
     /// Summed over the parts.
-    pub counters: crate::integrator::Counters,
+    pub counters: Counters,
 }
 
 fn located(path: &Path, field: Option<&str>, problem: String) -> Error {
@@ -160,7 +160,7 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
     let identity = check(&headers)?;
     let frame = Region::full(identity.frame.0, identity.frame.1);
     let (first, _) = &headers[0];
-    let layout = part::layout_of(&identity).map_err(|(f, e)| located(first, Some(f), e))?;
+    let layout = part::layout_of(&identity).map_err(|e| e.at(first))?;
     let output = part::parse_output(&identity.output).ok_or_else(|| {
         located(
             first,
@@ -168,7 +168,7 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
             format!("`{}` is not the frame's file options", identity.output),
         )
     })?;
-    let mut sums = Accumulated::with_passes(frame, 0, layout.as_ref())?;
+    let mut sums = Sums::with_passes(frame, 0, layout.as_ref())?;
     sums.done = identity.spp;
     for (path, header) in &headers {
         crate::interrupt::stop_if_requested()?;

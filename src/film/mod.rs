@@ -10,10 +10,14 @@ pub mod cryptomatte;
 pub mod exr_attributes;
 pub mod exr_layers;
 pub mod layers;
+pub mod pass_layout;
+pub mod pass_sums;
 pub mod passes;
 pub mod region;
 pub mod stale;
+pub mod sums;
 pub mod tonemap;
+pub mod variance;
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -21,6 +25,7 @@ use std::path::{Path, PathBuf};
 use crate::error::Error;
 use crate::geometry::Vec3;
 use crate::interrupt;
+pub use sums::Sums;
 pub use tonemap::ToneMap;
 
 #[derive(Clone, Debug, PartialEq)]
