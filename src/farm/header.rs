@@ -404,3 +404,107 @@ pub fn parse_samples(s: &str) -> Option<Range<u32>> {
     let (a, b): (u32, u32) = (a.trim().parse().ok()?, b.trim().parse().ok()?);
     (a < b).then_some(a..b)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header() -> Header {
+        Header {
+            identity: Identity {
+                version: "1.0".into(),
+                scene_hash: "00ff".into(),
+                seed: 7,
+                spp: 4,
+                options: "accel=bvh".into(),
+                frame: (8, 6),
+                passes: String::new(),
+                names: String::new(),
+                output: output_text(&OutputOptions::default()),
+            },
+            scene: "scene.toml".into(),
+            region: Region {
+                x0: 0,
+                y0: 2,
+                x1: 8,
+                y1: 6,
+            },
+            samples: 1..3,
+            requested: 1..4,
+            layers: layers_of(None),
+            counters: Counters {
+                rays: 5,
+                clamped: 1,
+                ..Counters::default()
+            },
+        }
+    }
+
+    fn exr_attributes(h: &Header) -> HashMap<Text, AttributeValue> {
+        h.attributes()
+            .into_iter()
+            .map(|(k, v)| {
+                (
+                    Text::new_or_panic(k),
+                    AttributeValue::Text(Text::new_or_panic(v.as_str())),
+                )
+            })
+            .collect()
+    }
+
+    /// Text fields are read as text even when they would parse as JSON (a
+    /// number, a quoted string): read as JSON, they would change or fail.
+    #[test]
+    fn a_header_reads_back_as_written_even_text_that_looks_like_json() {
+        let mut h = header();
+        h.identity.scene_hash = "1234".into();
+        h.scene = "\"quoted\"".into();
+        let back = Header::read(Path::new("p.exr"), &exr_attributes(&h)).unwrap();
+        assert_eq!(back, h);
+    }
+
+    /// Every bad field is named with the file, whether its JSON does not
+    /// parse, is missing a member, or disagrees with another field.
+    #[test]
+    fn a_bad_field_names_the_file_and_the_field() {
+        for (field, text) in [
+            ("lucent.seed", "seven"),
+            ("lucent.frame", "[8]"),
+            ("lucent.region", r#"{"x0":0,"y0":0,"x1":9,"y1":6}"#),
+            ("lucent.samples", r#"{"start":0,"end":3}"#),
+            ("lucent.counters", r#"{"rays":1}"#),
+            ("lucent.layers", "[]"),
+            ("lucent.output", "precision=full"),
+            ("lucent.format_version", "2"),
+        ] {
+            let mut attrs = exr_attributes(&header());
+            let value = AttributeValue::Text(Text::new_or_panic(text));
+            attrs.insert(Text::new_or_panic(field), value);
+            let e = Header::read(Path::new("p.exr"), &attrs)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("p.exr") && e.contains(field), "{field}: {e}");
+        }
+        let mut attrs = exr_attributes(&header());
+        attrs.remove(&Text::new_or_panic("lucent.spp"));
+        let e = Header::read(Path::new("p.exr"), &attrs)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("lucent.spp") && e.contains("missing"), "{e}");
+    }
+
+    /// The first differing field is reported in the identity's order, so
+    /// parts with other passes name the passes, not the names they imply.
+    #[test]
+    fn a_difference_names_the_first_field_in_order() {
+        let (a, mut b) = (header().identity, header().identity);
+        assert_eq!(a.difference(&b), None);
+        b.passes = "Z".into();
+        b.names = "{}".into();
+        let (field, ours, theirs) = a.difference(&b).unwrap();
+        assert_eq!(
+            (field, ours.as_str(), theirs.as_str()),
+            ("lucent.passes", "", "Z")
+        );
+    }
+}
