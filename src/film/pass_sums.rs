@@ -11,7 +11,7 @@
 use super::accumulate::FixedPoint;
 use super::layers::{Coverage, Layer};
 use super::out_of_memory;
-use super::pass_layout::Layout;
+use super::pass_layout::{Layout, Slot};
 use super::passes::Pass;
 use super::variance::{variance, SQUARE_WORDS};
 use crate::error::Error;
@@ -210,23 +210,8 @@ pub fn layers<'b>(
     n: u64,
     at: impl Fn(u32, u32) -> (usize, &'b [i128]),
 ) -> Result<(Vec<Layer>, Vec<Coverage>), Error> {
-    const F: FixedPoint = FixedPoint::RADIANCE;
     let pixels = width as usize * height as usize;
-    let mut layers = Vec::with_capacity(layout.slots().len());
-    for slot in layout.slots() {
-        let len = pixels.saturating_mul(slot.channels.len());
-        let mut values = Vec::new();
-        values.try_reserve_exact(len).map_err(|_| {
-            let bytes = len.saturating_mul(std::mem::size_of::<f32>());
-            out_of_memory(&format!("the {} pass", slot.name), bytes)
-        })?;
-        layers.push(Layer {
-            name: slot.name.clone(),
-            channels: slot.channels.iter().map(|c| c.to_string()).collect(),
-            kind: slot.kind,
-            values,
-        });
-    }
+    let mut layers = empty_layers(layout, pixels)?;
     let coverage_of = |p: Pass, kind: &str, names: &[String]| {
         layout.passes.contains(p).then(|| Coverage {
             kind: kind.to_string(),
@@ -243,20 +228,7 @@ pub fn layers<'b>(
             let sums = &aov.sums[i * st..(i + 1) * st];
             let near = aov.nearest.get(i).copied().unwrap_or(Nearest::NONE);
             for (layer, slot) in layers.iter_mut().zip(layout.slots()) {
-                let o = slot.offset;
-                let mean = |k: usize| F.mean(sums[o + k], n);
-                let v: [f32; 3] = match slot.pass {
-                    Pass::Position => near.p,
-                    Pass::Depth => [near.z, 0.0, 0.0],
-                    Pass::ObjectId => [near.object as f32, 0.0, 0.0],
-                    Pass::MaterialId => [near.material as f32, 0.0, 0.0],
-                    Pass::SampleCount => [n as f32, 0.0, 0.0],
-                    Pass::Variance => std::array::from_fn(|c| {
-                        let w = o + c * SQUARE_WORDS;
-                        variance(beauty[c], &sums[w..w + SQUARE_WORDS], n)
-                    }),
-                    _ => [mean(0), mean(1), mean(2)],
-                };
+                let v = slot_value(slot, sums, beauty, near, n);
                 layer.values.extend_from_slice(&v[..slot.channels.len()]);
             }
             let fractions = |counts: &[(u32, u32)]| {
@@ -274,6 +246,47 @@ pub fn layers<'b>(
         }
     }
     Ok((layers, objects.into_iter().chain(materials).collect()))
+}
+
+/// The layers of `layout`, named, with room for `pixels` pixels' values;
+/// an error naming the pass that does not fit in memory.
+fn empty_layers(layout: &Layout, pixels: usize) -> Result<Vec<Layer>, Error> {
+    let mut layers = Vec::with_capacity(layout.slots().len());
+    for slot in layout.slots() {
+        let len = pixels.saturating_mul(slot.channels.len());
+        let mut values = Vec::new();
+        values.try_reserve_exact(len).map_err(|_| {
+            let bytes = len.saturating_mul(std::mem::size_of::<f32>());
+            out_of_memory(&format!("the {} pass", slot.name), bytes)
+        })?;
+        layers.push(Layer {
+            name: slot.name.clone(),
+            channels: slot.channels.iter().map(|c| c.to_string()).collect(),
+            kind: slot.kind,
+            values,
+        });
+    }
+    Ok(layers)
+}
+
+/// A pixel's value of the layer of `slot` (its first channels), from the
+/// pixel's pass sums, its beauty sums, its nearest hit and `n` samples.
+fn slot_value(slot: &Slot, sums: &[i128], beauty: &[i128], near: Nearest, n: u64) -> [f32; 3] {
+    const F: FixedPoint = FixedPoint::RADIANCE;
+    let o = slot.offset;
+    let mean = |k: usize| F.mean(sums[o + k], n);
+    match slot.pass {
+        Pass::Position => near.p,
+        Pass::Depth => [near.z, 0.0, 0.0],
+        Pass::ObjectId => [near.object as f32, 0.0, 0.0],
+        Pass::MaterialId => [near.material as f32, 0.0, 0.0],
+        Pass::SampleCount => [n as f32, 0.0, 0.0],
+        Pass::Variance => std::array::from_fn(|c| {
+            let w = o + c * SQUARE_WORDS;
+            variance(beauty[c], &sums[w..w + SQUARE_WORDS], n)
+        }),
+        _ => [mean(0), mean(1), mean(2)],
+    }
 }
 
 #[cfg(test)]
