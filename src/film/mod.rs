@@ -4,6 +4,10 @@
 //! rename), so a reader never sees a half-written image under the real name;
 //! the outputs of one command are committed together ([`commit_all`]), so a
 //! failure never leaves an EXR without its PNG.
+//!
+//! The film also owns every per-pixel sum a render keeps: the beauty's and
+//! the passes' exact sums ([`Sums`], [`pass_sums`]), from which the image
+//! and the pass layers are made.
 
 pub mod accumulate;
 pub mod cryptomatte;
