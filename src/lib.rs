@@ -23,6 +23,7 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod session;
+pub mod stats;
 pub mod tools;
 
 pub use error::Error;

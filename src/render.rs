@@ -21,7 +21,7 @@
 //! a render can stop, never what it computes.
 //!
 //! Passes (AOVs, `crate::integrator::aov`) are summed in the same loop,
-//! exactly and order-free like the beauty (`crate::integrator::aov::pixels`),
+//! exactly and order-free like the beauty (`crate::film::pass_sums`),
 //! into sums that persist across passes, are kept at a signal, saved in
 //! parts and merged: everything said above of the beauty holds for them.
 //! Whether passes are computed is decided once per render, by which
@@ -36,13 +36,10 @@ use rayon::prelude::*;
 
 use crate::accel::Accel;
 use crate::error::Error;
-use crate::film::accumulate::FixedPoint;
 use crate::film::layers::{Coverage, Layer};
 use crate::film::passes::PassSet;
 use crate::film::region::Region;
-use crate::film::Film;
-use crate::geometry::Vec3;
-use crate::integrator::aov::pixels::{self, AovSums, Layout, Passes};
+use crate::film::{Film, Sums};
 use crate::integrator::aov::{NoAov, PixelPasses, Setup, TilePasses};
 use crate::integrator::path::Scratch;
 use crate::integrator::{Clock, Context, Counters, IntegratorKind, NoClock, Stopwatch};
@@ -50,7 +47,7 @@ use crate::interrupt;
 use crate::sampling::{Draw, Rng, SampleRng};
 use crate::scene::Scene;
 
-pub const TILE: u32 = 16;
+pub use crate::film::sums::TILE;
 
 /// The most worker threads a render, a study or a benchmark accepts: far
 /// above any core count, far below what exhausts memory in thread stacks.
@@ -114,7 +111,7 @@ impl RenderStats {
                 format!(
                     ", {} sample channels beyond ±{:e} clamped",
                     self.counters.clamped,
-                    Accumulated::FORMAT.max_sample()
+                    Sums::FORMAT.max_sample()
                 )
             } else {
                 String::new()
@@ -153,150 +150,6 @@ impl Job {
     }
 }
 
-/// The exact per-pixel sums of a region's samples `start..done`: beauty
-/// RGB, [`Accumulated::CHANNELS`] values a pixel in the format
-/// [`Accumulated::FORMAT`], stored tile by tile, and the passes' sums in
-/// the same pixel order.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Accumulated {
-    pub region: Region,
-    /// The first sample index summed.
-    pub start: u32,
-    /// One past the last sample index summed (`start` when none is).
-    pub done: u32,
-    /// Tallies of the summed samples.
-    pub counters: Counters,
-    sums: Vec<i128>,
-    /// The passes, when any is summed.
-    pub passes: Option<Passes>,
-}
-
-impl Accumulated {
-    /// Channels a pixel: R, G, B.
-    pub const CHANNELS: usize = 3;
-    /// Their fixed-point format.
-    pub const FORMAT: FixedPoint = FixedPoint::RADIANCE;
-
-    /// Zero sums over `region`, no sample yet (from `start`); fails with a
-    /// runtime error, not an abort, when the memory is not there.
-    pub fn new(region: Region, start: u32) -> Result<Accumulated, Error> {
-        Self::with_passes(region, start, None)
-    }
-
-    /// [`new`](Self::new), with zero sums for the passes of `layout` too.
-    pub fn with_passes(
-        region: Region,
-        start: u32,
-        layout: Option<&Layout>,
-    ) -> Result<Accumulated, Error> {
-        let n = region.area() as usize * Self::CHANNELS;
-        let mut sums = Vec::new();
-        sums.try_reserve_exact(n).map_err(|_| {
-            crate::film::out_of_memory(
-                &format!(
-                    "the sums of a {}×{} region",
-                    region.width(),
-                    region.height()
-                ),
-                n.saturating_mul(16),
-            )
-        })?;
-        sums.resize(n, 0);
-        Ok(Accumulated {
-            region,
-            start,
-            done: start,
-            counters: Counters::default(),
-            sums,
-            passes: match layout {
-                Some(l) => Some(Passes {
-                    layout: l.clone(),
-                    sums: AovSums::new(l, region.area() as usize)?,
-                }),
-                None => None,
-            },
-        })
-    }
-
-    /// Samples summed in each pixel.
-    pub fn count(&self) -> u32 {
-        self.done - self.start
-    }
-
-    /// Pixel (x, y)'s index in the sums (tile-major layout: the tiles of
-    /// `tiles` in order, each row-major); its beauty sums start at
-    /// index · [`CHANNELS`](Self::CHANNELS).
-    pub fn index(&self, x: u32, y: u32) -> usize {
-        let r = &self.region;
-        let (lx, ly) = (x - r.x0, y - r.y0);
-        let (tx, ty) = (lx / TILE * TILE, ly / TILE * TILE);
-        // full rows of tiles above, then full tiles to the left in this row
-        let above = ty as usize * r.width() as usize;
-        let th = TILE.min(r.height() - ty) as usize;
-        let left = tx as usize * th;
-        let tw = TILE.min(r.width() - tx) as usize;
-        above + left + (ly - ty) as usize * tw + (lx - tx) as usize
-    }
-
-    /// Pixel (x, y)'s sums (frame coordinates, inside the region).
-    pub fn pixel(&self, x: u32, y: u32) -> &[i128] {
-        let o = self.index(x, y) * Self::CHANNELS;
-        &self.sums[o..o + Self::CHANNELS]
-    }
-
-    /// The beauty sums of the pixel of index `i` ([`index`](Self::index)).
-    pub fn pixel_at(&self, i: usize) -> &[i128] {
-        &self.sums[i * Self::CHANNELS..(i + 1) * Self::CHANNELS]
-    }
-
-    /// [`pixel_at`](Self::pixel_at), to set.
-    pub fn pixel_at_mut(&mut self, i: usize) -> &mut [i128] {
-        &mut self.sums[i * Self::CHANNELS..(i + 1) * Self::CHANNELS]
-    }
-
-    /// Pixel (x, y)'s sums, to set (merging, reading a part back).
-    pub fn pixel_mut(&mut self, x: u32, y: u32) -> &mut [i128] {
-        let o = self.index(x, y) * Self::CHANNELS;
-        &mut self.sums[o..o + Self::CHANNELS]
-    }
-
-    /// The region's image: each pixel the mean of its [`count`](Self::count)
-    /// samples ([`FixedPoint::mean`]).
-    pub fn film(&self) -> Result<Film, Error> {
-        let r = self.region;
-        let mut film = Film::try_new(r.width(), r.height())?;
-        let n = self.count() as u64;
-        for y in r.y0..r.y1 {
-            for x in r.x0..r.x1 {
-                let s = self.pixel(x, y);
-                let m = |c: usize| Self::FORMAT.mean(s[c], n);
-                film.set(x - r.x0, y - r.y0, Vec3::new(m(0), m(1), m(2)));
-            }
-        }
-        Ok(film)
-    }
-
-    /// The region's passes (layers in output order, and ID coverage) from
-    /// their sums and the [`count`](Self::count): none without passes.
-    pub fn layers(&self) -> Result<(Vec<Layer>, Vec<Coverage>), Error> {
-        let Some(p) = &self.passes else {
-            return Ok((Vec::new(), Vec::new()));
-        };
-        let r = self.region;
-        pixels::layers(
-            &p.layout,
-            &p.sums,
-            r.width(),
-            r.height(),
-            self.count() as u64,
-            |x, y| {
-                let (x, y) = (x + r.x0, y + r.y0);
-                (self.index(x, y), self.pixel(x, y))
-            },
-        )
-    }
-}
-
 /// The tiles of `region`, TILE × TILE from its top-left corner, row by
 /// row (the last row and column smaller).
 fn tiles(region: &Region) -> Vec<Region> {
@@ -318,7 +171,7 @@ fn tiles(region: &Region) -> Vec<Region> {
 #[derive(Debug)]
 pub struct Rendered {
     /// The sums of every finished pass (and of the resumed part).
-    pub sums: Accumulated,
+    pub sums: Sums,
     pub stats: RenderStats,
     /// The signal that stopped the render before `job.samples.end`, if one
     /// did; `sums` then holds the passes finished before it.
@@ -380,8 +233,8 @@ pub fn render_job(
     accel: &dyn Accel,
     opts: &RenderOptions,
     job: &Job,
-    resume: Option<Accumulated>,
-    after_pass: &mut dyn FnMut(&Accumulated) -> Result<(), Error>,
+    resume: Option<Sums>,
+    after_pass: &mut dyn FnMut(&Sums) -> Result<(), Error>,
 ) -> Result<Rendered, Error> {
     let settings = Settings::resolved(scene, opts);
     if let Some(n) = opts.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
@@ -399,7 +252,7 @@ pub fn render_job(
     }
     let ctx = Context::new(scene, accel);
     let setup = (!job.passes.is_empty()).then(|| Setup::new(scene, &ctx.lights, job.passes));
-    let layout = setup.as_ref().map(Layout::of);
+    let layout = setup.as_ref().map(Setup::layout);
     let mut sums = match resume {
         Some(a) => {
             if a.passes.as_ref().map(|p| &p.layout) != layout.as_ref() {
@@ -416,7 +269,7 @@ pub fn render_job(
             }
             a
         }
-        None => Accumulated::with_passes(job.region, job.samples.start, layout.as_ref())?,
+        None => Sums::with_passes(job.region, job.samples.start, layout.as_ref())?,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads.unwrap_or(0))
@@ -425,7 +278,7 @@ pub fn render_job(
     let threads = pool.current_num_threads();
     let tiles = tiles(&job.region);
     let areas: Vec<usize> = tiles.iter().map(|t| t.area() as usize).collect();
-    let mut next = Accumulated::with_passes(job.region, job.samples.start, layout.as_ref())?;
+    let mut next = Sums::with_passes(job.region, job.samples.start, layout.as_ref())?;
     let first = sums.done;
 
     let total = job.region.area() * (job.samples.end - first) as u64;
@@ -449,9 +302,10 @@ pub fn render_job(
         let pass_start = Instant::now();
         // each tile reads its previous sums and writes previous + pass
         let mut chunks = Vec::with_capacity(tiles.len());
-        let (mut prev, mut rest) = (&sums.sums[..], &mut next.sums[..]);
+        let (out, out_passes) = next.sums_mut();
+        let (mut prev, mut rest) = (sums.beauty(), out);
         for t in &tiles {
-            let n = t.area() as usize * Accumulated::CHANNELS;
+            let n = t.area() as usize * Sums::CHANNELS;
             let (a, b) = prev.split_at(n);
             let (c, d) = rest.split_at_mut(n);
             chunks.push((t, a, c));
@@ -466,7 +320,7 @@ pub fn render_job(
             bar: &bar,
             stats: opts.stats,
         };
-        let counters = match (&setup, &layout, &sums.passes, &mut next.passes) {
+        let counters = match (&setup, &layout, &sums.passes, out_passes) {
             (Some(setup), Some(layout), Some(p), Some(q)) => {
                 let views = p.sums.views(layout, &areas);
                 let outs = q.sums.views_mut(layout, &areas);
@@ -483,8 +337,7 @@ pub fn render_job(
             interrupted = Some(sig);
             break;
         }
-        std::mem::swap(&mut sums.sums, &mut next.sums);
-        std::mem::swap(&mut sums.passes, &mut next.passes);
+        sums.swap_sums(&mut next);
         sums.done = s.end;
         for c in counters {
             sums.counters += c;
@@ -565,7 +418,7 @@ fn render_tile<P: PixelPasses, T: Clock>(
     out: &mut [i128],
     mut passes: P,
 ) -> Counters {
-    const C: usize = Accumulated::CHANNELS;
+    const C: usize = Sums::CHANNELS;
     let scene = ctx.scene;
     let w = scene.camera.width;
     let mut counters = Counters::default();
@@ -602,7 +455,7 @@ fn render_tile<P: PixelPasses, T: Clock>(
                 T::lap_sample(&mut counters, t0);
                 let finite = l.is_finite();
                 if finite {
-                    counters.clamped += Accumulated::FORMAT.add(&mut sum, &[l.x, l.y, l.z]) as u64;
+                    counters.clamped += Sums::FORMAT.add(&mut sum, &[l.x, l.y, l.z]) as u64;
                 } else {
                     counters.nonfinite += 1;
                 }

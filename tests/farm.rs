@@ -15,9 +15,10 @@ use std::process::{Command, Output};
 use lucent::accel;
 use lucent::farm::part::{self, Header, Identity};
 use lucent::film::layers::{Coverage, Layer};
+use lucent::film::pass_layout::Layout;
 use lucent::film::passes::PassSet;
 use lucent::film::region::Region;
-use lucent::integrator::aov::{self, Layout};
+use lucent::integrator::aov;
 use lucent::render::{self, Job, RenderOptions};
 use lucent::scene::Scene;
 

@@ -578,3 +578,27 @@ fn a_mod_rs_and_its_children_form_a_dag() {
         bad.join("\n  ")
     );
 }
+
+#[test]
+fn the_farm_stores_film_sums_without_the_integrator_or_the_renderer() {
+    let s = Source::load();
+    for forbidden in ["integrator", "render"] {
+        let hits = s.files_naming("farm", forbidden);
+        assert!(
+            hits.is_empty(),
+            "farm must not depend on `{forbidden}`: {}",
+            hits.join(", ")
+        );
+    }
+}
+
+#[test]
+fn the_film_knows_nothing_of_the_integrator() {
+    let s = Source::load();
+    let hits = s.files_naming("film", "integrator");
+    assert!(
+        hits.is_empty(),
+        "film must not depend on `integrator`: {}",
+        hits.join(", ")
+    );
+}

@@ -6,23 +6,24 @@
 //! and cover the frame's pixels × sample indices exactly once
 //! ([`super::cover`]). Then each part's integer sums are added into the
 //! frame's (exactly: integer addition, in any order), and the frame is the
-//! sums divided by spp, the same [`crate::render::Accumulated::film`] a
+//! sums divided by spp, the same [`crate::film::Sums::film`] a
 //! single-machine render ends with — so the merged frame is bitwise the
 //! uncut render. The passes' sums merge the same way (integer sums added,
 //! nearest hits by their unique (Z, sample) minimum, ID coverage by adding
 //! sample counts), and their layers and Cryptomatte come from the merged
-//! sums by [`crate::render::Accumulated::layers`], as in the uncut render.
+//! sums by [`crate::film::Sums::layers`], as in the uncut render.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::cover::{self, CoverError, Piece};
+use super::header::bad;
 use super::part::{self, Header, Identity};
-use crate::error::{Error, InputError};
+use crate::error::Error;
 use crate::film::exr_layers::OutputOptions;
 use crate::film::layers::{Coverage, Layer};
 use crate::film::region::Region;
-use crate::film::Film;
-use crate::render::Accumulated;
+use crate::film::{Film, Sums};
+use crate::stats::Counters;
 
 /// A merged frame and what its parts say about it.
 #[derive(Debug)]
@@ -36,20 +37,30 @@ pub struct Merged {
     pub output: OutputOptions,
     pub identity: Identity,
     /// Summed over the parts.
-    pub counters: crate::integrator::Counters,
-}
-
-fn located(path: &Path, field: Option<&str>, problem: String) -> Error {
-    let e = InputError::new(path, problem);
-    match field {
-        Some(f) => e.in_field(f).into(),
-        None => e.into(),
-    }
+    pub counters: Counters,
 }
 
 /// Checks that the parts' headers belong together and cover the frame
 /// exactly once; the identity they share.
 pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
+    let id = shared_identity(headers)?;
+    let pieces: Vec<Piece> = headers
+        .iter()
+        .map(|(_, h)| Piece {
+            region: h.region,
+            samples: h.samples.clone(),
+        })
+        .collect();
+    let frame = Region::full(id.frame.0, id.frame.1);
+    match cover::check(&pieces, frame, id.spp) {
+        Ok(()) => Ok(id),
+        Err(e) => Err(cover_error(headers, &pieces, &id, e)),
+    }
+}
+
+/// The identity every part has, or an error naming the first part that
+/// differs from the first and the field that does.
+fn shared_identity(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
     let Some((first_path, first)) = headers.first() else {
         return Err(Error::Argument {
             argument: "merge".into(),
@@ -71,36 +82,30 @@ pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
                     format!("`{v}`")
                 }
             };
-            return Err(located(
-                p,
-                Some(field),
-                format!(
-                    "{}, but {} has {}: {what}",
-                    show(&a),
-                    first_path.display(),
-                    show(&b)
-                ),
-            ));
+            let (a, first, b) = (show(&a), first_path.display(), show(&b));
+            let problem = format!("{a}, but {first} has {b}: {what}");
+            return Err(bad(p, Some(field), problem));
         }
     }
-    let id = first.identity.clone();
-    let frame = Region::full(id.frame.0, id.frame.1);
-    let pieces: Vec<Piece> = headers
-        .iter()
-        .map(|(_, h)| Piece {
-            region: h.region,
-            samples: h.samples.clone(),
-        })
-        .collect();
+    Ok(first.identity.clone())
+}
+
+/// The error of parts (`headers`, covering `pieces`) of the frame `id`
+/// that do not cover it exactly once.
+fn cover_error(
+    headers: &[(PathBuf, Header)],
+    pieces: &[Piece],
+    id: &Identity,
+    e: CoverError,
+) -> Error {
     let show = |r: &Region, s: &std::ops::Range<u32>| {
         format!(
             "pixels x {}..{}, y {}..{}, samples {}..{}",
             r.x0, r.x1, r.y0, r.y1, s.start, s.end
         )
     };
-    match cover::check(&pieces, frame, id.spp) {
-        Ok(()) => Ok(id),
-        Err(CoverError::Outside(i)) => Err(located(
+    match e {
+        CoverError::Outside(i) => bad(
             &headers[i].0,
             Some("lucent.region"),
             format!(
@@ -110,13 +115,13 @@ pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
                 id.frame.1,
                 id.spp
             ),
-        )),
-        Err(CoverError::Overlap {
+        ),
+        CoverError::Overlap {
             a,
             b,
             region,
             samples,
-        }) => Err(located(
+        } => bad(
             &headers[b].0,
             None,
             format!(
@@ -124,8 +129,8 @@ pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
                 headers[a].0.display(),
                 show(&region, &samples)
             ),
-        )),
-        Err(CoverError::Gap { region, samples }) => {
+        ),
+        CoverError::Gap { region, samples } => {
             // name the part that stopped short, if one did
             let short = headers
                 .iter()
@@ -143,10 +148,10 @@ pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
                     )
                 })
                 .unwrap_or_default();
-            Err(Error::Input(format!(
+            Error::Input(format!(
                 "merge: the parts leave a gap: no part covers {}{short}",
                 show(&region, &samples)
-            )))
+            ))
         }
     }
 }
@@ -160,21 +165,21 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
     let identity = check(&headers)?;
     let frame = Region::full(identity.frame.0, identity.frame.1);
     let (first, _) = &headers[0];
-    let layout = part::layout_of(&identity).map_err(|(f, e)| located(first, Some(f), e))?;
+    let layout = part::layout_of(&identity).map_err(|e| e.at(first))?;
     let output = part::parse_output(&identity.output).ok_or_else(|| {
-        located(
+        bad(
             first,
             Some("lucent.output"),
             format!("`{}` is not the frame's file options", identity.output),
         )
     })?;
-    let mut sums = Accumulated::with_passes(frame, 0, layout.as_ref())?;
+    let mut sums = Sums::with_passes(frame, 0, layout.as_ref())?;
     sums.done = identity.spp;
     for (path, header) in &headers {
         crate::interrupt::stop_if_requested()?;
         let (h, part) = part::read(path)?;
         if h != *header {
-            return Err(located(path, None, "changed while being merged".into()));
+            return Err(bad(path, None, "changed while being merged"));
         }
         sums.counters += part.counters;
         let r = part.region;
@@ -183,7 +188,7 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
                 let from = part.pixel(x, y);
                 // a forged part could hold sums no render makes
                 let beyond = || {
-                    located(
+                    bad(
                         path,
                         None,
                         format!("pixel ({x}, {y}): sums beyond any render's range"),

@@ -8,13 +8,14 @@
 //! sample indices ([`crate::render::render_job`]) are a part of the frame's
 //! sums, and adding parts ([`merge`]) gives exactly the sums of one run.
 //!
-//! - [`part`]: the part file (an EXR of the integer sums, with a header
-//!   saying which frame, region and samples it holds);
+//! - [`part`]: the part file (an EXR of the integer sums), with its
+//!   [`header`] saying which frame, region and samples it holds;
 //! - [`cover`]: whether parts cover the frame exactly once;
 //! - [`merge`]: the checks and the sum;
 //! - [`mod@scene_hash`]: which scene a part is of.
 
 pub mod cover;
+pub mod header;
 pub mod merge;
 pub mod part;
 pub mod scene_hash;

@@ -60,7 +60,8 @@
 
 /// The fixed-point format of a layer's sums: an integer `v` stands for
 /// `v · 2^−frac_bits`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(transparent)]
 pub struct FixedPoint {
     pub frac_bits: u32,
 }

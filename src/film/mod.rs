@@ -4,16 +4,24 @@
 //! rename), so a reader never sees a half-written image under the real name;
 //! the outputs of one command are committed together ([`commit_all`]), so a
 //! failure never leaves an EXR without its PNG.
+//!
+//! The film also owns every per-pixel sum a render keeps: the beauty's and
+//! the passes' exact sums ([`Sums`], [`pass_sums`]), from which the image
+//! and the pass layers are made.
 
 pub mod accumulate;
 pub mod cryptomatte;
 pub mod exr_attributes;
 pub mod exr_layers;
 pub mod layers;
+pub mod pass_layout;
+pub mod pass_sums;
 pub mod passes;
 pub mod region;
 pub mod stale;
+pub mod sums;
 pub mod tonemap;
+pub mod variance;
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -21,6 +29,7 @@ use std::path::{Path, PathBuf};
 use crate::error::Error;
 use crate::geometry::Vec3;
 use crate::interrupt;
+pub use sums::Sums;
 pub use tonemap::ToneMap;
 
 #[derive(Clone, Debug, PartialEq)]

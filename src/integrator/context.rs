@@ -5,7 +5,6 @@
 
 #[cfg(feature = "subsurface")]
 use super::control_variate;
-use super::counters::Counters;
 use super::culling;
 use super::footprint::CameraSpread;
 use super::interaction::{self, Interaction};
@@ -15,6 +14,7 @@ use crate::accel::Accel;
 use crate::geometry::curvature::{MeshCurvature, TriangleCurvature};
 use crate::lights::LightSet;
 use crate::scene::Scene;
+use crate::stats::Counters;
 
 /// Subsurface hits at depths below this, on materials with `probe_pair`
 /// on (off by default: the plane control variate takes most of the same

@@ -29,7 +29,9 @@
 //! elsewhere (`Instant`, nanoseconds). Shares are ratios of one clock's
 //! ticks, so its rate never needs to be known.
 
-use super::counters::{Counters, Effect};
+pub use crate::stats::{Effect, EFFECTS};
+
+use crate::stats::Counters;
 
 /// A clock the tile loop and the integrators read around effect sections
 /// (module docs).

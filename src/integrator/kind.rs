@@ -3,12 +3,12 @@
 
 use super::aov;
 use super::context::Context;
-use super::counters::Counters;
 use super::effects::Clock;
 use super::path;
 #[cfg(feature = "subsurface")]
 use super::randomwalk;
 use crate::accel::Traversal;
+use crate::stats::Counters;
 
 /// Which estimator renders the image. Both treat surfaces, lights and the
 /// environment alike; they differ at subsurface objects.

@@ -9,7 +9,7 @@
 //! geometry; [`probe`] runs the BSSRDF's probe query and
 //! [`control_variate`] is its plane control variate; [`footprint`] is the
 //! path's ray cone; [`culling`] answers rays proven to meet nothing;
-//! [`aov`] records what the passes measure; [`counters`] and [`effects`]
+//! [`aov`] records what the passes measure; [`effects`] (with [`crate::stats`])
 //! tally ray queries and time per effect for `--stats`. `probe`,
 //! `control_variate`, `randomwalk` and `diffuse_boundary` exist only with
 //! the `subsurface` feature (the default).
@@ -21,7 +21,6 @@ mod coated;
 pub mod context;
 #[cfg(feature = "subsurface")]
 pub mod control_variate;
-pub mod counters;
 pub mod culling;
 #[cfg(feature = "subsurface")]
 pub mod diffuse_boundary;
@@ -42,8 +41,8 @@ mod state;
 #[cfg(feature = "subsurface")]
 mod subsurface;
 
+pub use crate::stats::{Counters, Effect, EFFECTS};
 pub use context::Context;
-pub use counters::{Counters, Effect, EFFECTS};
 pub use effects::{Clock, NoClock, Stopwatch};
 pub use interaction::Interaction;
 pub use kind::IntegratorKind;

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use crate::error::Error;
 use crate::farm::part::{self, Header};
-use crate::render::Accumulated;
+use crate::film::Sums;
 
 /// Where a render keeps its finished samples for `--resume` (at a signal,
 /// at checkpoints): `OUT.partial.exr` beside `OUT.exr`.
@@ -25,7 +25,7 @@ pub struct Checkpoints<'a> {
 
 impl Checkpoints<'_> {
     /// Called after every pass with its sums and their part header.
-    pub fn after_pass(&mut self, sums: &Accumulated, header: &Header) -> Result<(), Error> {
+    pub fn after_pass(&mut self, sums: &Sums, header: &Header) -> Result<(), Error> {
         match self.every {
             Some(every) if self.last.elapsed().as_secs_f64() >= every && sums.done < self.end => {
                 crate::film::commit_all(vec![part::stage(self.path, header, sums)?])?;

@@ -9,7 +9,7 @@ use crate::error::Error;
 use crate::farm::part::{self, Identity};
 use crate::film::exr_layers::{FrameHeader, OutputOptions};
 use crate::film::passes::PassSet;
-use crate::integrator::aov::pixels::Layout;
+use crate::film::pass_layout::Layout;
 use crate::integrator::{plan, IntegratorKind};
 use crate::render::Settings;
 use crate::scene::Scene;

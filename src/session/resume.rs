@@ -5,11 +5,12 @@ use std::path::Path;
 
 use crate::error::{Error, InputError};
 use crate::farm::part::{self, Identity};
-use crate::render::{Accumulated, Job};
+use crate::film::Sums;
+use crate::render::Job;
 
 /// The sums of the part at `path`, checked to be a start of `job` of the
 /// frame `identity`.
-pub fn resumable(path: &Path, identity: &Identity, job: &Job) -> Result<Accumulated, Error> {
+pub fn resumable(path: &Path, identity: &Identity, job: &Job) -> Result<Sums, Error> {
     let (h, sums) = part::read(path)?;
     let located = |field: &str, problem: String| -> Error {
         InputError::new(path, problem).in_field(field).into()

@@ -14,7 +14,8 @@ use crate::error::{Error, InputError};
 use crate::farm::part;
 use crate::film::exr_layers::{self, OutputOptions};
 use crate::film::region::Region;
-use crate::render::{self, Accumulated, RenderStats, Settings};
+use crate::film::Sums;
+use crate::render::{self, RenderStats, Settings};
 use crate::scene::{self, Scene};
 
 /// What a finished render did (for its summary line).
@@ -146,7 +147,7 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let header = |sums: &Accumulated| part::Header {
+    let header = |sums: &Sums| part::Header {
         identity: identity.clone(),
         scene: scene_name.clone(),
         region,
@@ -177,7 +178,7 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         end: samples.end,
         last: Instant::now(),
     };
-    let mut after_pass = |sums: &Accumulated| checkpoints.after_pass(sums, &header(sums));
+    let mut after_pass = |sums: &Sums| checkpoints.after_pass(sums, &header(sums));
     let done = render::render_job(
         &scene,
         accel.as_ref(),

@@ -45,11 +45,12 @@
 pub mod pixels;
 mod sample;
 
-pub use pixels::{AovSums, Layout, Passes, PixelPasses, TilePasses};
+pub use pixels::{PixelPasses, TilePasses};
 pub use sample::SampleAovs;
 
 use std::collections::HashMap;
 
+use crate::film::pass_layout::Layout;
 use crate::film::passes::{Pass, PassSet};
 use crate::geometry::Vec3;
 use crate::lights::LightSet;
@@ -179,12 +180,22 @@ pub struct Setup {
 /// The layout of `passes` over `scene`'s names (what a part of its render
 /// holds), without building the scene's lights.
 pub fn layout(scene: &Scene, passes: PassSet) -> Layout {
-    Layout::of(&Setup::build(scene, None, passes))
+    Setup::build(scene, None, passes).layout()
 }
 
 impl Setup {
     pub fn new(scene: &Scene, lights: &LightSet, passes: PassSet) -> Setup {
         Setup::build(scene, Some(lights), passes)
+    }
+
+    /// The layout of the passes over these names.
+    pub fn layout(&self) -> Layout {
+        Layout::new(
+            self.passes,
+            &self.groups,
+            &self.object_names,
+            &self.material_names,
+        )
     }
 
     /// [`Setup::new`]; without `lights`, no light has a group.

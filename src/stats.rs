@@ -1,6 +1,10 @@
-//! Per-thread tallies of a render ([`Counters`]): ray queries by
-//! [`Effect`], samples discarded or clamped, walks capped or escaped, and
-//! the clock ticks [`super::effects`] measures; summed after rendering.
+//! The render's tallies: ray queries (in total and by [`Effect`]), samples
+//! dropped or clamped, random walks cut short, and the clock ticks of
+//! `--stats` (`crate::integrator::effects`). Kept apart from the
+//! integrator that counts them so that what stores them (parts,
+//! `crate::farm`) need not depend on it.
+
+use serde::{Deserialize, Serialize};
 
 /// The effects ray queries and time are counted by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,8 +47,10 @@ impl Effect {
 }
 
 /// Per-thread tallies, summed after rendering (no shared atomics in the
-/// hot loop).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// hot loop). Serialized (in parts): the totals of the samples, not the
+/// ray-query breakdown and ticks of one render's `--stats`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Counters {
     /// Ray queries issued: nearest, shadow and probe.
     pub rays: u64,
@@ -58,13 +64,18 @@ pub struct Counters {
     /// Random walks that left an open mesh through a hole (no boundary hit).
     pub walks_escaped: u64,
     /// Of `rays`, those answered without the accelerator: proven to meet
-    /// nothing ([`super::culling`]).
+    /// nothing (`crate::integrator::culling`).
+    #[serde(skip)]
     pub culled: u64,
     /// Ray queries by [`Effect`]: they sum to `rays`.
+    #[serde(skip)]
     pub effect_rays: [u64; EFFECTS],
-    /// Clock ticks by [`Effect`] (0 unless timed, [`super::effects`]).
+    /// Clock ticks by [`Effect`] (0 unless timed,
+    /// `crate::integrator::effects`).
+    #[serde(skip)]
     pub effect_ticks: [u64; EFFECTS],
     /// Clock ticks of whole samples (0 unless timed).
+    #[serde(skip)]
     pub sample_ticks: u64,
 }
 
