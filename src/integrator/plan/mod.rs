@@ -14,7 +14,10 @@
 //! (`tests/plan.rs`) check that the explanation says what the flags do
 //! and that a render honours it (no probe ray where it says none).
 
+mod choice;
 pub mod explain;
+mod materials;
+mod options;
 pub mod text;
 
 use crate::scene::Scene;
