@@ -37,6 +37,7 @@ use rayon::prelude::*;
 use crate::accel::Accel;
 use crate::error::Error;
 use crate::film::layers::{Coverage, Layer};
+use crate::film::pass_layout::Layout;
 use crate::film::passes::PassSet;
 use crate::film::region::Region;
 use crate::film::{Film, Sums};
@@ -237,44 +238,12 @@ pub fn render_job(
     after_pass: &mut dyn FnMut(&Sums) -> Result<(), Error>,
 ) -> Result<Rendered, Error> {
     let settings = Settings::resolved(scene, opts);
-    if let Some(n) = opts.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
-        return Err(Error::Argument {
-            argument: "--threads".into(),
-            problem: format!("{n} is not a thread count (1 to {MAX_THREADS})"),
-        });
-    }
-    let frame = Region::full(scene.camera.width, scene.camera.height);
-    if job.region.is_empty() || !job.region.within(&frame) || job.samples.is_empty() {
-        return Err(Error::Input(format!(
-            "nothing to render: region {} of a {}×{} frame, samples {}..{}",
-            job.region, frame.x1, frame.y1, job.samples.start, job.samples.end
-        )));
-    }
+    check_job(scene, opts, job)?;
     let ctx = Context::new(scene, accel);
     let setup = (!job.passes.is_empty()).then(|| Setup::new(scene, &ctx.lights, job.passes));
     let layout = setup.as_ref().map(Setup::layout);
-    let mut sums = match resume {
-        Some(a) => {
-            if a.passes.as_ref().map(|p| &p.layout) != layout.as_ref() {
-                return Err(Error::Input(
-                    "cannot resume: the saved sums hold other passes than the job's".into(),
-                ));
-            }
-            if a.region != job.region || a.start != job.samples.start || a.done > job.samples.end {
-                return Err(Error::Input(format!(
-                    "cannot resume: the saved sums cover region {} samples {}..{}, the job \
-                     region {} samples {}..{}",
-                    a.region, a.start, a.done, job.region, job.samples.start, job.samples.end
-                )));
-            }
-            a
-        }
-        None => Sums::with_passes(job.region, job.samples.start, layout.as_ref())?,
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| Error::Runtime(format!("cannot start worker threads: {e}")))?;
+    let mut sums = starting_sums(resume, job, layout.as_ref())?;
+    let pool = worker_pool(opts.threads)?;
     let threads = pool.current_num_threads();
     let tiles = tiles(&job.region);
     let areas: Vec<usize> = tiles.iter().map(|t| t.area() as usize).collect();
@@ -282,17 +251,7 @@ pub fn render_job(
     let first = sums.done;
 
     let total = job.region.area() * (job.samples.end - first) as u64;
-    let bar = if opts.progress {
-        let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-        b.set_style(
-            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
-                .unwrap()
-                .progress_chars("=> "),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
-    };
+    let bar = progress_bar(opts.progress, total);
 
     let start = Instant::now();
     let mut interrupted = None;
@@ -300,17 +259,6 @@ pub fn render_job(
     while sums.done < job.samples.end {
         let s = sums.done..sums.done + size.min(job.samples.end - sums.done);
         let pass_start = Instant::now();
-        // each tile reads its previous sums and writes previous + pass
-        let mut chunks = Vec::with_capacity(tiles.len());
-        let (out, out_passes) = next.sums_mut();
-        let (mut prev, mut rest) = (sums.beauty(), out);
-        for t in &tiles {
-            let n = t.area() as usize * Sums::CHANNELS;
-            let (a, b) = prev.split_at(n);
-            let (c, d) = rest.split_at_mut(n);
-            chunks.push((t, a, c));
-            (prev, rest) = (b, d);
-        }
         let pass = Pass {
             ctx: &ctx,
             integrator: settings.integrator,
@@ -320,18 +268,13 @@ pub fn render_job(
             bar: &bar,
             stats: opts.stats,
         };
-        let counters = match (&setup, &layout, &sums.passes, out_passes) {
-            (Some(setup), Some(layout), Some(p), Some(q)) => {
-                let views = p.sums.views(layout, &areas);
-                let outs = q.sums.views_mut(layout, &areas);
-                let with = views
-                    .into_iter()
-                    .zip(outs)
-                    .map(|(v, o)| TilePasses::new(setup, layout, v, o));
-                pass.run(chunks.into_iter().zip(with).collect())
-            }
-            _ => pass.run(chunks.into_iter().map(|c| (c, NoAov)).collect()),
+        let grid = Grid {
+            tiles: &tiles,
+            areas: &areas,
+            setup: setup.as_ref(),
+            layout: layout.as_ref(),
         };
+        let counters = grid.run(&pass, &sums, &mut next);
         // stopped by a signal: this pass is incomplete, drop it
         if let Some(sig) = interrupt::requested() {
             interrupted = Some(sig);
@@ -359,6 +302,108 @@ pub fn render_job(
         stats,
         interrupted,
     })
+}
+
+/// Refuses a thread count out of range and a job with nothing to render.
+fn check_job(scene: &Scene, opts: &RenderOptions, job: &Job) -> Result<(), Error> {
+    if let Some(n) = opts.threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
+        return Err(Error::Argument {
+            argument: "--threads".into(),
+            problem: format!("{n} is not a thread count (1 to {MAX_THREADS})"),
+        });
+    }
+    let frame = Region::full(scene.camera.width, scene.camera.height);
+    if job.region.is_empty() || !job.region.within(&frame) || job.samples.is_empty() {
+        return Err(Error::Input(format!(
+            "nothing to render: region {} of a {}×{} frame, samples {}..{}",
+            job.region, frame.x1, frame.y1, job.samples.start, job.samples.end
+        )));
+    }
+    Ok(())
+}
+
+/// The sums the job starts from: `resume`'s when they hold the job's
+/// passes, region and first sample, else empty ones.
+fn starting_sums(resume: Option<Sums>, job: &Job, layout: Option<&Layout>) -> Result<Sums, Error> {
+    match resume {
+        Some(a) => {
+            if a.passes.as_ref().map(|p| &p.layout) != layout {
+                return Err(Error::Input(
+                    "cannot resume: the saved sums hold other passes than the job's".into(),
+                ));
+            }
+            if a.region != job.region || a.start != job.samples.start || a.done > job.samples.end {
+                return Err(Error::Input(format!(
+                    "cannot resume: the saved sums cover region {} samples {}..{}, the job \
+                     region {} samples {}..{}",
+                    a.region, a.start, a.done, job.region, job.samples.start, job.samples.end
+                )));
+            }
+            Ok(a)
+        }
+        None => Ok(Sums::with_passes(job.region, job.samples.start, layout)?),
+    }
+}
+
+/// The worker threads (`None`: one per core).
+fn worker_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Error> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| Error::Runtime(format!("cannot start worker threads: {e}")))
+}
+
+/// The progress bar over `total` pixel samples (hidden without `show`).
+fn progress_bar(show: bool, total: u64) -> ProgressBar {
+    if show {
+        let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}%, eta {eta}")
+                .unwrap()
+                .progress_chars("=> "),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    }
+}
+
+/// The job's tiles and passes: what every pass splits its sums by.
+struct Grid<'a> {
+    tiles: &'a [Region],
+    /// Each tile's pixel count.
+    areas: &'a [usize],
+    setup: Option<&'a Setup>,
+    layout: Option<&'a Layout>,
+}
+
+impl Grid<'_> {
+    /// Runs `pass` over every tile: each reads its previous sums from
+    /// `sums` and writes previous + pass into `next`.
+    fn run(&self, pass: &Pass, sums: &Sums, next: &mut Sums) -> Vec<Counters> {
+        let mut chunks = Vec::with_capacity(self.tiles.len());
+        let (out, out_passes) = next.sums_mut();
+        let (mut prev, mut rest) = (sums.beauty(), out);
+        for t in self.tiles {
+            let n = t.area() as usize * Sums::CHANNELS;
+            let (a, b) = prev.split_at(n);
+            let (c, d) = rest.split_at_mut(n);
+            chunks.push((t, a, c));
+            (prev, rest) = (b, d);
+        }
+        match (self.setup, self.layout, &sums.passes, out_passes) {
+            (Some(setup), Some(layout), Some(p), Some(q)) => {
+                let views = p.sums.views(layout, self.areas);
+                let outs = q.sums.views_mut(layout, self.areas);
+                let with = views
+                    .into_iter()
+                    .zip(outs)
+                    .map(|(v, o)| TilePasses::new(setup, layout, v, o));
+                pass.run(chunks.into_iter().zip(with).collect())
+            }
+            _ => pass.run(chunks.into_iter().map(|c| (c, NoAov)).collect()),
+        }
+    }
 }
 
 /// One pass over the tiles: what every tile of it needs.
