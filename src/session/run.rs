@@ -2,6 +2,7 @@
 //! checkpoints), write the frame or the part.
 
 use std::ops::Range;
+use std::path::PathBuf;
 use std::time::Instant;
 
 use super::checkpoint::{self, Checkpoints};
@@ -13,6 +14,7 @@ use crate::accel;
 use crate::error::{Error, InputError};
 use crate::farm::part;
 use crate::film::exr_layers::{self, OutputOptions};
+use crate::film::passes::PassSet;
 use crate::film::region::Region;
 use crate::film::Sums;
 use crate::render::{self, RenderStats, Settings};
@@ -130,9 +132,7 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
     let samples = samples_of(&r.split, settings.spp)?;
     let passes = r.aov.unwrap_or(scene.output.aovs);
     let layout = (!passes.is_empty()).then(|| crate::integrator::aov::layout(&scene, passes));
-    let mut out = r
-        .file
-        .over(scene.output.file.over(OutputOptions::default()));
+    let mut out = output_options(r, &scene);
     let identity = identity::identity(
         text.as_bytes(),
         &scene,
@@ -142,11 +142,7 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         layout.as_ref(),
         &out,
     );
-    let scene_name = r
-        .scene
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let scene_name = scene_name(r);
     let header = |sums: &Sums| part::Header {
         identity: identity.clone(),
         scene: scene_name.clone(),
@@ -156,12 +152,7 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         layers: part::layers_of(layout.as_ref()),
         counters: sums.counters,
     };
-    let job = render::Job {
-        region,
-        samples: samples.clone(),
-        pass_seconds: r.split.checkpoint.map_or(2.0, |c| (c / 2.0).min(2.0)),
-        passes,
-    };
+    let job = job_of(r, region, samples.clone(), passes);
     let resume = match &r.split.resume {
         Some(p) => Some(resumable(p, &identity, &job)?),
         None => None,
@@ -188,17 +179,7 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         &mut after_pass,
     )?;
     if let Some(signal) = done.interrupted {
-        if done.sums.count() == 0 {
-            return Err(Error::Interrupted(signal));
-        }
-        let staged = part::stage(&keep, &header(&done.sums), &done.sums)?;
-        crate::film::commit_even_if_interrupted(vec![staged])?;
-        return Err(Error::InterruptedKept {
-            signal,
-            part: keep,
-            samples: done.sums.start..done.sums.done,
-            requested: samples,
-        });
+        return keep_interrupted(signal, keep, &header(&done.sums), &done.sums, samples);
     }
     if r.split.is_part() {
         crate::film::commit_all(vec![part::stage(
@@ -216,9 +197,7 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
             &settings,
             done.stats.seconds,
         )?;
-        let (layers, coverage) = done.sums.layers()?;
-        let film = done.sums.film()?;
-        exr_layers::write_frame(&r.output, &film, &layers, &coverage, &header, &out)?;
+        write_frame(r, &done.sums, &header, &out)?;
     }
     checkpoint::clean(&keep);
     Ok(Outcome {
@@ -232,4 +211,63 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         stats: done.stats,
         rejected_rays: accel.rejected_rays(),
     })
+}
+
+/// The output options: the command line's over the scene's over the
+/// defaults.
+fn output_options(r: &Request, scene: &Scene) -> OutputOptions {
+    r.file
+        .over(scene.output.file.over(OutputOptions::default()))
+}
+
+/// The scene file's name, for part headers.
+fn scene_name(r: &Request) -> String {
+    r.scene
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// The render job: checkpoints pace the passes (at most 2 s each).
+fn job_of(r: &Request, region: Region, samples: Range<u32>, passes: PassSet) -> render::Job {
+    render::Job {
+        region,
+        samples,
+        pass_seconds: r.split.checkpoint.map_or(2.0, |c| (c / 2.0).min(2.0)),
+        passes,
+    }
+}
+
+/// A render stopped by `signal`: keeps the finished passes as a part at
+/// `keep` (none finished: nothing kept) and reports the stop.
+fn keep_interrupted(
+    signal: i32,
+    keep: PathBuf,
+    header: &part::Header,
+    sums: &Sums,
+    requested: Range<u32>,
+) -> Result<Outcome, Error> {
+    if sums.count() == 0 {
+        return Err(Error::Interrupted(signal));
+    }
+    let staged = part::stage(&keep, header, sums)?;
+    crate::film::commit_even_if_interrupted(vec![staged])?;
+    Err(Error::InterruptedKept {
+        signal,
+        part: keep,
+        samples: sums.start..sums.done,
+        requested,
+    })
+}
+
+/// Writes the finished frame's layers to the output EXR.
+fn write_frame(
+    r: &Request,
+    sums: &Sums,
+    header: &exr_layers::FrameHeader,
+    out: &OutputOptions,
+) -> Result<(), Error> {
+    let (layers, coverage) = sums.layers()?;
+    let film = sums.film()?;
+    exr_layers::write_frame(&r.output, &film, &layers, &coverage, header, out)
 }
