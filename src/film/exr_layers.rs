@@ -293,37 +293,46 @@ impl File {
         );
         let image = Image::from_layer(layer);
         Staged::write(&self.path, |tmp| {
-            image
-                .write()
-                .non_parallel()
-                .to_file(tmp)
-                .map_err(|e| e.to_string())?;
+            image.write().non_parallel().to_file(tmp)?;
             sort_header_in_file(tmp)
         })
     }
 }
 
+/// Why the frame's EXR could not be written to its temporary file: the
+/// encoder's or the file system's error, or a header the in-place sort
+/// cannot read.
+#[derive(Debug, thiserror::Error)]
+enum FrameWriteError {
+    #[error("{0}")]
+    Exr(#[from] exr::error::Error),
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    #[error("malformed EXR header")]
+    MalformedHeader,
+    #[error("a multi-part EXR header (not written here)")]
+    MultiPart,
+}
+
 /// [`sort_header_attributes`] on the file at `path`, reading only its
 /// header (the first 64 kB, more if the header is longer), so the pixels
 /// are never held in memory twice.
-fn sort_header_in_file(path: &Path) -> Result<(), String> {
+fn sort_header_in_file(path: &Path) -> Result<(), FrameWriteError> {
     use std::io::{Read, Seek, SeekFrom, Write};
-    let io = |e: std::io::Error| e.to_string();
     let mut f = std::fs::OpenOptions::new()
         .read(true)
         .write(true)
-        .open(path)
-        .map_err(io)?;
-    let len = f.metadata().map_err(io)?.len() as usize;
+        .open(path)?;
+    let len = f.metadata()?.len() as usize;
     let mut n = len.min(1 << 16);
     loop {
         let mut head = vec![0u8; n];
-        f.seek(SeekFrom::Start(0)).map_err(io)?;
-        f.read_exact(&mut head).map_err(io)?;
+        f.seek(SeekFrom::Start(0))?;
+        f.read_exact(&mut head)?;
         match sort_header_attributes(&mut head) {
             Ok(end) => {
-                f.seek(SeekFrom::Start(0)).map_err(io)?;
-                return f.write_all(&head[..end]).map_err(io);
+                f.seek(SeekFrom::Start(0))?;
+                return Ok(f.write_all(&head[..end])?);
             }
             Err(_) if n < len => n = (2 * n).min(len),
             Err(e) => return Err(e),
@@ -426,15 +435,15 @@ fn check_layers(layers: &[Layer], coverage: &[Coverage], pixels: usize) -> Resul
 /// ends with an empty name; the header's length, hence the offset table
 /// after it, is unchanged. Returns where the attribute list ends (the
 /// bytes before it are all this changes); fails on a list cut short.
-fn sort_header_attributes(bytes: &mut [u8]) -> Result<usize, String> {
-    let malformed = || "malformed EXR header".to_string();
+fn sort_header_attributes(bytes: &mut [u8]) -> Result<usize, FrameWriteError> {
+    let malformed = || FrameWriteError::MalformedHeader;
     if bytes.len() < 8 || bytes[..4] != [0x76, 0x2f, 0x31, 0x01] {
         return Err(malformed());
     }
     if bytes[5] & 0x10 != 0 {
-        return Err("a multi-part EXR header (not written here)".into());
+        return Err(FrameWriteError::MultiPart);
     }
-    let cstr_end = |from: usize| -> Result<usize, String> {
+    let cstr_end = |from: usize| -> Result<usize, FrameWriteError> {
         bytes[from..]
             .iter()
             .position(|&b| b == 0)

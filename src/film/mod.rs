@@ -23,6 +23,7 @@ pub mod sums;
 pub mod tonemap;
 pub mod variance;
 
+use std::fmt::Display;
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -94,13 +95,7 @@ impl Film {
             line_order: LineOrder::Increasing,
         };
         let image = Image::from_encoded_channels((w, self.height as usize), encoding, channels);
-        Staged::write(path, |tmp| {
-            image
-                .write()
-                .non_parallel()
-                .to_file(tmp)
-                .map_err(|e| e.to_string())
-        })
+        Staged::write(path, |tmp| image.write().non_parallel().to_file(tmp))
     }
 
     /// The EXR at `exr` and its PNG preview beside it
@@ -177,11 +172,11 @@ pub fn out_of_memory(what: &str, bytes: usize) -> Error {
 
 /// Runs `write` on a temporary path next to `path`, then renames it into
 /// place; on any failure the temporary file is removed and nothing appears
-/// under `path`. `write` reports its failure as a message; the error names
-/// `path`.
-pub fn write_atomically(
+/// under `path`. `write` reports its failure as any displayable error; the
+/// error names `path` and carries that text.
+pub fn write_atomically<E: Display>(
     path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
+    write: impl FnOnce(&Path) -> Result<(), E>,
 ) -> Result<(), Error> {
     commit_all(vec![Staged::write(path, write)?])
 }
@@ -200,9 +195,9 @@ pub struct Staged {
 impl Staged {
     /// Runs `write` on the temporary path of `path`; on failure the
     /// temporary file is removed and the error names `path`.
-    pub fn write(
+    pub fn write<E: Display>(
         path: &Path,
-        write: impl FnOnce(&Path) -> Result<(), String>,
+        write: impl FnOnce(&Path) -> Result<(), E>,
     ) -> Result<Staged, Error> {
         // what a killed process left of this output (SIGKILL, `stale`)
         stale::clean(path);
@@ -214,7 +209,7 @@ impl Staged {
         // on failure, dropping `staged` removes the temporary file
         write(&staged.tmp).map_err(|problem| Error::Write {
             path: path.to_path_buf(),
-            problem,
+            problem: problem.to_string(),
         })?;
         Ok(staged)
     }
@@ -309,9 +304,9 @@ fn roll_back(done: Vec<(&Path, Option<PathBuf>)>) {
 
 /// [`write_atomically`] with the error as its message (`cannot write PATH:
 /// …`), for the tools (plots, study, bench) that still report strings.
-pub fn atomic_write(
+pub fn atomic_write<E: Display>(
     path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
+    write: impl FnOnce(&Path) -> Result<(), E>,
 ) -> Result<(), String> {
     write_atomically(path, write).map_err(String::from)
 }
@@ -408,7 +403,7 @@ mod tests {
         let p2 = dir.path().join("b.exr");
         let r = atomic_write(&p2, |tmp| {
             fs::write(tmp, b"partial").unwrap();
-            Err("simulated failure".into())
+            Err("simulated failure".to_string())
         });
         assert!(r.is_err() && !p2.exists());
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0);

@@ -188,7 +188,7 @@ fn check_obj(text: &str) -> Result<(), (usize, String)> {
                     ));
                 }
                 for r in refs {
-                    check_vertex_ref(r, [nv, nt, nn]).map_err(|m| (ln, m))?;
+                    check_vertex_ref(r, [nv, nt, nn]).map_err(|e| (ln, e.to_string()))?;
                 }
             }
             _ => {}
@@ -222,15 +222,30 @@ fn without_vertex_colours(text: &str) -> Cow<'_, str> {
     Cow::Owned(out)
 }
 
+/// What is wrong with a face/line/point vertex reference.
+#[derive(Debug, thiserror::Error)]
+enum VertexRefError {
+    #[error("malformed face vertex `{r}` (expected v, v/vt, v//vn or v/vt/vn)")]
+    Malformed { r: String },
+    #[error("malformed face vertex `{r}`: `{part}` is not an integer index")]
+    NotAnIndex { r: String, part: String },
+    #[error(
+        "face {what} index {i} out of range: {count} defined before this line (indices start at 1; negative ones count back)"
+    )]
+    OutOfRange {
+        what: &'static str,
+        i: i64,
+        count: usize,
+    },
+}
+
 /// Checks one face/line/point vertex reference `v`, `v/vt`, `v//vn` or
 /// `v/vt/vn` against the `[vertices, texture coordinates, normals]` defined
 /// so far: each index non-zero and in range (negative ones count back).
-fn check_vertex_ref(r: &str, counts: [usize; 3]) -> Result<(), String> {
+fn check_vertex_ref(r: &str, counts: [usize; 3]) -> Result<(), VertexRefError> {
     let parts: Vec<&str> = r.split('/').collect();
     if parts.len() > 3 || parts[0].is_empty() {
-        return Err(format!(
-            "malformed face vertex `{r}` (expected v, v/vt, v//vn or v/vt/vn)"
-        ));
+        return Err(VertexRefError::Malformed { r: r.to_string() });
     }
     let what = ["vertex", "texture coordinate", "normal"];
     for (k, p) in parts.iter().enumerate() {
@@ -238,18 +253,17 @@ fn check_vertex_ref(r: &str, counts: [usize; 3]) -> Result<(), String> {
             continue;
         }
         let (count, what) = (counts[k], what[k]);
-        let i: i64 = p
-            .parse()
-            .map_err(|_| format!("malformed face vertex `{r}`: `{p}` is not an integer index"))?;
+        let i: i64 = p.parse().map_err(|_| VertexRefError::NotAnIndex {
+            r: r.to_string(),
+            part: p.to_string(),
+        })?;
         let ok = if i > 0 {
             (i as u64) <= count as u64
         } else {
             i != 0 && i.unsigned_abs() <= count as u64
         };
         if !ok {
-            return Err(format!(
-                "face {what} index {i} out of range: {count} defined before this line (indices start at 1; negative ones count back)"
-            ));
+            return Err(VertexRefError::OutOfRange { what, i, count });
         }
     }
     Ok(())

@@ -73,41 +73,115 @@ pub struct Api {
     _lib: libloading::Library,
 }
 
-/// Whether `version` is one the binding knows; the message says what was
-/// found and what is needed.
-pub fn check_version(path: &str, (major, minor, patch): (u32, u32, u32)) -> Result<(), String> {
+/// What the embree4 backend needs, for the version errors.
+fn need() -> String {
     let (lo, hi) = (KNOWN_MINORS.start(), KNOWN_MINORS.end());
-    let need = format!("the embree4 backend needs Embree 4.{lo} to 4.{hi}");
+    format!("the embree4 backend needs Embree 4.{lo} to 4.{hi}")
+}
+
+/// Why Embree 4 could not be loaded; every message names the library (or
+/// the places it was looked for) and what is needed.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    #[error("{}={path}: cannot load it ({problem})", ENV_VAR)]
+    CannotLoad { path: String, problem: String },
+    #[error(
+        "Embree 4 was not found: {tried} (Debian 13: `apt-get install libembree4-4`; or \
+         set {} to the path of libembree4.so.4, e.g. the one \
+         scripts/install-deps.sh unpacks into .cache/embree4/)",
+        ENV_VAR
+    )]
+    NotFound { tried: String },
+    #[error("{path} is not an Embree 4 library: it has no {symbol} ({problem})")]
+    MissingSymbol {
+        path: String,
+        symbol: &'static str,
+        problem: String,
+    },
+    #[error("{path}: rtcNewDevice failed: {} ({code})", super::super::embree_shared::error_name(*.code))]
+    NoDevice { path: String, code: RTCError },
+    #[error("{path} is Embree {major}.{minor}.{patch}, not Embree 4: {}", need())]
+    NotEmbree4 {
+        path: String,
+        major: u32,
+        minor: u32,
+        patch: u32,
+    },
+    #[error(
+        "{path} is Embree {major}.{minor}.{patch}, too old: {} (before 4.3 RTCRayHit \
+         had another layout)",
+        need()
+    )]
+    TooOld {
+        path: String,
+        major: u32,
+        minor: u32,
+        patch: u32,
+    },
+    #[error(
+        "{path} is Embree {major}.{minor}.{patch}, newer than this lucent knows: {} \
+         (the layouts of a later release are unchecked; use --accel embree3 or bvh, or a \
+         lucent built for it)",
+        need()
+    )]
+    TooNew {
+        path: String,
+        major: u32,
+        minor: u32,
+        patch: u32,
+    },
+    #[error(
+        "{path} (Embree {major}.{minor}.{patch}) was built without triangle or \
+         filter-function support"
+    )]
+    MissingFeatures {
+        path: String,
+        major: u32,
+        minor: u32,
+        patch: u32,
+    },
+}
+
+/// Whether `version` is one the binding knows; the error says what was
+/// found and what is needed.
+pub fn check_version(path: &str, (major, minor, patch): (u32, u32, u32)) -> Result<(), LoadError> {
+    let path = path.to_string();
     if major != 4 {
-        return Err(format!(
-            "{path} is Embree {major}.{minor}.{patch}, not Embree 4: {need}"
-        ));
+        return Err(LoadError::NotEmbree4 {
+            path,
+            major,
+            minor,
+            patch,
+        });
     }
-    if minor < *lo {
-        return Err(format!(
-            "{path} is Embree {major}.{minor}.{patch}, too old: {need} (before 4.3 RTCRayHit \
-             had another layout)"
-        ));
+    if minor < *KNOWN_MINORS.start() {
+        return Err(LoadError::TooOld {
+            path,
+            major,
+            minor,
+            patch,
+        });
     }
-    if minor > *hi {
-        return Err(format!(
-            "{path} is Embree {major}.{minor}.{patch}, newer than this lucent knows: {need} \
-             (the layouts of a later release are unchecked; use --accel embree3 or bvh, or a \
-             lucent built for it)"
-        ));
+    if minor > *KNOWN_MINORS.end() {
+        return Err(LoadError::TooNew {
+            path,
+            major,
+            minor,
+            patch,
+        });
     }
     Ok(())
 }
 
 /// The loaded Embree 4, or why there is none (loaded once per process).
 pub fn api() -> Result<&'static Api, Error> {
-    static API: OnceLock<Result<Api, String>> = OnceLock::new();
+    static API: OnceLock<Result<Api, LoadError>> = OnceLock::new();
     API.get_or_init(load)
         .as_ref()
-        .map_err(|why| Error::Unavailable(why.clone()))
+        .map_err(|why| Error::Unavailable(why.to_string()))
 }
 
-fn load() -> Result<Api, String> {
+fn load() -> Result<Api, LoadError> {
     let (lib, path) = match std::env::var_os(ENV_VAR).filter(|v| !v.is_empty()) {
         Some(p) => {
             let shown = p.to_string_lossy().into_owned();
@@ -115,8 +189,11 @@ fn load() -> Result<Api, String> {
             // library's are sound. A path to some other library is the
             // user's explicit choice, and it is refused below before any
             // Embree 4 call unless it has Embree's functions and version.
-            let lib = unsafe { libloading::Library::new(&p) }
-                .map_err(|e| format!("{ENV_VAR}={shown}: cannot load it ({e})"))?;
+            let lib =
+                unsafe { libloading::Library::new(&p) }.map_err(|e| LoadError::CannotLoad {
+                    path: shown.clone(),
+                    problem: e.to_string(),
+                })?;
             (lib, shown)
         }
         None => {
@@ -132,13 +209,8 @@ fn load() -> Result<Api, String> {
                     Err(e) => errs.push(e.to_string()),
                 }
             }
-            found.ok_or_else(|| {
-                format!(
-                    "Embree 4 was not found: {} (Debian 13: `apt-get install libembree4-4`; or \
-                     set {ENV_VAR} to the path of libembree4.so.4, e.g. the one \
-                     scripts/install-deps.sh unpacks into .cache/embree4/)",
-                    errs.join("; ")
-                )
+            found.ok_or_else(|| LoadError::NotFound {
+                tried: errs.join("; "),
             })?
         }
     };
@@ -146,7 +218,7 @@ fn load() -> Result<Api, String> {
 }
 
 /// Looks every function up, then asks the version before anything else.
-fn bind(lib: libloading::Library, path: String) -> Result<Api, String> {
+fn bind(lib: libloading::Library, path: String) -> Result<Api, LoadError> {
     macro_rules! sym {
         ($name:literal) => {{
             // SAFETY: the symbol, if present, is the Embree function of that
@@ -154,10 +226,11 @@ fn bind(lib: libloading::Library, path: String) -> Result<Api, String> {
             // against the headers); the pointer is copied out and kept
             // together with `lib`, which is never unloaded.
             let s = unsafe { lib.get(concat!($name, "\0").as_bytes()) }.map_err(|e| {
-                format!(
-                    "{path} is not an Embree 4 library: it has no {} ({e})",
-                    $name
-                )
+                LoadError::MissingSymbol {
+                    path: path.clone(),
+                    symbol: $name,
+                    problem: e.to_string(),
+                }
             })?;
             *s
         }};
@@ -194,10 +267,7 @@ fn bind(lib: libloading::Library, path: String) -> Result<Api, String> {
     if dev.is_null() {
         // SAFETY: with a null device, the error of the failed rtcNewDevice.
         let code = unsafe { (api.get_device_error)(std::ptr::null_mut()) };
-        return Err(format!(
-            "{path}: rtcNewDevice failed: {} ({code})",
-            super::super::embree_shared::error_name(code)
-        ));
+        return Err(LoadError::NoDevice { path, code });
     }
     // SAFETY: `dev` is a live device; properties are plain queries.
     let p = |prop| unsafe { (api.get_device_property)(dev, prop) };
@@ -215,10 +285,12 @@ fn bind(lib: libloading::Library, path: String) -> Result<Api, String> {
     unsafe { (api.release_device)(dev) };
     check_version(&path, version)?;
     if features.0 == 0 || features.1 == 0 {
-        return Err(format!(
-            "{path} (Embree {}.{}.{}) was built without triangle or filter-function support",
-            version.0, version.1, version.2
-        ));
+        return Err(LoadError::MissingFeatures {
+            path,
+            major: version.0,
+            minor: version.1,
+            patch: version.2,
+        });
     }
     api.version = version;
     Ok(api)
@@ -233,7 +305,7 @@ mod tests {
         for ok in [(4, 3, 0), (4, 3, 3), (4, 4, 0), (4, 4, 9)] {
             assert!(check_version("lib", ok).is_ok(), "{ok:?}");
         }
-        let msg = |v| check_version("/x/lib.so", v).unwrap_err();
+        let msg = |v| check_version("/x/lib.so", v).unwrap_err().to_string();
         let e = msg((3, 13, 5));
         assert!(
             e.contains("/x/lib.so is Embree 3.13.5, not Embree 4"),
