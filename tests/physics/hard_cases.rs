@@ -23,7 +23,7 @@
 // Per-channel arrays are indexed by channel number.
 #![allow(clippy::needless_range_loop)]
 
-mod common;
+use crate::common;
 
 use common::mean_se;
 use std::path::Path;

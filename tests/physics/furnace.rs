@@ -1,7 +1,7 @@
 //! White-furnace tests of the path tracer: closed-form answers for scenes
 //! where light transport can be summed by hand.
 
-mod common;
+use crate::common;
 
 use common::backends;
 use std::sync::Arc;

@@ -11,7 +11,6 @@
 //! 2. **Flat surfaces are untouched, bit for bit.** A slab (flat-shaded
 //!    box) renders the same image with the correction on and off.
 
-mod common;
 
 use std::sync::Arc;
 

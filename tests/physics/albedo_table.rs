@@ -15,7 +15,7 @@
 //!    1.5 % (measured: within 0.8 %), which the given A (the Jensen table's
 //!    Rd column, 2–4 % off) misses.
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 

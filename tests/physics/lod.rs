@@ -4,7 +4,7 @@
 //! query where every hit is under LOD; the camera footprint as the rule
 //! sees it; LOD off and LOD that never triggers leave the image bit for bit.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -3,7 +3,7 @@
 //! diffusion BSSRDF on the flat-slab ground truth, determinism across thread
 //! counts, and clean termination on open meshes.
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 
