@@ -27,7 +27,7 @@ cargo test --all-targets
 # A real Slurm cluster of one node (this machine): a job array of parts and
 # a dependent merge, checked bitwise against one process. Needs root and
 # starts daemons, so only when asked (about 45 s after the build;
-# docs/farm.md). tests/farm.rs runs a multi-process split + merge always.
+# docs/farm.md). tests/cli/farm.rs runs a multi-process split + merge always.
 if [ "${LUCENT_SLURM_TEST:-}" = 1 ]; then
   echo "--- Slurm, one node (LUCENT_SLURM_TEST=1) ---"
   scripts/slurm-local.sh
