@@ -485,10 +485,9 @@ fn the_renderer_never_imports_the_measuring_tools() {
 /// Hubs (relative to src/) whose own code and children still use each
 /// other: [`a_mod_rs_and_its_children_form_a_dag`] holds every other hub to
 /// the rule, and these to staying on this list only while knotted.
-const KNOTS: [&str; 7] = [
+const KNOTS: [&str; 6] = [
     "accel/embree4/mod.rs",
     "accel/mod.rs",
-    "integrator/aov/mod.rs",
     "materials/mod.rs",
     "scene/mod.rs",
     "tools/bench/replay/mod.rs",
