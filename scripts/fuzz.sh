@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Long runs of the mutation fuzzer (tests/fuzz.rs): `scripts/fuzz.sh
+# Long runs of the mutation fuzzer (tests/robustness/fuzz.rs): `scripts/fuzz.sh
 # [SECONDS] [SEED]` (defaults: 600 s, a seed from the clock, printed).
 # Every failing case is saved under tests/fuzz-corpus/ (scene, mesh,
 # arguments, and an `expect` file with the exit codes allowed and what
@@ -13,4 +13,4 @@ export LUCENT_FUZZ_SECONDS="${1:-${LUCENT_FUZZ_SECONDS:-600}}"
 export LUCENT_FUZZ_SEED="${2:-${LUCENT_FUZZ_SEED:-$(date +%s)}}"
 export LUCENT_FUZZ_CORPUS="${LUCENT_FUZZ_CORPUS:-$PWD/tests/fuzz-corpus}"
 echo "fuzzing for ${LUCENT_FUZZ_SECONDS} s with seed ${LUCENT_FUZZ_SEED}; failures go to ${LUCENT_FUZZ_CORPUS}"
-cargo test --test fuzz mutated_inputs_end_in_an_image_or_a_clear_error -- --nocapture
+cargo test --test robustness fuzz::mutated_inputs_end_in_an_image_or_a_clear_error -- --nocapture

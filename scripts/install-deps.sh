@@ -3,7 +3,7 @@
 # Embree 3 (Debian's libembree-dev, the production ray-query backend),
 # pkg-config (to find it), a C compiler (for the FFI layout test), the
 # DejaVu Sans font (text in `lucent study` plots, read by path),
-# OpenImageIO's tools (`oiiotool`, `iinfo`: tests/exr_oiio.rs reads the EXR
+# OpenImageIO's tools (`oiiotool`, `iinfo`: tests/cli/exr_oiio.rs reads the EXR
 # files back with them), and an Embree 4 for the tests of the `embree4`
 # backend (Debian 12 has none: the 4.4.0 library and the TBB it needs, from
 # the `embreex` wheel on PyPI, unpacked into .cache/embree4/, which

@@ -43,19 +43,15 @@ usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; }
 CORE=(src/bssrdf src/integrator src/materials src/accel/bvh)
 # The smallest subsets that cover each folder (sample mode): the unit
 # tests, which cargo runs first and which stop the run when they catch the
-# mutant, then the scene-level tests that reach the folder's code. Only
-# these test binaries are built for a mutant.
-TESTS_BVH=(--lib --test bvh_brute_force)
-TESTS_BSSRDF=(--lib --test params_edges --test curvature --test hard_cases --test slab
-    --test plan)
-TESTS_MATERIALS=(--lib --test coat --test dielectric --test furnace --test params_edges
-    --test specular_coat --test plan --test lod)
-TESTS_INTEGRATOR=(--lib --test coat --test dielectric --test furnace --test hard_cases
-    --test plan --test probe_pair --test randomwalk --test slab --test specular_coat
-    --test lod)
-TESTS_AOV=(--lib --test aov --test farm)
-TESTS=(--lib --test furnace --test slab --test randomwalk --test hard_cases
-    --test bvh_brute_force --test dielectric --test specular_coat --test params_edges)
+# mutant, then the group binaries (tests/README.md) whose scene-level tests
+# reach the folder's code. Only these test binaries are built for a mutant;
+# a group runs whole (a name filter would apply to the unit tests too).
+TESTS_BVH=(--lib --test accel)
+TESTS_BSSRDF=(--lib --test physics --test cli)
+TESTS_MATERIALS=(--lib --test physics --test cli)
+TESTS_INTEGRATOR=(--lib --test physics --test cli)
+TESTS_AOV=(--lib --test cli)
+TESTS=(--lib --test physics --test accel)
 if [ -n "${MUTANTS_TESTS:-}" ]; then
     read -r -a TESTS <<<"$MUTANTS_TESTS"
 fi

@@ -27,7 +27,7 @@ cargo test --all-targets
 # A real Slurm cluster of one node (this machine): a job array of parts and
 # a dependent merge, checked bitwise against one process. Needs root and
 # starts daemons, so only when asked (about 45 s after the build;
-# docs/farm.md). tests/farm.rs runs a multi-process split + merge always.
+# docs/farm.md). tests/cli/farm.rs runs a multi-process split + merge always.
 if [ "${LUCENT_SLURM_TEST:-}" = 1 ]; then
   echo "--- Slurm, one node (LUCENT_SLURM_TEST=1) ---"
   scripts/slurm-local.sh
@@ -36,7 +36,8 @@ fi
 # The BVH's portable box and triangle tests, which other architectures
 # run, forced on x86_64 (only lucent is rebuilt).
 echo "--- BVH portable path (--features bvh-portable) ---"
-cargo test --lib --test bvh_brute_force --features bvh-portable
+cargo test --features bvh-portable --lib
+cargo test --features bvh-portable --test accel -- bvh_brute_force::
 
 # Same target dir: only lucent itself is rebuilt, the dependencies are
 # reused. The library's own tests, and the command-line tests whose
@@ -47,4 +48,5 @@ cargo test --lib --test bvh_brute_force --features bvh-portable
 # no code depends on the two together, so the default build and this one
 # compile every gated item both ways (the cheapest addition: no third build).
 echo "--- No default features: BVH only, no subsurface (--no-default-features) ---"
-cargo test --no-default-features --lib --test cli --test bench_cli --test subsurface_feature
+cargo test --no-default-features --lib
+cargo test --no-default-features --test cli -- cli:: subsurface_feature::

@@ -265,7 +265,7 @@ pub enum Backend {
 }
 
 /// The order in which [`Backend::Embree`] picks an Embree: Embree 4 first.
-/// Both answer the queries alike (tests/backend_equivalence.rs); Embree 4
+/// Both answer the queries alike (tests/accel/backend_equivalence.rs); Embree 4
 /// is the maintained series, and where a machine has it, it is the one the
 /// user installed on purpose (Debian 13, or `LUCENT_EMBREE4`). The speed
 /// difference measured on these machines is in docs/performance.md.
@@ -388,7 +388,7 @@ pub fn embree_report() -> Vec<String> {
 /// - `Fast`: Embree's default arithmetic, without those guarantees, as
 ///   Mitsuba 3 renders by default. A ray aimed exactly at a shared edge
 ///   can slip through (the constructed edge rays of
-///   `tests/backend_equivalence.rs` do), but a Monte Carlo ray almost
+///   `tests/accel/backend_equivalence.rs` do), but a Monte Carlo ray almost
 ///   never is, and a slipped ray loses one sample of one pixel. The leak
 ///   rates measured and the instructions it saves: docs/performance.md,
 ///   "Traversal".

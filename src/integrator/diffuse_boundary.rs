@@ -40,7 +40,7 @@
 //! either reflects or transmits with probabilities summing to 1, and both
 //! direction laws are normalized, so the boundary neither creates nor
 //! destroys energy: with σa = 0 a closed object in a uniform environment
-//! returns the environment exactly (tests/randomwalk.rs).
+//! returns the environment exactly (tests/physics/randomwalk.rs).
 //!
 //! **Estimator.** Tracing from the camera, step 1 is sampled exactly (the
 //! inner direction by rejection from the cosine lobe: accept with

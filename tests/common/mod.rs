@@ -5,6 +5,9 @@
 use lucent::accel::Backend;
 use lucent::film::Film;
 
+pub mod brute;
+pub mod scene;
+
 /// The backends this build has: our BVH always, Embree with the `embree`
 /// feature (a build without it must not pretend to test it).
 pub fn backends() -> Vec<Backend> {

@@ -5,7 +5,7 @@
 //! and so every struct we share with Embree carries compile-time size and
 //! offset checks. The values are those of a build with
 //! `RTC_MAX_INSTANCE_LEVEL_COUNT == 1` and `RTC_MIN_WIDTH == 0` (see
-//! `rtcore_config.h`); `tests/embree_layout.rs` compiles a C program against
+//! `rtcore_config.h`); `tests/accel/embree_layout.rs` compiles a C program against
 //! the installed headers and compares it with [`layout_table`], so a library
 //! built with other options fails the tests instead of corrupting memory.
 
@@ -270,7 +270,7 @@ const _: () = {
 
 /// Sizes and offsets of the shared structs as Rust lays them out, named as
 /// the C expression that should give the same number (`sizeof(RTCRay)`,
-/// `offsetof(RTCRay, tfar)`, ...), for `tests/embree_layout.rs`.
+/// `offsetof(RTCRay, tfar)`, ...), for `tests/accel/embree_layout.rs`.
 ///
 /// Over 120 lines on purpose: it is a flat table, one line per size or
 /// offset checked, and reads best as one list beside the C side's.

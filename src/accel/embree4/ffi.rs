@@ -9,7 +9,7 @@
 //! the query arguments that replace `RTCIntersectContext`, when the argument
 //! filter runs): `docs/testing.md`, "The Embree 4 backend". Every size,
 //! offset and constant below is asserted at compile time, and
-//! `tests/embree4_layout.rs` compares [`layout_table`] with the C compiler's
+//! `tests/accel/embree4_layout.rs` compares [`layout_table`] with the C compiler's
 //! answer where Embree 4 headers are installed, and with [`TRANSCRIBED`]
 //! everywhere.
 
@@ -376,7 +376,7 @@ pub const TRANSCRIBED: &[(&str, usize)] = &[
 ];
 
 /// Sizes, offsets and constants as Rust has them, named as the C expression
-/// that should give the same number, for `tests/embree4_layout.rs`.
+/// that should give the same number, for `tests/accel/embree4_layout.rs`.
 ///
 /// Over 100 lines on purpose: a flat table, one line per value checked.
 #[doc(hidden)]

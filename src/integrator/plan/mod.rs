@@ -11,7 +11,7 @@
 //! prints it ([`text`] for people, JSON for pipelines) and the EXR header
 //! stores it (`lucent/plan`, `docs/output.md`). Both are derived from the
 //! same scene and options by the functions of this module, and the tests
-//! (`tests/plan.rs`) check that the explanation says what the flags do
+//! (`tests/cli/plan.rs`) check that the explanation says what the flags do
 //! and that a render honours it (no probe ray where it says none).
 
 mod choice;

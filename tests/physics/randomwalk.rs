@@ -3,10 +3,11 @@
 //! diffusion BSSRDF on the flat-slab ground truth, determinism across thread
 //! counts, and clean termination on open meshes.
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 
+use crate::common::scene::{object, TestScene};
 use lucent::accel::{self, Backend};
 use lucent::bssrdf::params::{dipole_reflectance, invert_dipole_reflectance, Medium};
 use lucent::bssrdf::{Fit, Measured, ProbeOptions, SubsurfaceParams, PRESETS};
@@ -15,7 +16,7 @@ use lucent::geometry::{Mesh, Vec3};
 use lucent::integrator::{Counters, Effect, IntegratorKind};
 use lucent::materials::{Material, Subsurface, WalkBoundary};
 use lucent::render::{render, RenderOptions};
-use lucent::scene::{shapes, Camera, Object, RenderSettings, Scene};
+use lucent::scene::{shapes, Camera, Scene};
 
 fn placed(mut m: Mesh, scale: Vec3, translate: Vec3) -> Mesh {
     m.transform(|p| p * scale + translate, |n| n / scale);
@@ -57,29 +58,17 @@ fn scene(parts: Vec<Part>, env: Option<Vec3>, camera: Camera, spp: u32, max_dept
     let objects = parts
         .iter()
         .enumerate()
-        .map(|(i, p)| Object {
-            name: format!("o{i}"),
-            material: i,
-            emission: p.emission,
-        })
+        .map(|(i, p)| object(format!("o{i}"), i, p.emission))
         .collect();
     let materials = parts.into_iter().map(|p| p.material).collect();
-    Scene {
+    TestScene {
         camera,
-        settings: RenderSettings {
-            spp,
-            max_depth,
-            seed: 11,
-            ..RenderSettings::default()
-        },
-        meshes: Arc::new(meshes),
-        objects,
-        materials,
+        spp,
+        max_depth,
+        seed: 11,
         environment: env,
-        units_per_mm: 1.0,
-        source: None,
-        output: Default::default(),
     }
+    .build(meshes, materials, objects)
 }
 
 fn run(scene: &Scene, integrator: IntegratorKind, threads: Option<usize>) -> (Film, Counters, f64) {

@@ -1,17 +1,17 @@
 //! White-furnace tests of the path tracer: closed-form answers for scenes
 //! where light transport can be summed by hand.
 
-mod common;
+use crate::common;
 
 use common::backends;
-use std::sync::Arc;
 
+use crate::common::scene::{object, TestScene};
 use lucent::accel::{self, Backend};
 use lucent::film::Film;
 use lucent::geometry::Vec3;
 use lucent::materials::Material;
 use lucent::render::{render, RenderOptions};
-use lucent::scene::{shapes, Camera, Object, RenderSettings, Scene};
+use lucent::scene::{shapes, Camera, Scene};
 
 fn scene_with(
     mesh: lucent::geometry::Mesh,
@@ -22,26 +22,14 @@ fn scene_with(
     spp: u32,
     max_depth: u32,
 ) -> Scene {
-    Scene {
+    TestScene {
         camera,
-        settings: RenderSettings {
-            spp,
-            max_depth,
-            seed: 7,
-            ..RenderSettings::default()
-        },
-        meshes: Arc::new(vec![mesh]),
-        objects: vec![Object {
-            name: "s".into(),
-            material: 0,
-            emission,
-        }],
-        materials: vec![material],
+        spp,
+        max_depth,
+        seed: 7,
         environment: env,
-        units_per_mm: 1.0,
-        source: None,
-        output: Default::default(),
     }
+    .build(vec![mesh], vec![material], vec![object("s", 0, emission)])
 }
 
 fn faceted_sphere(level: u32) -> lucent::geometry::Mesh {

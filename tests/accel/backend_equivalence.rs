@@ -13,7 +13,7 @@
 //!
 //! Every check runs once on Embree 3 and once on Embree 4 (`on_embree3::*`,
 //! `on_embree4::*`). Built only with the `embree` feature
-//! (`required-features` in Cargo.toml).
+//! (`#[cfg]` in tests/accel/main.rs).
 
 mod embree_vs_bvh {
     use std::path::Path;
@@ -24,98 +24,13 @@ mod embree_vs_bvh {
     use lucent::sampling::Rng;
     use lucent::scene::shapes;
 
+    use crate::common::brute::{reference, RefHit};
+
     /// Relative tolerance on t between a backend and the reference.
     const T_TOL: f64 = 1e-4;
 
     fn t_close(a: f64, b: f64) -> bool {
         (a - b).abs() <= T_TOL * a.abs().max(b.abs()).max(1.0)
-    }
-
-    /// One triangle the reference says the ray may hit.
-    #[derive(Clone, Copy, Debug)]
-    struct RefHit {
-        geom: u32,
-        prim: u32,
-        t: f64,
-        u: f64,
-        v: f64,
-        /// Far from every knife edge: a backend must report it.
-        sure: bool,
-    }
-
-    /// Every triangle hit with t in [tmin, tmax], closed edges, in f64.
-    /// With `eps == 0` only exact hits count and all are `sure` (for meshes
-    /// where f32 arithmetic is exact); otherwise hits within `eps` of an edge
-    /// or bound are included but not `sure`, and so are near misses.
-    fn reference(
-        meshes: &[Mesh],
-        ray: &Ray,
-        tmin: f32,
-        tmax: f32,
-        only_geom: Option<u32>,
-        eps: f64,
-    ) -> Vec<RefHit> {
-        let v = |p: Vec3| [p.x as f64, p.y as f64, p.z as f64];
-        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        let cross = |a: [f64; 3], b: [f64; 3]| {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        };
-        let norm = |a: [f64; 3]| dot(a, a).sqrt();
-        let (o, d) = (v(ray.o), v(ray.d));
-        let (tmin, tmax) = (tmin as f64, tmax as f64);
-        let mut out = Vec::new();
-        for (g, m) in meshes.iter().enumerate() {
-            if only_geom.is_some_and(|w| w != g as u32) {
-                continue;
-            }
-            for prim in 0..m.triangle_count() as u32 {
-                let [a, b, c] = m.triangle(prim).map(v);
-                let (e1, e2) = (sub(b, a), sub(c, a));
-                let p = cross(d, e2);
-                let det = dot(e1, p);
-                let scale = norm(e1) * norm(e2) * norm(d);
-                if det == 0.0 || scale == 0.0 {
-                    continue;
-                }
-                // How much f32 rounding in a backend is amplified in the
-                // barycentrics and t: 1 for a ray hitting a well-shaped
-                // triangle head-on, large at grazing angles.
-                // An origin far away relative to the triangle's size
-                // amplifies them too.
-                let s = sub(o, a);
-                let cond = scale / det.abs();
-                let far = (norm(s) / (norm(e1) * norm(e2)).sqrt()).max(1.0);
-                let eps = eps * cond * far;
-                let grazing = cond > 1e4;
-                let u = dot(s, p) / det;
-                let q = cross(s, e1);
-                let w = dot(d, q) / det;
-                let t = dot(e2, q) / det;
-                let margin = u.min(w).min(1.0 - u - w);
-                let t_eps = eps * t.abs().max(1.0);
-                let inside = margin >= 0.0 && t >= tmin && t <= tmax;
-                let near = margin >= -eps && t >= tmin - t_eps && t <= tmax + t_eps;
-                let sure = inside
-                    && (eps == 0.0
-                        || (margin > eps && t > tmin + t_eps && t < tmax - t_eps && !grazing));
-                if inside || near {
-                    out.push(RefHit {
-                        geom: g as u32,
-                        prim,
-                        t,
-                        u,
-                        v: w,
-                        sure,
-                    });
-                }
-            }
-        }
-        out
     }
 
     /// Whether a query's answer leaves no room for two correct backends to

@@ -23,12 +23,13 @@
 // Per-channel arrays are indexed by channel number.
 #![allow(clippy::needless_range_loop)]
 
-mod common;
+use crate::common;
 
 use common::mean_se;
 use std::path::Path;
 use std::sync::Arc;
 
+use crate::common::scene::{object, TestScene};
 use lucent::accel::{self, Accel, Backend, ProbeHits, MAX_PROBE_HITS};
 use lucent::bssrdf::{
     ChannelStrategy, Fit, ProbeAxes, ProbeOptions, ProbeRandoms, ProbeSampler, RadiusSampler,
@@ -40,7 +41,7 @@ use lucent::integrator::probe::{sample_entry, ProbeTarget};
 use lucent::materials::{Material, Subsurface};
 use lucent::render::{render, RenderOptions, RenderStats};
 use lucent::sampling::Rng;
-use lucent::scene::{load_str, shapes, Camera, Object, RenderSettings, Scene};
+use lucent::scene::{load_str, shapes, Camera, Scene};
 
 /// 4√3: the geometric factor of the Mis3 weight bound (some axis has
 /// |V·N| ≥ 1/√3 and is chosen with probability ≥ ¼).
@@ -91,29 +92,17 @@ fn scene(
     spp: u32,
     max_depth: u32,
 ) -> Scene {
-    let n = meshes.len();
-    Scene {
+    let objects = (0..meshes.len())
+        .map(|i| object(format!("o{i}"), i.min(materials.len() - 1), None))
+        .collect();
+    TestScene {
         camera,
-        settings: RenderSettings {
-            spp,
-            max_depth,
-            seed: 11,
-            ..RenderSettings::default()
-        },
-        meshes: Arc::new(meshes),
-        objects: (0..n)
-            .map(|i| Object {
-                name: format!("o{i}"),
-                material: i.min(materials.len() - 1),
-                emission: None,
-            })
-            .collect(),
-        materials,
+        spp,
+        max_depth,
+        seed: 11,
         environment: Some(Vec3::ONE),
-        units_per_mm: 1.0,
-        source: None,
-        output: Default::default(),
     }
+    .build(meshes, materials, objects)
 }
 
 /// The cube [-1, 1]³ scaled by `half` and moved by `at`.

@@ -15,7 +15,7 @@
 //!    beam would need ~10⁴ times the samples: the probe would have to land
 //!    on the beam's tiny footprint by chance.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::sync::Arc;

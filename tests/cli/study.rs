@@ -2,7 +2,7 @@
 //! that follow from the math (docs/bssrdf.md), resumption from the CSV, the
 //! outputs, and the command line's handling of bad input.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -20,7 +20,7 @@
 //! white diffuse panel above the slab, so every coated hit there is at
 //! depth ≥ 1.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -4,7 +4,7 @@
 //! query where every hit is under LOD; the camera footprint as the rule
 //! sees it; LOD off and LOD that never triggers leave the image bit for bit.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
@@ -106,7 +106,7 @@ fn forced_lod_on_the_uniform_slab_reflects_a_without_probes() {
     }
 }
 
-/// The coat scene of tests/coat.rs (renormalized slab at μo = 0.25 under
+/// The coat scene of tests/physics/coat.rs (renormalized slab at μo = 0.25 under
 /// uniform light L = 1): the coat reflects E(μo) (Fr for the smooth one),
 /// the medium A of the rest, with `panel` every coated hit at depth ≥ 1.
 fn coat_scene(roughness: f32, a: f32, panel: bool) -> Scene {

@@ -7,7 +7,7 @@
 //!
 //! Run on Embree 3 and on Embree 4 (where this process has it; required
 //! under scripts/test.sh, which sets `LUCENT_REQUIRE_EMBREE4`). Built only
-//! with the `embree` feature (`required-features` in Cargo.toml).
+//! with the `embree` feature (`#[cfg]` in tests/accel/main.rs).
 
 use std::path::Path;
 

@@ -15,10 +15,11 @@
 //!    1.5 % (measured: within 0.8 %), which the given A (the Jensen table's
 //!    Rd column, 2–4 % off) misses.
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 
+use crate::common::scene::{object, TestScene};
 use lucent::accel::{self, Backend};
 use lucent::bssrdf::albedo_table::AlbedoTable;
 use lucent::bssrdf::{AlbedoSource, Fit, Measured, ProbeOptions, SubsurfaceParams};
@@ -28,7 +29,7 @@ use lucent::geometry::{Mesh, Vec3};
 use lucent::integrator::IntegratorKind;
 use lucent::materials::{Material, Subsurface};
 use lucent::render::{render, RenderOptions};
-use lucent::scene::{shapes, Camera, Object, RenderSettings, Scene};
+use lucent::scene::{shapes, Camera, Scene};
 
 /// The material with the renderer's defaults (smooth coat, Sw lobe),
 /// renormalized so the diffusion side reflects exactly A.
@@ -50,26 +51,14 @@ fn slab_scene(material: Material, side: f32, thickness: f32, theta_deg: f32, spp
     mesh.transform(|p| p * Vec3::new(h, t, h) - Vec3::new(0.0, t, 0.0), |n| n);
     let th = theta_deg.to_radians();
     let eye = Vec3::new(0.0, th.cos(), th.sin()) * 10.0;
-    Scene {
+    TestScene {
         camera: Camera::new(eye, Vec3::ZERO, Vec3::X, 4.0, 8, 8),
-        settings: RenderSettings {
-            spp,
-            max_depth: 8,
-            seed: 5,
-            ..RenderSettings::default()
-        },
-        meshes: Arc::new(vec![mesh]),
-        objects: vec![Object {
-            name: "slab".into(),
-            material: 0,
-            emission: None,
-        }],
-        materials: vec![material],
+        spp,
+        max_depth: 8,
+        seed: 5,
         environment: Some(Vec3::ONE),
-        units_per_mm: 1.0,
-        source: None,
-        output: Default::default(),
     }
+    .build(vec![mesh], vec![material], vec![object("slab", 0, None)])
 }
 
 fn run(scene: &Scene, integrator: IntegratorKind) -> Film {

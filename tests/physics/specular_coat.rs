@@ -15,7 +15,7 @@
 //!
 //! Built with `scene::load_str` and rendered through the public API only.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

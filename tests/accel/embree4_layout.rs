@@ -10,8 +10,7 @@
 //!   and the bytes the library wrote show it uses the 96-byte 4.3+
 //!   `RTCRayHit` (it writes `instPrimID` at byte 80) and nothing beyond it.
 //!
-//! Built only with the `embree4` feature (`required-features` in
-//! Cargo.toml).
+//! Built only with the `embree4` feature (`#[cfg]` in tests/accel/main.rs).
 
 use std::collections::HashMap;
 use std::path::PathBuf;

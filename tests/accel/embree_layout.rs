@@ -4,7 +4,7 @@
 //! built with other options (e.g. more instance levels) or a different major
 //! version then fails here instead of corrupting memory at run time.
 //!
-//! Built only with the `embree` feature (`required-features` in Cargo.toml).
+//! Built only with the `embree` feature (`#[cfg]` in tests/accel/main.rs).
 
 #[test]
 fn rust_layout_matches_embree_headers() {

@@ -4,77 +4,13 @@
 //! through shared vertices and edges), degenerate input and overflowing
 //! probe segments.
 
-use lucent::accel::bvh::triangle::RayTri;
 use lucent::accel::bvh::{can_hit, Bvh};
-use lucent::accel::{Accel, Hit, ProbeHits, MAX_PROBE_HITS};
+use lucent::accel::{Accel, ProbeHits, MAX_PROBE_HITS};
 use lucent::geometry::{Mesh, Ray, Vec3};
 use lucent::sampling::Rng;
 use lucent::scene::shapes;
 
-/// The reference: every triangle that can be hit, in order.
-struct Brute<'a> {
-    meshes: &'a [Mesh],
-    tris: Vec<(u32, u32, [Vec3; 3])>,
-}
-
-impl<'a> Brute<'a> {
-    fn new(meshes: &'a [Mesh]) -> Self {
-        let tris = meshes
-            .iter()
-            .enumerate()
-            .flat_map(|(g, m)| {
-                (0..m.triangle_count() as u32).filter_map(move |i| {
-                    let p = m.triangle(i);
-                    can_hit(p).then_some((g as u32, i, p))
-                })
-            })
-            .collect();
-        Brute { meshes, tris }
-    }
-    fn test(&self, ray: &Ray, p: [Vec3; 3], tmin: f32, tmax: f32) -> Option<(f32, f32, f32)> {
-        RayTri::new(ray).intersect(p[0], p[1], p[2], tmin, tmax)
-    }
-    fn all(&self, ray: &Ray, tmin: f32, tmax: f32) -> Vec<Hit> {
-        let rt = RayTri::new(ray);
-        let mut v: Vec<Hit> = self
-            .tris
-            .iter()
-            .filter_map(|&(geom, prim, p)| {
-                rt.intersect(p[0], p[1], p[2], tmin, tmax)
-                    .map(|(t, u, v)| Hit {
-                        t,
-                        geom,
-                        prim,
-                        u,
-                        v,
-                    })
-            })
-            .collect();
-        v.sort_by(|a, b| {
-            a.t.total_cmp(&b.t)
-                .then(a.geom.cmp(&b.geom))
-                .then(a.prim.cmp(&b.prim))
-        });
-        v
-    }
-    fn nearest(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.all(ray, tmin, tmax).first().copied()
-    }
-    fn segment(&self, ray: &Ray, tmax: f32, geom: u32, seed: u32) -> ProbeHits {
-        probe(&self.all(ray, 0.0, tmax), geom, seed)
-    }
-}
-
-/// What hits_on_segment should return, given every hit on the segment.
-fn probe(all: &[Hit], geom: u32, seed: u32) -> ProbeHits {
-    let mut out = ProbeHits::new();
-    out.reset(seed);
-    for h in all.iter().filter(|h| h.geom == geom) {
-        out.record(*h);
-    }
-    out.finish();
-    out
-}
+use crate::common::brute::{probe, Brute};
 
 /// Checks all three queries of `bvh` against brute force on one ray.
 fn compare(bvh: &Bvh, brute: &Brute, ray: &Ray, tmin: f32, tmax: f32, seed: u32) {

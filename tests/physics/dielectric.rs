@@ -17,7 +17,7 @@
 //! - The sampled split: reflected with frequency F and transmitted with
 //!   frequency 1 − F, so R + T = 1.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -5,7 +5,7 @@
 //! the same file; and every bad set of parts is refused with exit 2, a
 //! message naming the file and the problem, and nothing written.
 
-mod common;
+use crate::common;
 
 use std::fs;
 use std::ops::Range;

@@ -11,10 +11,9 @@
 //! 2. **Flat surfaces are untouched, bit for bit.** A slab (flat-shaded
 //!    box) renders the same image with the correction on and off.
 
-mod common;
-
 use std::sync::Arc;
 
+use crate::common::scene::{object, TestScene};
 use lucent::accel::{self, Backend};
 use lucent::bssrdf::{Fit, ProbeOptions, SubsurfaceParams};
 use lucent::film::Film;
@@ -22,7 +21,7 @@ use lucent::geometry::{Mesh, Vec3};
 use lucent::integrator::IntegratorKind;
 use lucent::materials::{CurvatureMode, Material, Subsurface};
 use lucent::render::{render, RenderOptions};
-use lucent::scene::{shapes, Camera, Object, RenderSettings, Scene};
+use lucent::scene::{shapes, Camera, Scene};
 
 /// The material with the renderer's defaults (smooth coat, Sw lobe),
 /// renormalized so the diffusion side reflects exactly A on a flat surface.
@@ -43,26 +42,14 @@ const RES: u32 = 16;
 /// `mesh` under a uniform environment, seen by a camera at `eye` looking
 /// at the origin.
 fn scene(material: Material, mesh: Mesh, eye: Vec3, up: Vec3, fov: f32, spp: u32) -> Scene {
-    Scene {
+    TestScene {
         camera: Camera::new(eye, Vec3::ZERO, up, fov, RES, RES),
-        settings: RenderSettings {
-            spp,
-            max_depth: 4,
-            seed: 1,
-            ..RenderSettings::default()
-        },
-        meshes: Arc::new(vec![mesh]),
-        objects: vec![Object {
-            name: "body".into(),
-            material: 0,
-            emission: None,
-        }],
-        materials: vec![material],
+        spp,
+        max_depth: 4,
+        seed: 1,
         environment: Some(Vec3::ONE),
-        output: Default::default(),
-        units_per_mm: 1.0,
-        source: None,
     }
+    .build(vec![mesh], vec![material], vec![object("body", 0, None)])
 }
 
 fn run(scene: &Scene, integrator: IntegratorKind) -> Film {

@@ -1,0 +1,21 @@
+//! The command line and the library entry points end to end: `render`,
+//! `plan`, `bench`, `study`, scene errors, the EXR outputs and passes,
+//! the farm split and merge, sessions, and what each feature set accepts.
+//! One test binary; a module whose theme is a feature is built with it.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+#[cfg(feature = "subsurface")]
+mod aov;
+mod bench_cli;
+mod cli;
+mod exr_oiio;
+mod farm;
+#[cfg(feature = "subsurface")]
+mod plan;
+mod scene_errors;
+mod session;
+#[cfg(feature = "subsurface")]
+mod study;
+mod subsurface_feature;

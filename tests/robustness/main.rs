@@ -1,0 +1,12 @@
+//! Robustness of the real binary: the seeded fuzzer, hostile and huge
+//! input, and interruption by signals. One test binary: the tests run
+//! `lucent` as a child process or render in-process without touching
+//! process-wide state (environment, working directory, signal handlers).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod fuzz;
+mod hostile_input;
+mod huge_numbers;
+mod interrupt;
