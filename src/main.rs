@@ -49,6 +49,24 @@ enum AccelArg {
     Bvh,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum ToneMapArg {
+    /// Clip each channel to [0, 1].
+    Clamp,
+    /// The ACES filmic curve fit of Narkowicz (2015): a soft shoulder so
+    /// bright lights keep detail instead of clipping.
+    Filmic,
+}
+
+impl From<ToneMapArg> for ToneMap {
+    fn from(t: ToneMapArg) -> ToneMap {
+        match t {
+            ToneMapArg::Clamp => ToneMap::Clamp,
+            ToneMapArg::Filmic => ToneMap::Filmic,
+        }
+    }
+}
+
 impl From<AccelArg> for Backend {
     fn from(a: AccelArg) -> Backend {
         match a {
@@ -73,7 +91,7 @@ enum Command {
         #[arg(long)]
         spp: Option<u32>,
         /// Worker threads, 1 to 1024 (default: all cores).
-        #[arg(long, value_parser = lucent::tools::bench::parse_threads)]
+        #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
         threads: Option<usize>,
         /// Random seed (default: the scene's `render.seed`).
         #[arg(long)]
@@ -85,7 +103,7 @@ enum Command {
         accel: Option<AccelArg>,
         /// Tone map of the PNG preview (the EXR is always linear).
         #[arg(long, value_enum, default_value = "filmic")]
-        tonemap: ToneMap,
+        tonemap: ToneMapArg,
         /// Exposure of the PNG preview in stops.
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         exposure: f32,
@@ -141,7 +159,7 @@ enum Command {
         output: PathBuf,
         /// Tone map of the PNG preview (the EXR is always linear).
         #[arg(long, value_enum, default_value = "filmic")]
-        tonemap: ToneMap,
+        tonemap: ToneMapArg,
         /// Exposure of the PNG preview in stops.
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         exposure: f32,
@@ -443,7 +461,7 @@ fn main() -> ExitCode {
                 spp,
                 seed,
                 threads,
-                progress: !quiet,
+                progress: (!quiet).then(lucent_tools::progress::Bar::sink),
                 integrator,
                 stats,
             };
@@ -460,7 +478,10 @@ fn main() -> ExitCode {
                     overrides: subsurface.overrides(),
                     file,
                     split: split.into(),
-                    preview: Preview { tonemap, exposure },
+                    preview: Preview {
+                        tonemap: tonemap.into(),
+                        exposure,
+                    },
                 };
                 run_render(&r, quiet)
             })
@@ -471,7 +492,7 @@ fn main() -> ExitCode {
             tonemap,
             exposure,
             quiet,
-        } => run_merge(&parts, &output, tonemap, exposure, quiet),
+        } => run_merge(&parts, &output, tonemap.into(), exposure, quiet),
         #[cfg(feature = "subsurface")]
         Command::Study(args) => run_study(args),
         Command::Bench(args) => run_bench(args),
@@ -630,7 +651,7 @@ struct StudyArgs {
     #[arg(long)]
     quick: bool,
     /// Worker threads, 1 to 1024 (default: all cores).
-    #[arg(long, value_parser = lucent::tools::bench::parse_threads)]
+    #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
     threads: Option<usize>,
     /// Integrator of the reference render: diffusion | randomwalk.
     #[arg(long, default_value = "diffusion", value_parser = parse_study_integrator)]
@@ -654,7 +675,7 @@ struct StudyArgs {
     /// renormalize, exit_sw, specular, backend, integrator, boundary, lod,
     /// variance); the baseline always runs.
     #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
-    only: Vec<lucent::tools::study::Axis>,
+    only: Vec<lucent_tools::study::Axis>,
     /// No progress bars.
     #[arg(short, long)]
     quiet: bool,
@@ -662,13 +683,13 @@ struct StudyArgs {
 
 #[cfg(feature = "subsurface")]
 fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, ValueError> {
-    lucent::tools::study::config::parse_integrator(s)
+    lucent_tools::study::config::parse_integrator(s)
         .ok_or_else(|| expected("diffusion or randomwalk", s))
 }
 
 #[cfg(feature = "subsurface")]
-fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, ValueError> {
-    lucent::tools::study::Axis::parse(s).ok_or_else(|| ValueError::Unknown {
+fn parse_study_axis(s: &str) -> Result<lucent_tools::study::Axis, ValueError> {
+    lucent_tools::study::Axis::parse(s).ok_or_else(|| ValueError::Unknown {
         what: "axis",
         found: s.into(),
     })
@@ -676,7 +697,7 @@ fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, ValueError> {
 
 #[cfg(feature = "subsurface")]
 fn run_study(a: StudyArgs) -> Result<(), Error> {
-    use lucent::tools::study;
+    use lucent_tools::study;
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = a
             .scene
@@ -720,13 +741,13 @@ struct BenchArgs {
     quick: bool,
     /// Triangle counts, comma separated (1k, 16k, 1.3M; each becomes the
     /// displaced sphere of 20·4^level triangles nearest to it).
-    #[arg(long, value_delimiter = ',', value_parser = lucent::tools::bench::parse_size)]
+    #[arg(long, value_delimiter = ',', value_parser = lucent_tools::bench::parse_size)]
     sizes: Vec<usize>,
     /// Thread counts, comma separated (default: 1 and all cores).
-    #[arg(long, value_delimiter = ',', value_parser = lucent::tools::bench::parse_threads)]
+    #[arg(long, value_delimiter = ',', value_parser = lucent_tools::bench::parse_threads)]
     threads: Vec<usize>,
     /// Rays per query set (default 500000, quick 16384).
-    #[arg(long, value_parser = lucent::tools::bench::parse_rays)]
+    #[arg(long, value_parser = lucent_tools::bench::parse_rays)]
     rays: Option<usize>,
     /// Backends to measure: bvh | embree (the best available) | embree3 |
     /// embree4 | both (every backend available; the default).
@@ -757,7 +778,7 @@ enum BenchAccelArg {
 /// this process lacks is bad input, with why and how to get it.
 fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Error> {
     let want = match a {
-        None | Some(BenchAccelArg::Both) => return Ok(lucent::tools::bench::available_backends()),
+        None | Some(BenchAccelArg::Both) => return Ok(lucent_tools::bench::available_backends()),
         Some(BenchAccelArg::Bvh) => Backend::Bvh,
         Some(BenchAccelArg::Embree) => Backend::Embree,
         Some(BenchAccelArg::Embree3) => Backend::Embree3,
@@ -767,7 +788,7 @@ fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Error> {
 }
 
 fn run_bench(a: BenchArgs) -> Result<(), Error> {
-    use lucent::tools::bench;
+    use lucent_tools::bench;
     let backends = bench_backends(a.accel)?;
     if let Some(scene) = &a.scene {
         let mut s = bench::replay::Settings::new(scene, &a.output);

@@ -10,8 +10,8 @@ use std::time::Instant;
 
 use lucent::film::Film;
 use lucent::materials::Material;
-use lucent::tools::study::results::Row;
-use lucent::tools::study::{self, config, Axis, Settings};
+use lucent_tools::study::results::Row;
+use lucent_tools::study::{self, config, Axis, Settings};
 
 use common::mean_se;
 
