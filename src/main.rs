@@ -10,7 +10,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use lucent::accel::{self, Backend};
 use lucent::farm::part;
 use lucent::film::cryptomatte;
-use lucent::film::exr_layers::{self, ExrCompression, OutputOptions, Precision, Preview};
+use lucent::film::exr_layers::{ExrCompression, Precision, Preview};
 use lucent::film::passes::PassSet;
 use lucent::film::region::Region;
 use lucent::film::ToneMap;
@@ -172,14 +172,14 @@ enum Command {
     /// rays; bench.csv, report.txt and plots in the output directory. With
     /// --scene: the render's end-to-end ray rate against the backend's raw
     /// rate on the render's own queries (render-mix.csv, render-mix.txt).
-    Bench(BenchArgs),
+    Bench(lucent_tools::bench::cli::BenchArgs),
     /// Print the build's ray-query backends and versions.
     Info,
     /// Measure error against time for every sampling choice of the
     /// subsurface estimator: results.csv, plots and report.md in the output
     /// directory (resumes from results.csv; see src/tools/study/mod.rs).
     #[cfg(feature = "subsurface")]
-    Study(StudyArgs),
+    Study(lucent_tools::study::cli::StudyArgs),
 }
 
 /// Splitting a frame into parts, checkpoints and resuming (docs/farm.md).
@@ -227,9 +227,6 @@ enum ValueError {
         expected: &'static str,
         found: String,
     },
-    /// Not one of the names of `what`.
-    #[cfg(feature = "subsurface")]
-    Unknown { what: &'static str, found: String },
     /// A problem the parser named.
     Problem(String),
 }
@@ -240,8 +237,6 @@ impl std::fmt::Display for ValueError {
             ValueError::Expected { expected, found } => {
                 write!(f, "expected {expected}, found \"{found}\"")
             }
-            #[cfg(feature = "subsurface")]
-            ValueError::Unknown { what, found } => write!(f, "unknown {what} \"{found}\""),
             ValueError::Problem(p) => f.write_str(p),
         }
     }
@@ -492,12 +487,22 @@ fn main() -> ExitCode {
             tonemap,
             exposure,
             quiet,
-        } => run_merge(&parts, &output, tonemap.into(), exposure, quiet),
+        } => {
+            let preview = Preview {
+                tonemap: tonemap.into(),
+                exposure,
+            };
+            session::merge_parts(&parts, &output, preview).map(|m| {
+                if !quiet {
+                    eprintln!("{}", m.summary(&output));
+                }
+            })
+        }
         #[cfg(feature = "subsurface")]
-        Command::Study(args) => run_study(args),
-        Command::Bench(args) => run_bench(args),
+        Command::Study(args) => lucent_tools::study::cli::run_study(args),
+        Command::Bench(args) => lucent_tools::bench::cli::run_bench(args),
         Command::Info => {
-            println!("{}", info());
+            println!("{}", session::build_info());
             Ok(())
         }
     };
@@ -572,45 +577,6 @@ fn run_explain(
     Ok(())
 }
 
-fn run_merge(
-    parts: &[PathBuf],
-    output: &Path,
-    tonemap: ToneMap,
-    exposure: f32,
-    quiet: bool,
-) -> Result<(), Error> {
-    session::check_exr_output(output)?;
-    let start = std::time::Instant::now();
-    let m = lucent::farm::merge::merge(parts)?;
-    let header = lucent::film::exr_attributes::FrameHeader {
-        spp: Some(m.identity.spp),
-        seed: Some(m.identity.seed),
-        ..Default::default()
-    };
-    let out = OutputOptions {
-        preview: Some(Preview { tonemap, exposure }),
-        ..m.output
-    };
-    exr_layers::write_frame(output, &m.film, &m.layers, &m.coverage, &header, &out)?;
-    if !quiet {
-        eprintln!(
-            "{}: {} parts merged, {}×{} at {} spp, {:.2} s{}",
-            output.display(),
-            parts.len(),
-            m.film.width,
-            m.film.height,
-            m.identity.spp,
-            start.elapsed().as_secs_f64(),
-            if m.counters.nonfinite > 0 {
-                format!(", {} non-finite samples discarded", m.counters.nonfinite)
-            } else {
-                String::new()
-            }
-        );
-    }
-    Ok(())
-}
-
 /// `s` with every control character (from a file name, an OBJ line or a
 /// key quoted in the message) shown as its escape: a message is one line,
 /// and input cannot send escape sequences to the terminal.
@@ -637,223 +603,4 @@ fn report_rejected_rays(n: u64) {
             accel::MAX_RAY_COMPONENT
         );
     }
-}
-
-#[cfg(feature = "subsurface")]
-#[derive(clap::Args)]
-struct StudyArgs {
-    /// The scene description (TOML; needs a subsurface material).
-    scene: PathBuf,
-    /// Output directory (created; default: study-<scene name>).
-    #[arg(short, long)]
-    output: Option<PathBuf>,
-    /// Small images, few configurations, short ladders: under two minutes.
-    #[arg(long)]
-    quick: bool,
-    /// Worker threads, 1 to 1024 (default: all cores).
-    #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
-    threads: Option<usize>,
-    /// Integrator of the reference render: diffusion | randomwalk.
-    #[arg(long, default_value = "diffusion", value_parser = parse_study_integrator)]
-    reference: lucent::integrator::IntegratorKind,
-    /// Samples per pixel of the reference (default 4096, quick 512).
-    #[arg(long)]
-    reference_spp: Option<u32>,
-    /// Largest sample count of the ladder 1, 2, 4, … (default 128, quick 16).
-    #[arg(long)]
-    max_spp: Option<u32>,
-    /// Image width in pixels, aspect kept (default 128, quick 48).
-    #[arg(long)]
-    width: Option<u32>,
-    /// Base seed (default: the scene's).
-    #[arg(long)]
-    seed: Option<u64>,
-    /// Firefly threshold: pixels above K times the reference.
-    #[arg(long, default_value_t = 10.0)]
-    firefly_k: f64,
-    /// Only these axes (comma separated: radius, rmax, axes, channel,
-    /// renormalize, exit_sw, specular, backend, integrator, boundary, lod,
-    /// variance); the baseline always runs.
-    #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
-    only: Vec<lucent_tools::study::Axis>,
-    /// No progress bars.
-    #[arg(short, long)]
-    quiet: bool,
-}
-
-#[cfg(feature = "subsurface")]
-fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, ValueError> {
-    lucent_tools::study::config::parse_integrator(s)
-        .ok_or_else(|| expected("diffusion or randomwalk", s))
-}
-
-#[cfg(feature = "subsurface")]
-fn parse_study_axis(s: &str) -> Result<lucent_tools::study::Axis, ValueError> {
-    lucent_tools::study::Axis::parse(s).ok_or_else(|| ValueError::Unknown {
-        what: "axis",
-        found: s.into(),
-    })
-}
-
-#[cfg(feature = "subsurface")]
-fn run_study(a: StudyArgs) -> Result<(), Error> {
-    use lucent_tools::study;
-    let out = a.output.clone().unwrap_or_else(|| {
-        let stem = a
-            .scene
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        PathBuf::from(format!("study-{stem}"))
-    });
-    let mut s = study::Settings::new(&a.scene, out, a.quick);
-    s.threads = a.threads;
-    s.reference = a.reference;
-    s.reference_spp = a.reference_spp.unwrap_or(s.reference_spp);
-    s.max_spp = a.max_spp.unwrap_or(s.max_spp);
-    s.width = a.width.unwrap_or(s.width);
-    s.seed = a.seed;
-    s.firefly_k = a.firefly_k;
-    s.only = a.only;
-    s.progress = !a.quiet;
-    let o = study::run(&s)?;
-    if !a.quiet {
-        eprintln!(
-            "{}: {} configurations, {} rows ({} rendered now), reference {} at {} spp",
-            o.report.display(),
-            o.configs.len(),
-            o.rows.len(),
-            o.rendered_rows,
-            study::config::integrator_name(o.reference.integrator),
-            o.reference.spp
-        );
-    }
-    Ok(())
-}
-
-#[derive(clap::Args)]
-struct BenchArgs {
-    /// Output directory for bench.csv, report.txt and the plots.
-    #[arg(short, long, default_value = "bench")]
-    output: PathBuf,
-    /// Sizes up to 80k triangles, 16k rays, short timing: under a minute.
-    #[arg(long)]
-    quick: bool,
-    /// Triangle counts, comma separated (1k, 16k, 1.3M; each becomes the
-    /// displaced sphere of 20·4^level triangles nearest to it).
-    #[arg(long, value_delimiter = ',', value_parser = lucent_tools::bench::parse_size)]
-    sizes: Vec<usize>,
-    /// Thread counts, comma separated (default: 1 and all cores).
-    #[arg(long, value_delimiter = ',', value_parser = lucent_tools::bench::parse_threads)]
-    threads: Vec<usize>,
-    /// Rays per query set (default 500000, quick 16384).
-    #[arg(long, value_parser = lucent_tools::bench::parse_rays)]
-    rays: Option<usize>,
-    /// Backends to measure: bvh | embree (the best available) | embree3 |
-    /// embree4 | both (every backend available; the default).
-    #[arg(long, value_enum)]
-    accel: Option<BenchAccelArg>,
-    /// Render this scene, record its ray queries and replay them on the bare
-    /// backend: end-to-end against raw ray rate (instead of the meshes).
-    #[arg(long, conflicts_with_all = ["quick", "sizes", "rays"])]
-    scene: Option<PathBuf>,
-    /// Samples per pixel of the scene's renders (with --scene; default 2).
-    #[arg(long, requires = "scene")]
-    spp: Option<u32>,
-    /// No progress bar.
-    #[arg(short, long)]
-    quiet: bool,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum BenchAccelArg {
-    Bvh,
-    Embree,
-    Embree3,
-    Embree4,
-    Both,
-}
-
-/// The backends `--accel` asks for, each concrete (`embree` resolved); one
-/// this process lacks is bad input, with why and how to get it.
-fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Error> {
-    let want = match a {
-        None | Some(BenchAccelArg::Both) => return Ok(lucent_tools::bench::available_backends()),
-        Some(BenchAccelArg::Bvh) => Backend::Bvh,
-        Some(BenchAccelArg::Embree) => Backend::Embree,
-        Some(BenchAccelArg::Embree3) => Backend::Embree3,
-        Some(BenchAccelArg::Embree4) => Backend::Embree4,
-    };
-    Ok(vec![want.resolve()?])
-}
-
-fn run_bench(a: BenchArgs) -> Result<(), Error> {
-    use lucent_tools::bench;
-    let backends = bench_backends(a.accel)?;
-    if let Some(scene) = &a.scene {
-        let mut s = bench::replay::Settings::new(scene, &a.output);
-        s.spp = a.spp.unwrap_or(s.spp);
-        if !a.threads.is_empty() {
-            s.threads = a.threads;
-        }
-        s.backends = backends;
-        s.progress = !a.quiet;
-        let o = bench::replay::run(&s)?;
-        print!("{}", o.report);
-        if !a.quiet {
-            eprintln!("{} rows in {}", o.rows.len(), o.csv.display());
-        }
-        return Ok(());
-    }
-    let mut s = bench::Settings::new(&a.output, a.quick);
-    s.backends = backends;
-    if !a.sizes.is_empty() {
-        s.sizes = a.sizes;
-    }
-    if !a.threads.is_empty() {
-        s.threads = a.threads;
-    }
-    s.rays = a.rays.unwrap_or(s.rays);
-    s.progress = !a.quiet;
-    let o = bench::run(&s)?;
-    print!("{}", o.report);
-    if !a.quiet {
-        eprintln!(
-            "{} rows in {}; plots: {}",
-            o.rows.len(),
-            o.csv.display(),
-            o.plots
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    Ok(())
-}
-
-fn info() -> String {
-    let names: Vec<&str> = Backend::all_available().iter().map(|b| b.name()).collect();
-    let mut s = format!(
-        "lucent {}\nbackends: {}",
-        env!("CARGO_PKG_VERSION"),
-        names.join(", ")
-    );
-    for line in accel::embree_report() {
-        s.push('\n');
-        s.push_str(&line);
-    }
-    let default = Backend::default_available();
-    s.push_str(&format!("\ndefault backend: {}", default.name()));
-    if let Ok(b) = default.resolve() {
-        if b != default {
-            s.push_str(&format!(" ({})", b.name()));
-        }
-    }
-    s.push_str(if cfg!(feature = "subsurface") {
-        "\nsubsurface: yes"
-    } else {
-        "\nsubsurface: no (built without the `subsurface` feature)"
-    });
-    s
 }

@@ -12,6 +12,7 @@
 //! very queries that render issued. The files: `settings`, `meshes`,
 //! [`rays`], [`measure`], `run`, `hits`, `csv`, `report` and [`plot`].
 
+pub mod cli;
 mod csv;
 mod hits;
 pub mod measure;

@@ -13,6 +13,7 @@
 //! `resume` (what is already done), `ladder` (the renders), [`metrics`],
 //! [`results`], [`plots`] and [`report`].
 
+pub mod cli;
 pub mod config;
 mod ladder;
 pub mod metrics;

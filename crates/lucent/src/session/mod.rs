@@ -6,12 +6,16 @@
 
 pub mod checkpoint;
 pub mod identity;
+mod info;
+mod merge;
 pub mod output;
 pub mod overrides;
 pub mod request;
 pub mod resume;
 mod run;
 
+pub use info::build_info;
+pub use merge::{merge_parts, MergedFrame};
 pub use output::check_exr_output;
 pub use overrides::Overrides;
 pub use request::{Request, Split};
