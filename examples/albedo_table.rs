@@ -1,4 +1,4 @@
-//! Generates `src/bssrdf/albedo_table.csv`, the total diffuse reflectance
+//! Generates `crates/lucent/src/bssrdf/albedo_table.csv`, the total diffuse reflectance
 //! of a semi-infinite medium behind a smooth dielectric boundary, by the
 //! random walk's physics (`lucent_tools::halfspace`; `docs/bssrdf.md` §9).
 //!
@@ -20,7 +20,7 @@ fn main() {
         .iter()
         .find(|a| !a.starts_with("--"))
         .cloned()
-        .unwrap_or_else(|| "src/bssrdf/albedo_table.csv".into());
+        .unwrap_or_else(|| "crates/lucent/src/bssrdf/albedo_table.csv".into());
     let mut s = TableSettings::default();
     if args.iter().any(|a| a == "--similarity") {
         similarity(&s);

@@ -1,4 +1,4 @@
-//! Generates `src/bssrdf/curvature_table.csv`: per (η, x = √(1 − α'), ρ)
+//! Generates `crates/lucent/src/bssrdf/curvature_table.csv`: per (η, x = √(1 − α'), ρ)
 //! the ratio h = (1 − A_sphere) / (1 − A_slab) of what a sphere of radius
 //! ρ diffusion lengths and the half-space of the same medium absorb under
 //! uniform light, by the random walk's physics
@@ -23,7 +23,7 @@ fn main() {
         .iter()
         .find(|a| !a.starts_with("--"))
         .cloned()
-        .unwrap_or_else(|| "src/bssrdf/curvature_table.csv".into());
+        .unwrap_or_else(|| "crates/lucent/src/bssrdf/curvature_table.csv".into());
     let mut s = Settings::default();
     if args.iter().any(|a| a == "--check") {
         check(&s);

@@ -254,8 +254,8 @@ fn non_test_code(text: &str) -> String {
     code
 }
 
-/// Top-level module of a file under src/: `src/bssrdf/probe.rs` → bssrdf,
-/// `src/render.rs` → render; None for the crate roots.
+/// Top-level module of a file under a crate's src/: `src/bssrdf/probe.rs`
+/// → bssrdf, `src/render.rs` → render; None for the crate roots.
 fn top_module(src: &Path, file: &Path) -> Option<String> {
     let rel = file.strip_prefix(src).unwrap();
     let first = rel.components().next()?.as_os_str().to_str()?.to_string();
@@ -511,7 +511,8 @@ fn the_library_depends_on_no_cli_plotting_or_progress_bar_crate() {
     }
 }
 
-/// Hubs (relative to the library's src/, or the tools' as `tools/…`) whose own code and children still use each
+/// Hubs (relative to the library's src/, or the tools' src/ as `tools/…`)
+/// whose own code and children still use each
 /// other: [`a_mod_rs_and_its_children_form_a_dag`] holds every other hub to
 /// the rule, and these to staying on this list only while knotted.
 const KNOTS: [&str; 6] = [

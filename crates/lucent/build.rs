@@ -7,7 +7,7 @@
 //! standard Debian locations. Not found is a build error that says what to
 //! install. Without the feature (`--no-default-features`) it does nothing
 //! and lucent has only its own BVH. Embree 4 (the `embree4` feature) needs
-//! nothing here: it is opened at run time (src/accel/embree4/load.rs).
+//! nothing here: it is opened at run time (crates/lucent/src/accel/embree4/load.rs).
 
 use std::env;
 use std::path::{Path, PathBuf};

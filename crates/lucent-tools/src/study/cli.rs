@@ -6,6 +6,8 @@ use lucent::integrator::IntegratorKind;
 use lucent::Error;
 
 /// `lucent study`'s arguments.
+// The fields' docs are the --help text, not HTML.
+#[allow(rustdoc::invalid_html_tags)]
 #[derive(clap::Args)]
 pub struct StudyArgs {
     /// The scene description (TOML; needs a subsurface material).

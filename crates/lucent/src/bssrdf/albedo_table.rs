@@ -54,7 +54,7 @@ pub fn interpolate_row(r: &[f64], x: f64, eta: f64) -> f64 {
 pub const DATA: &str = include_str!("albedo_table.csv");
 
 /// Where the data file is, for messages.
-pub const DATA_PATH: &str = "src/bssrdf/albedo_table.csv";
+pub const DATA_PATH: &str = "crates/lucent/src/bssrdf/albedo_table.csv";
 
 /// A line of the data file that does not parse: the line (1-based), the
 /// field and what is wrong.

@@ -21,7 +21,7 @@ use super::albedo_table::{read_rows, TableError};
 pub const DATA: &str = include_str!("curvature_table.csv");
 
 /// Where the data file is, for messages.
-pub const DATA_PATH: &str = "src/bssrdf/curvature_table.csv";
+pub const DATA_PATH: &str = "crates/lucent/src/bssrdf/curvature_table.csv";
 
 /// The data file's columns, in order.
 pub const COLUMNS: [&str; 7] = ["eta", "x", "rho", "h", "se_h", "a_sphere", "a_slab"];
