@@ -56,7 +56,7 @@ pub fn requested() -> Option<i32> {
 }
 
 /// [`crate::Error::Interrupted`] once a signal asked the process to stop.
-pub fn stop_if_requested() -> Result<(), crate::Error> {
+pub(crate) fn stop_if_requested() -> Result<(), crate::Error> {
     match requested() {
         Some(sig) => Err(crate::Error::Interrupted(sig)),
         None => Ok(()),
@@ -75,7 +75,7 @@ pub fn exit_code(signal: i32) -> i32 {
 }
 
 /// The signal's name for messages (`SIGINT`), or its number.
-pub fn signal_name(signal: i32) -> String {
+pub(crate) fn signal_name(signal: i32) -> String {
     match signal {
         SIGINT => "SIGINT".into(),
         SIGTERM => "SIGTERM".into(),
@@ -92,7 +92,7 @@ pub fn register_temporary(path: &Path) {
 }
 
 /// The temporary file was renamed into place or removed: forget it.
-pub fn unregister_temporary(path: &Path) {
+pub(crate) fn unregister_temporary(path: &Path) {
     if let Ok(mut t) = TEMPORARIES.lock() {
         if let Some(i) = t.iter().rposition(|p| p == path) {
             t.swap_remove(i);

@@ -135,7 +135,7 @@ impl LightSet {
 
     /// The area density with which [`sample`](Self::sample) picks a point on
     /// triangle (geom, prim); 0 for non-emitters.
-    pub fn pdf_area(&self, geom: u32, prim: u32) -> f32 {
+    pub(crate) fn pdf_area(&self, geom: u32, prim: u32) -> f32 {
         match self.first.get(geom as usize).copied().flatten() {
             Some(f) => self.tris[(f + prim) as usize].pdf_area,
             None => 0.0,

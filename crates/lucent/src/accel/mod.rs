@@ -200,7 +200,7 @@ pub fn valid_query(ray: &Ray, tmin: f32, tmax: f32) -> bool {
 /// the traversal. Bumped only on the rare refusal, so it costs nothing on
 /// the hot path.
 #[derive(Debug, Default)]
-pub struct RejectedRays(AtomicU64);
+pub(crate) struct RejectedRays(AtomicU64);
 
 impl RejectedRays {
     /// Counts one refused query.
@@ -355,7 +355,7 @@ fn embree4_available() -> Result<(), Error> {
 
 /// The Embree versions this process has, one line each, for `lucent info`:
 /// "embree3: Embree 3.13.5", "embree4: Embree 4.4.0 (path)", or why not.
-pub fn embree_report() -> Vec<String> {
+pub(crate) fn embree_report() -> Vec<String> {
     let mut v = Vec::new();
     #[cfg(feature = "embree")]
     v.push(format!("embree3: Embree {}", embree::version()));

@@ -18,7 +18,7 @@ use super::dipole::dipole_reflectance;
 
 /// ρ = R / R_dipole at the equally spaced x nodes of one row (η fixed);
 /// at x = 1, where both vanish, ρ of the node before.
-pub fn ratio_row(r: &[f64], eta: f64) -> Vec<f64> {
+pub(crate) fn ratio_row(r: &[f64], eta: f64) -> Vec<f64> {
     let n = r.len() - 1;
     let mut rho: Vec<f64> = (0..=n)
         .map(|j| {
@@ -36,7 +36,7 @@ pub fn ratio_row(r: &[f64], eta: f64) -> Vec<f64> {
 }
 
 /// ρ linearly interpolated at x ∈ [0, 1] on equally spaced nodes.
-pub fn lerp_nodes(ys: &[f64], x: f64) -> f64 {
+pub(crate) fn lerp_nodes(ys: &[f64], x: f64) -> f64 {
     let n = ys.len() - 1;
     let f = (x * n as f64).clamp(0.0, n as f64);
     let j = (f.floor() as usize).min(n - 1);
@@ -51,10 +51,10 @@ pub fn interpolate_row(r: &[f64], x: f64, eta: f64) -> f64 {
 }
 
 /// The data file, embedded.
-pub const DATA: &str = include_str!("albedo_table.csv");
+pub(crate) const DATA: &str = include_str!("albedo_table.csv");
 
 /// Where the data file is, for messages.
-pub const DATA_PATH: &str = "crates/lucent/src/bssrdf/albedo_table.csv";
+pub(crate) const DATA_PATH: &str = "crates/lucent/src/bssrdf/albedo_table.csv";
 
 /// A line of the data file that does not parse: the line (1-based), the
 /// field and what is wrong.
@@ -237,7 +237,7 @@ impl AlbedoTable {
     }
 
     /// The tabulated η range.
-    pub fn eta_range(&self) -> (f64, f64) {
+    pub(crate) fn eta_range(&self) -> (f64, f64) {
         (self.etas[0], *self.etas.last().unwrap())
     }
 
@@ -266,7 +266,7 @@ impl AlbedoTable {
 
     /// The α' with `reflectance(α', η) = a` (bisection; R is increasing in
     /// α', checked by a test), None outside the η range.
-    pub fn invert(&self, a: f64, eta: f64) -> Option<f64> {
+    pub(crate) fn invert(&self, a: f64, eta: f64) -> Option<f64> {
         self.reflectance(0.5, eta)?;
         let (mut lo, mut hi) = (0.0f64, 1.0f64);
         for _ in 0..64 {

@@ -31,7 +31,7 @@ pub const MIN_FACTOR: f64 = 0.9;
 /// The exit point's curvature κo and its factor f(κo)
 /// ([`CurvatureCorrection::at_exit`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ExitFactor {
+pub(crate) struct ExitFactor {
     kappa: f32,
     f: [f32; 3],
 }
@@ -41,7 +41,7 @@ impl ExitFactor {
     /// gets, √(f(κo)·f(κo)) (1 on flat and concave surfaces). The plane
     /// control variate's model surface is such a point everywhere
     /// (`integrator::control_variate`).
-    pub fn at_exit_alone(&self) -> Vec3 {
+    pub(crate) fn at_exit_alone(&self) -> Vec3 {
         Vec3::from_array(self.f)
     }
 }
@@ -191,7 +191,7 @@ impl CurvatureCorrection {
     /// The exit point's half of [`weight`](Self::weight): κo and f(κo),
     /// computed once for all the probes from one exit point (the
     /// antithetic pair's two; `crate::kernels`).
-    pub fn at_exit(&self, kappa_o: f32) -> ExitFactor {
+    pub(crate) fn at_exit(&self, kappa_o: f32) -> ExitFactor {
         ExitFactor {
             kappa: kappa_o,
             f: self.factor(kappa_o),
@@ -200,13 +200,13 @@ impl CurvatureCorrection {
 
     /// [`weight`](Self::weight) from the exit point's [`at_exit`](Self::at_exit):
     /// the same value, bit for bit.
-    pub fn weight_from(&self, exit: &ExitFactor, kappa_i: f32) -> Option<Vec3> {
+    pub(crate) fn weight_from(&self, exit: &ExitFactor, kappa_i: f32) -> Option<Vec3> {
         self.weight_from_factor(exit, kappa_i, self.factor(kappa_i))
     }
 
     /// [`at_exit`](Self::at_exit) with f(κo) already known (a cache of
     /// [`factor`](Self::factor)): the same value, bit for bit.
-    pub fn at_exit_with(&self, kappa_o: f32, f_o: [f32; 3]) -> ExitFactor {
+    pub(crate) fn at_exit_with(&self, kappa_o: f32, f_o: [f32; 3]) -> ExitFactor {
         ExitFactor {
             kappa: kappa_o,
             f: f_o,
@@ -216,7 +216,7 @@ impl CurvatureCorrection {
     /// [`weight_from`](Self::weight_from) with f(κi) already known (`f_i`,
     /// a cache of [`factor`](Self::factor)): the same value, bit for bit.
     #[inline]
-    pub fn weight_from_factor(
+    pub(crate) fn weight_from_factor(
         &self,
         exit: &ExitFactor,
         kappa_i: f32,

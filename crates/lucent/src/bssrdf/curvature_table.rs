@@ -18,10 +18,10 @@ use std::sync::OnceLock;
 use super::albedo_table::{read_rows, TableError};
 
 /// The data file, embedded.
-pub const DATA: &str = include_str!("curvature_table.csv");
+pub(crate) const DATA: &str = include_str!("curvature_table.csv");
 
 /// Where the data file is, for messages.
-pub const DATA_PATH: &str = "crates/lucent/src/bssrdf/curvature_table.csv";
+pub(crate) const DATA_PATH: &str = "crates/lucent/src/bssrdf/curvature_table.csv";
 
 /// The data file's columns, in order.
 pub const COLUMNS: [&str; 7] = ["eta", "x", "rho", "h", "se_h", "a_sphere", "a_slab"];
@@ -160,7 +160,7 @@ impl CurvatureTable {
 
     /// h(ρ) from a [`row`](Self::row): linear in ln ρ between nodes,
     /// clamped below the grid, 1 − (1 − h_N)·ρ_N/ρ beyond it (module docs).
-    pub fn at_rho(&self, row: &[f64], rho: f64) -> f64 {
+    pub(crate) fn at_rho(&self, row: &[f64], rho: f64) -> f64 {
         let n = self.rhos.len();
         let last = self.rhos[n - 1];
         if rho >= last {

@@ -30,7 +30,7 @@ enum Disk {
 
 /// Per-material constants of the density, lengths in units of L.
 #[derive(Clone, Debug)]
-pub struct ProbeDensity {
+pub(crate) struct ProbeDensity {
     /// L and 1/L in scene units.
     len: f64,
     inv_len: f64,

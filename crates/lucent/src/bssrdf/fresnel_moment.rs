@@ -11,7 +11,7 @@ use crate::fresnel;
 
 /// First Fresnel moment FM1(η) = ∫_0^1 Fr(μ, η) μ dμ, polynomial fits
 /// (pbrt-v3 `FresnelMoment1`).
-pub fn fm1(eta: f64) -> f64 {
+pub(crate) fn fm1(eta: f64) -> f64 {
     let (e, e2, e3, e4, e5) = (eta, eta * eta, eta.powi(3), eta.powi(4), eta.powi(5));
     if eta < 1.0 {
         0.45966 - 1.73965 * e + 3.37668 * e2 - 3.904945 * e3 + 2.49277 * e4 - 0.68441 * e5

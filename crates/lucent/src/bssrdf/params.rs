@@ -55,7 +55,7 @@ fn table() -> &'static AlbedoTable {
 /// The total diffuse reflectance of a semi-infinite medium of reduced
 /// albedo α' behind a boundary of index η: the albedo table, or the dipole
 /// outside its η range.
-pub fn medium_reflectance(alpha_reduced: f64, eta: f64) -> f64 {
+pub(crate) fn medium_reflectance(alpha_reduced: f64, eta: f64) -> f64 {
     table()
         .reflectance(alpha_reduced, eta)
         .unwrap_or_else(|| dipole_reflectance(alpha_reduced, eta))
@@ -63,7 +63,7 @@ pub fn medium_reflectance(alpha_reduced: f64, eta: f64) -> f64 {
 
 /// The α' whose reflectance is `a` under `source` (table or dipole), capped
 /// at 1 − [`MIN_ABSORPTION_FRACTION`].
-pub fn invert_reflectance(a: f64, eta: f64, source: AlbedoSource) -> f64 {
+pub(crate) fn invert_reflectance(a: f64, eta: f64, source: AlbedoSource) -> f64 {
     match source {
         AlbedoSource::Table => table()
             .invert(a, eta)
@@ -245,7 +245,7 @@ impl Medium {
     /// albedo table or the dipole) is `albedo` and whose diffuse mean free
     /// path (or, with `volume_mfp`, volume mean free path 1/σt') is `mfp`
     /// (scene units), g = 0. See the module docs.
-    pub fn from_reflectance(
+    pub(crate) fn from_reflectance(
         albedo: [f64; 3],
         mfp: [f64; 3],
         eta: f32,
@@ -396,7 +396,7 @@ impl SubsurfaceParams {
     }
 
     /// [`Self::from_measured`] with the albedo taken from `source`.
-    pub fn from_measured_with(
+    pub(crate) fn from_measured_with(
         m: &Measured,
         units_per_mm: f64,
         fit: Fit,
@@ -450,7 +450,7 @@ impl SubsurfaceParams {
 
     /// [`Self::from_artist`] with the random-walk medium derived by
     /// inverting `source`'s reflectance (the table, or the dipole).
-    pub fn from_artist_with(
+    pub(crate) fn from_artist_with(
         albedo: [f64; 3],
         mfp: [f64; 3],
         eta: f32,
@@ -496,7 +496,7 @@ impl SubsurfaceParams {
     }
 
     /// The largest d among active channels (0 if none is active).
-    pub fn max_active_d(&self) -> f64 {
+    pub(crate) fn max_active_d(&self) -> f64 {
         (0..3)
             .filter(|&c| self.active(c))
             .map(|c| self.d[c])

@@ -78,7 +78,7 @@ impl ProbeAxes {
 /// probes along N, so a smaller ε leaves it more of the probes; the bound
 /// grows as 1/ε_min (docs/accuracy.md, "The plane control variate", for the
 /// trade measured); the grazing scene keeps ε = ¼.
-pub const TANGENT_PROB_MIN: f64 = 0.005;
+pub(crate) const TANGENT_PROB_MIN: f64 = 0.005;
 
 /// κ·d at and beyond which [`ProbeAxes::Curvature`] uses mis3's ¼.
 pub const TANGENT_PROB_FULL_AT: f64 = 1.0;
@@ -458,7 +458,7 @@ impl ProbeSampler {
     /// `sample_probe` gives for its angle. The channel, radius and axis —
     /// the radius inverse CDF and the axis probabilities, most of a
     /// probe's sampling work — are computed once for both (`crate::kernels`).
-    pub fn sample_probe_pair(
+    pub(crate) fn sample_probe_pair(
         &self,
         xo: Vec3,
         frame: &Frame,
@@ -492,7 +492,7 @@ impl ProbeSampler {
     /// [`sample_probe_pair`](Self::sample_probe_pair), bit for bit, and
     /// the first probe's [`PlaneModel`] (the twin's is the same with the
     /// offset negated).
-    pub fn sample_probe_pair_and_plane(
+    pub(crate) fn sample_probe_pair_and_plane(
         &self,
         xo: Vec3,
         frame: &Frame,

@@ -48,7 +48,7 @@ pub fn radial_density_unit(rho: f64) -> f64 {
 /// Written with `expm1` so it keeps full relative precision as ρ → 0, where
 /// the direct form cancels (CDF ≈ ρ/2).
 #[inline]
-pub fn cdf_unit(rho: f64) -> f64 {
+pub(crate) fn cdf_unit(rho: f64) -> f64 {
     if rho <= 0.0 {
         return 0.0;
     }
@@ -58,7 +58,7 @@ pub fn cdf_unit(rho: f64) -> f64 {
 /// 1 − CDF(ρ) = e^{−ρ}/4 + 3e^{−ρ/3}/4, with full relative precision in the
 /// tail (where 1 − cdf_unit would cancel).
 #[inline]
-pub fn ccdf_unit(rho: f64) -> f64 {
+pub(crate) fn ccdf_unit(rho: f64) -> f64 {
     if rho <= 0.0 {
         return 1.0;
     }
@@ -89,7 +89,7 @@ pub fn cdf(r: f64, d: f64) -> f64 {
 /// sampler computes it as (1 − u)·c + (1 − c)) keep the tail precise.
 /// Returns +∞ for ξ = 1 (u = 0).
 #[inline]
-pub fn inverse_cdf_unit_pair(xi: f64, one_minus_xi: f64) -> f64 {
+pub(crate) fn inverse_cdf_unit_pair(xi: f64, one_minus_xi: f64) -> f64 {
     if xi <= 0.0 {
         return 0.0;
     }
@@ -141,7 +141,7 @@ fn cbrt_cardano(x: f64) -> f64 {
 /// Inverse CDF at d = 1: the radius ρ = r/d holding a fraction `xi` of the
 /// profile's energy (1 − ξ is computed exactly for ξ ≥ ½ by Sterbenz).
 #[inline]
-pub fn inverse_cdf_unit(xi: f64) -> f64 {
+pub(crate) fn inverse_cdf_unit(xi: f64) -> f64 {
     inverse_cdf_unit_pair(xi, 1.0 - xi)
 }
 
@@ -187,7 +187,7 @@ impl Fit {
 
     /// Whether the length this fit expects is the volume mean free path
     /// 1/σt' (true) or the diffuse mean free path 1/σtr (false).
-    pub fn uses_volume_mfp(self) -> bool {
+    pub(crate) fn uses_volume_mfp(self) -> bool {
         matches!(self, Fit::VolumeMfp)
     }
 

@@ -144,7 +144,7 @@ const TABLE_TOP: f64 = 1e-12;
 
 /// The inverse CDF of the profile at d = 1, tabulated at n + 1 nodes.
 #[derive(Debug)]
-pub struct InverseCdfTable {
+pub(crate) struct InverseCdfTable {
     spacing: TableSpacing,
     /// ρ at the nodes; `nodes[0] = 0`, strictly increasing.
     nodes: Vec<f64>,
@@ -190,7 +190,7 @@ impl InverseCdfTable {
     }
 
     /// The largest ρ the table can return.
-    pub fn rho_cap(&self) -> f64 {
+    pub(crate) fn rho_cap(&self) -> f64 {
         self.nodes[self.size()]
     }
 
@@ -221,7 +221,7 @@ impl InverseCdfTable {
 
     /// The interpolated inverse: ρ for ξ ∈ [0, 1].
     #[inline]
-    pub fn sample_unit(&self, xi: f64) -> f64 {
+    pub(crate) fn sample_unit(&self, xi: f64) -> f64 {
         let n = self.size();
         let x = self.v_of_xi(xi) * n as f64;
         let i = (x as usize).min(n - 1);
@@ -239,7 +239,7 @@ impl InverseCdfTable {
     }
 
     /// The CDF of what the table samples (untruncated), at ρ.
-    pub fn cdf_unit(&self, rho: f64) -> f64 {
+    pub(crate) fn cdf_unit(&self, rho: f64) -> f64 {
         if rho <= 0.0 {
             return 0.0;
         }
@@ -251,7 +251,7 @@ impl InverseCdfTable {
     }
 
     /// The radial density dξ/dρ of what the table samples (untruncated).
-    pub fn density_unit(&self, rho: f64) -> f64 {
+    pub(crate) fn density_unit(&self, rho: f64) -> f64 {
         if !(0.0..self.rho_cap()).contains(&rho) {
             return 0.0;
         }
@@ -347,7 +347,7 @@ impl RadialDist {
 
     /// The profile's energy within Rmax, CDF(Rmax/d), whatever the sampler:
     /// the factor a truncated estimate falls short of A by.
-    pub fn profile_mass(&self) -> f64 {
+    pub(crate) fn profile_mass(&self) -> f64 {
         profile::cdf_unit(self.rmax / self.d)
     }
 
@@ -361,7 +361,7 @@ impl RadialDist {
     /// [`sample`](Self::sample) without the pdf, for callers that evaluate
     /// the density of the point the radius leads to instead.
     #[inline]
-    pub fn sample_radius(&self, u: f64) -> f64 {
+    pub(crate) fn sample_radius(&self, u: f64) -> f64 {
         let u = u.clamp(0.0, 1.0 - f64::EPSILON / 2.0);
         let d = self.d;
         let r = match &self.kind {

@@ -200,7 +200,7 @@ pub fn stage(path: &Path, header: &Header, sums: &Sums) -> Result<Staged, Error>
 }
 
 /// The header of the part at `path`, without its pixels.
-pub fn read_header(path: &Path) -> Result<Header, Error> {
+pub(crate) fn read_header(path: &Path) -> Result<Header, Error> {
     let meta = exr::meta::MetaData::read_from_file(path, true).map_err(|e| {
         let problem = format!("not a readable OpenEXR file (not a lucent part): {e}");
         bad(path, None, problem)

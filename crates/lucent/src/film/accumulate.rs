@@ -68,7 +68,7 @@ pub struct FixedPoint {
 
 /// The largest magnitude of one term of a sum, as a power of two: with at
 /// most `u32::MAX` terms, a sum stays below 2^127.
-pub const TERM_BITS: u32 = 95;
+pub(crate) const TERM_BITS: u32 = 95;
 
 impl FixedPoint {
     /// Radiance (beauty and light-path layers): Q63.64, exact for f32 in
@@ -163,7 +163,7 @@ pub fn to_words(v: i128) -> [u32; 4] {
 }
 
 /// The inverse of [`to_words`].
-pub fn from_words(w: [u32; 4]) -> i128 {
+pub(crate) fn from_words(w: [u32; 4]) -> i128 {
     (w[0] as u128 | (w[1] as u128) << 32 | (w[2] as u128) << 64 | (w[3] as u128) << 96) as i128
 }
 

@@ -35,7 +35,7 @@ use super::layers::Coverage;
 use crate::error::Error;
 
 /// The standard's suggested number of ranks (3 RGBA layers).
-pub const DEFAULT_RANKS: usize = 6;
+pub(crate) const DEFAULT_RANKS: usize = 6;
 
 /// The largest number of ranks accepted (32 RGBA layers).
 pub const MAX_RANKS: usize = 64;
@@ -114,7 +114,7 @@ pub fn manifest(names: &[String]) -> String {
 /// One Cryptomatte, ready for the file: planar channels (`NAME00.R`, …)
 /// and the header attributes (name, value) of its metadata.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Encoded {
+pub(crate) struct Encoded {
     pub name: String,
     /// (channel name, one value per pixel, row-major).
     pub channels: Vec<(String, Vec<f32>)>,
@@ -123,7 +123,7 @@ pub struct Encoded {
 
 /// Encodes `cov` over `pixels` pixels with `ranks` ranks (rounded up to
 /// whole RGBA layers; the extra rank, if any, stays empty).
-pub fn encode(cov: &Coverage, pixels: usize, ranks: usize) -> Result<Encoded, Error> {
+pub(crate) fn encode(cov: &Coverage, pixels: usize, ranks: usize) -> Result<Encoded, Error> {
     if !(1..=MAX_RANKS).contains(&ranks) {
         return Err(Error::Runtime(format!(
             "Cryptomatte ranks: {ranks} is not in 1 to {MAX_RANKS}"

@@ -16,7 +16,7 @@ use exr::meta::attribute::{AttributeValue, Text};
 use exr::prelude::Vec2;
 
 /// The renderer's name, written into `software` with its version.
-pub const RENDERER: &str = "lucent";
+pub(crate) const RENDERER: &str = "lucent";
 
 /// What the header records about one render. Every field but the
 /// resolution (taken from the film) is filled by the caller; `None` and

@@ -91,7 +91,7 @@ pub enum ExrCompression {
 }
 
 impl ExrCompression {
-    pub const NAMES: &'static str = "none, rle, zips, zip or piz";
+    pub(crate) const NAMES: &'static str = "none, rle, zips, zip or piz";
 
     /// "none", "rle", "zips", "zip" or "piz".
     pub fn parse(s: &str) -> Option<Self> {
@@ -183,7 +183,7 @@ pub fn write_frame(
 
 /// [`write_frame`] to temporary files only, for [`commit_all`] (with other
 /// outputs of the same command).
-pub fn stage_frame(
+pub(crate) fn stage_frame(
     path: &Path,
     film: &Film,
     layers: &[Layer],

@@ -168,7 +168,7 @@ impl Film {
 }
 
 /// The error of an allocation that failed: what it was for and its size.
-pub fn out_of_memory(what: &str, bytes: usize) -> Error {
+pub(crate) fn out_of_memory(what: &str, bytes: usize) -> Error {
     Error::Runtime(format!(
         "out of memory: cannot allocate {} MB for {what}",
         bytes.div_ceil(1 << 20)

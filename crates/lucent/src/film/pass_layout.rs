@@ -45,7 +45,7 @@ const XYZ: &[&str] = &["X", "Y", "Z"];
 /// A layer of summed channels, as a part lists it: name, channels, and
 /// the fixed-point fraction bits of their sums.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct SumLayer {
+pub(crate) struct SumLayer {
     pub name: String,
     pub channels: Vec<String>,
     pub frac_bits: u32,
@@ -140,7 +140,7 @@ impl Layout {
 
     /// The summed layers, in stride order (a part's `lucent.layers` after
     /// the beauty).
-    pub fn sum_layers(&self) -> Vec<SumLayer> {
+    pub(crate) fn sum_layers(&self) -> Vec<SumLayer> {
         let mut v = Vec::new();
         for s in &self.slots {
             match s.pass {

@@ -32,7 +32,7 @@ pub struct Nearest {
 
 impl Nearest {
     /// No hit: loses to every hit.
-    pub const NONE: Nearest = Nearest {
+    pub(crate) const NONE: Nearest = Nearest {
         z: f32::INFINITY,
         sample: u32::MAX,
         p: [0.0; 3],
@@ -46,7 +46,7 @@ impl Nearest {
     }
 
     /// The nearer of the two.
-    pub fn nearer(self, o: Nearest) -> Nearest {
+    pub(crate) fn nearer(self, o: Nearest) -> Nearest {
         if self.object == 0 || (o.object != 0 && o.order(&self).is_lt()) {
             o
         } else {
@@ -57,7 +57,7 @@ impl Nearest {
 
 /// Adds `o`'s counts (sorted by ID) to `into` (sorted by ID), keeping it
 /// sorted.
-pub fn add_counts(into: &mut Vec<(u32, u32)>, o: &[(u32, u32)]) -> Option<()> {
+pub(crate) fn add_counts(into: &mut Vec<(u32, u32)>, o: &[(u32, u32)]) -> Option<()> {
     for &(id, c) in o {
         match into.binary_search_by_key(&id, |e| e.0) {
             Ok(i) => into[i].1 = into[i].1.checked_add(c)?,
@@ -99,7 +99,7 @@ impl AovSums {
     }
 
     /// Splits into consecutive views of `pixels[k]` pixels each.
-    pub fn views<'a>(&'a self, layout: &Layout, pixels: &[usize]) -> Vec<AovView<'a>> {
+    pub(crate) fn views<'a>(&'a self, layout: &Layout, pixels: &[usize]) -> Vec<AovView<'a>> {
         let (mut s, mut n, mut o, mut m) = (
             &self.sums[..],
             &self.nearest[..],
@@ -126,7 +126,11 @@ impl AovSums {
     }
 
     /// Splits into consecutive mutable views of `pixels[k]` pixels each.
-    pub fn views_mut<'a>(&'a mut self, layout: &Layout, pixels: &[usize]) -> Vec<AovViewMut<'a>> {
+    pub(crate) fn views_mut<'a>(
+        &'a mut self,
+        layout: &Layout,
+        pixels: &[usize],
+    ) -> Vec<AovViewMut<'a>> {
         let (mut s, mut n, mut o, mut m) = (
             &mut self.sums[..],
             &mut self.nearest[..],
@@ -156,7 +160,13 @@ impl AovSums {
 
     /// Adds pixel `j` of `o` to pixel `i` of `self`; None on an overflow
     /// (sums no render makes).
-    pub fn add_pixel(&mut self, layout: &Layout, i: usize, o: &AovSums, j: usize) -> Option<()> {
+    pub(crate) fn add_pixel(
+        &mut self,
+        layout: &Layout,
+        i: usize,
+        o: &AovSums,
+        j: usize,
+    ) -> Option<()> {
         let st = layout.stride();
         for (a, b) in self.sums[i * st..(i + 1) * st]
             .iter_mut()

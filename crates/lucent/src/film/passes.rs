@@ -130,7 +130,7 @@ impl Pass {
     }
 
     /// The pass named `name`, if one is.
-    pub fn from_name(name: &str) -> Option<Pass> {
+    pub(crate) fn from_name(name: &str) -> Option<Pass> {
         ALL.into_iter().find(|p| p.name() == name)
     }
 
@@ -165,7 +165,7 @@ impl PassSet {
     }
 
     /// The union of both sets.
-    pub fn union(self, o: PassSet) -> PassSet {
+    pub(crate) fn union(self, o: PassSet) -> PassSet {
         PassSet(self.0 | o.0)
     }
 
@@ -193,7 +193,7 @@ impl PassSet {
 
     /// The union of the passes `names` select; the first name that selects
     /// none is the error, with its index.
-    pub fn from_names<'a>(
+    pub(crate) fn from_names<'a>(
         names: impl IntoIterator<Item = &'a str>,
     ) -> Result<PassSet, UnknownPass> {
         let mut set = PassSet::EMPTY;

@@ -51,7 +51,11 @@ impl Sums {
     }
 
     /// [`new`](Self::new), with zero sums for the passes of `layout` too.
-    pub fn with_passes(region: Region, start: u32, layout: Option<&Layout>) -> Result<Sums, Error> {
+    pub(crate) fn with_passes(
+        region: Region,
+        start: u32,
+        layout: Option<&Layout>,
+    ) -> Result<Sums, Error> {
         let n = region.area() as usize * Self::CHANNELS;
         let mut sums = Vec::new();
         sums.try_reserve_exact(n).map_err(|_| {
@@ -107,13 +111,13 @@ impl Sums {
     }
 
     /// The beauty's and the passes' sums, to set.
-    pub fn sums_mut(&mut self) -> (&mut [i128], Option<&mut Passes>) {
+    pub(crate) fn sums_mut(&mut self) -> (&mut [i128], Option<&mut Passes>) {
         (&mut self.sums, self.passes.as_mut())
     }
 
     /// Exchanges the beauty's and the passes' sums with `o`'s (region,
     /// samples and counters stay).
-    pub fn swap_sums(&mut self, o: &mut Sums) {
+    pub(crate) fn swap_sums(&mut self, o: &mut Sums) {
         std::mem::swap(&mut self.sums, &mut o.sums);
         std::mem::swap(&mut self.passes, &mut o.passes);
     }
@@ -125,17 +129,17 @@ impl Sums {
     }
 
     /// The beauty sums of the pixel of index `i` ([`index`](Self::index)).
-    pub fn pixel_at(&self, i: usize) -> &[i128] {
+    pub(crate) fn pixel_at(&self, i: usize) -> &[i128] {
         &self.sums[i * Self::CHANNELS..(i + 1) * Self::CHANNELS]
     }
 
     /// [`pixel_at`](Self::pixel_at), to set.
-    pub fn pixel_at_mut(&mut self, i: usize) -> &mut [i128] {
+    pub(crate) fn pixel_at_mut(&mut self, i: usize) -> &mut [i128] {
         &mut self.sums[i * Self::CHANNELS..(i + 1) * Self::CHANNELS]
     }
 
     /// Pixel (x, y)'s sums, to set (merging, reading a part back).
-    pub fn pixel_mut(&mut self, x: u32, y: u32) -> &mut [i128] {
+    pub(crate) fn pixel_mut(&mut self, x: u32, y: u32) -> &mut [i128] {
         let o = self.index(x, y) * Self::CHANNELS;
         &mut self.sums[o..o + Self::CHANNELS]
     }

@@ -26,7 +26,7 @@ impl ToneMap {
 }
 
 /// The sRGB opto-electronic transfer function on [0, 1]; NaN maps to 0.
-pub fn srgb_encode(v: f32) -> f32 {
+pub(crate) fn srgb_encode(v: f32) -> f32 {
     if v.is_nan() {
         return 0.0;
     }

@@ -13,15 +13,15 @@
 
 /// The fixed-point format of Σq² words (each an integer: q² is in units
 /// of 2^−128; the words are the fraction bits' 64-bit pieces).
-pub const SQUARE_BITS: u32 = 128;
+pub(crate) const SQUARE_BITS: u32 = 128;
 
 /// i128 sums a channel of the variance pass keeps: Σq²'s 64-bit words.
-pub const SQUARE_WORDS: usize = 3;
+pub(crate) const SQUARE_WORDS: usize = 3;
 
 /// q² of a term q (|q| ≤ 2^95) as its three 64-bit words, least
 /// significant first (q² < 2^190).
 #[inline]
-pub fn square_words(q: i128) -> [i128; SQUARE_WORDS] {
+pub(crate) fn square_words(q: i128) -> [i128; SQUARE_WORDS] {
     let w = mul_u128(q.unsigned_abs(), q.unsigned_abs());
     [
         w[0] as i128,

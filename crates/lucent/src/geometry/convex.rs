@@ -15,11 +15,11 @@ const LEAF: usize = 8;
 /// Meshes with more triangles than this are not tested (reported convex
 /// on neither side): this bounds the test's time
 /// (`docs/performance.md`, "Convex-outside sides").
-pub const MAX_TRIANGLES: usize = 100_000;
+pub(crate) const MAX_TRIANGLES: usize = 100_000;
 
 /// Which sides of a mesh are convex-outside (module docs), with tolerance
 /// `tol` (scene units, ≥ 0): `[front, back]`. An empty mesh has neither.
-pub fn outside_sides(mesh: &Mesh, tol: f64) -> [bool; 2] {
+pub(crate) fn outside_sides(mesh: &Mesh, tol: f64) -> [bool; 2] {
     let verts: Vec<DVec3> = mesh.positions().iter().map(|p| p.as_dvec3()).collect();
     if verts.is_empty() || mesh.triangle_count() == 0 || mesh.triangle_count() > MAX_TRIANGLES {
         return [false, false];

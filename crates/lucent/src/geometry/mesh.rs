@@ -97,7 +97,7 @@ impl Mesh {
     /// of the triangles around each vertex (the cross product's length is
     /// twice the area, so summing unnormalized cross products weights by
     /// area). Vertices of only degenerate triangles get +z.
-    pub fn compute_smooth_normals(&mut self) {
+    pub(crate) fn compute_smooth_normals(&mut self) {
         let mut n = vec![Vec3::ZERO; self.vertex_count()];
         for &[a, b, c] in &self.indices {
             let p = &self.positions;

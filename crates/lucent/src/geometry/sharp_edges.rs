@@ -12,10 +12,10 @@ use crate::geometry::{Mesh, Vec3};
 /// it sharp. A flat-shaded sphere of 20,480 triangles turns ~2.5° per
 /// edge (not sharp: its 1/R floor and its size speak for it); a box turns
 /// 90°, a regular icosahedron 41.8°.
-pub const SHARP_ANGLE_DEG: f32 = 30.0;
+pub(crate) const SHARP_ANGLE_DEG: f32 = 30.0;
 
 /// Most segments in a leaf of the tree.
-pub const LEAF: usize = 4;
+pub(crate) const LEAF: usize = 4;
 
 /// One mesh's sharp edges, in a tree for nearest-distance queries.
 #[derive(Clone, Debug)]
@@ -138,7 +138,7 @@ impl SharpEdges {
     }
 
     /// The tree over `segments`; None when there are none.
-    pub fn from_segments(mut segments: Vec<[Vec3; 2]>) -> Option<Self> {
+    pub(crate) fn from_segments(mut segments: Vec<[Vec3; 2]>) -> Option<Self> {
         if segments.is_empty() {
             return None;
         }

@@ -103,7 +103,7 @@ impl<'a> Context<'a> {
     /// ([`TriangleCurvature`]), from the cache where the mesh has one.
     #[cfg(feature = "subsurface")]
     #[inline]
-    pub fn curvatures(&self, geom: u32, prim: u32) -> TriangleCurvature {
+    pub(crate) fn curvatures(&self, geom: u32, prim: u32) -> TriangleCurvature {
         match &self.curvature[geom as usize] {
             Some(c) => c.mesh.triangle(prim),
             None => TriangleCurvature::of(&self.scene.meshes[geom as usize], prim),
@@ -115,7 +115,7 @@ impl<'a> Context<'a> {
     /// cache where the mesh has one ([`SubsurfaceCurvature::factor`]).
     #[cfg(feature = "subsurface")]
     #[inline]
-    pub fn curvature_factor(
+    pub(crate) fn curvature_factor(
         &self,
         geom: u32,
         prim: u32,
@@ -198,7 +198,11 @@ impl<'a> Context<'a> {
     /// [`Context::leaving`] for a ray spawned at `si` in direction `dir`
     /// ([`Interaction::spawn`]: offset to the side `dir` points to).
     #[inline(always)]
-    pub fn leaving_towards(&self, si: &Interaction, dir: crate::geometry::Vec3) -> Option<u32> {
+    pub(crate) fn leaving_towards(
+        &self,
+        si: &Interaction,
+        dir: crate::geometry::Vec3,
+    ) -> Option<u32> {
         self.leaving(si.geom, dir.dot(si.ng) >= 0.0)
     }
 

@@ -75,7 +75,7 @@ use crate::geometry::Vec3;
 /// (module docs). 1: the camera vertex only (the default of
 /// [`super::Context::cv_depth`]); deeper vertices carry little of the
 /// image and their light is already averaged over many paths.
-pub const CV_DEPTH: u32 = 1;
+pub(crate) const CV_DEPTH: u32 = 1;
 
 /// Whether the control variate applies at a subsurface hit at `depth`:
 /// below the context's depth, and only where there is an area light to
@@ -110,7 +110,13 @@ pub fn model_point(xo: Vec3, n: Vec3, kappa: f32, d: Vec3) -> (Vec3, Vec3) {
 /// and −d, per channel; `a_plane` is A_plane. Zero for probes along T or
 /// B, which have no [`PlaneModel`].
 #[inline]
-pub fn one_probe(plane: &PlaneModel, a_plane: Vec3, g0: Vec3, g_d: Vec3, g_minus_d: Vec3) -> Vec3 {
+pub(crate) fn one_probe(
+    plane: &PlaneModel,
+    a_plane: Vec3,
+    g0: Vec3,
+    g_d: Vec3,
+    g_minus_d: Vec3,
+) -> Vec3 {
     let g_hat = g0 + 0.5 * (g_d - g_minus_d);
     plane.weight * g_hat - (a_plane / plane.p_normal) * g0
 }

@@ -130,7 +130,7 @@ impl DiffuseBoundary {
 
     /// Fr_in(μ'): the probability that a walk arriving at the boundary from
     /// inside with cosine `mu_in` (> 0) to the outward normal reflects back.
-    pub fn reflect_in(&self, mu_in: f32) -> f32 {
+    pub(crate) fn reflect_in(&self, mu_in: f32) -> f32 {
         fresnel::dielectric(-mu_in, self.eta)
     }
 
@@ -170,7 +170,7 @@ pub struct ExitLobe {
 }
 
 impl ExitLobe {
-    pub fn eval(&self, wi: Vec3) -> f32 {
+    pub(crate) fn eval(&self, wi: Vec3) -> f32 {
         if wi.z <= 0.0 {
             return 0.0;
         }

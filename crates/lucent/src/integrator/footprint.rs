@@ -35,7 +35,7 @@ impl Cone {
 
     /// The footprint width at distance `t` along the ray (unit direction).
     #[inline]
-    pub fn width_at(&self, t: f32) -> f32 {
+    pub(crate) fn width_at(&self, t: f32) -> f32 {
         self.width + self.spread * t
     }
 

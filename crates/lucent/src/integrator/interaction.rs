@@ -116,7 +116,7 @@ impl Interaction {
     }
 
     /// The shading frame oriented towards the side the ray came from.
-    pub fn shading_frame_facing(&self, wo: Vec3) -> Frame {
+    pub(crate) fn shading_frame_facing(&self, wo: Vec3) -> Frame {
         let n = if wo.dot(self.ng) >= 0.0 {
             self.ns
         } else {

@@ -59,7 +59,7 @@ pub fn sample_entry(
 /// [`ProbeSampler::sample_probe`], or one of
 /// [`ProbeSampler::sample_probe_pair`]'s two) with randoms `u`: every hit
 /// of `seg` on the object, one picked, weighed.
-pub fn entry_on_segment(
+pub(crate) fn entry_on_segment(
     sampler: &ProbeSampler,
     seg: &ProbeSegment,
     u: &ProbeRandoms,

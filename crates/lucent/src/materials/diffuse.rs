@@ -6,7 +6,7 @@ use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf};
 use std::f32::consts::FRAC_1_PI;
 
 /// f(wo, wi): ρ/π when both lie on the same side, else 0.
-pub fn eval(albedo: Vec3, wo: Vec3, wi: Vec3) -> Vec3 {
+pub(crate) fn eval(albedo: Vec3, wo: Vec3, wi: Vec3) -> Vec3 {
     if wo.z * wi.z > 0.0 {
         albedo * FRAC_1_PI
     } else {

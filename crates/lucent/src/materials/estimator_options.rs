@@ -195,7 +195,7 @@ impl EstimatorOption {
     }
 
     /// Whether `s` names one of the research values (case-insensitive).
-    pub fn is_research(&self, s: &str) -> bool {
+    pub(crate) fn is_research(&self, s: &str) -> bool {
         let base = s.split(':').next().unwrap_or(s);
         self.research.iter().any(|r| r.eq_ignore_ascii_case(base))
     }
@@ -492,7 +492,7 @@ impl Assignments {
 
     /// The options given, `name=value` in table order with the values as
     /// the scene format writes them (a part's identity).
-    pub fn canonical(&self) -> String {
+    pub(crate) fn canonical(&self) -> String {
         let o = self.over(EstimatorOptions::default());
         let given: Vec<String> = OPTIONS
             .iter()

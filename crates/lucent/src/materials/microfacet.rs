@@ -22,7 +22,7 @@ pub const SMOOTH_ALPHA: f32 = 1e-3;
 
 /// Intervals of the E(μ) table. Nodes are μ = (k / ALBEDO_NODES)²,
 /// dense at grazing angles, where Fresnel reflectance changes fastest.
-pub const ALBEDO_NODES: usize = 64;
+pub(crate) const ALBEDO_NODES: usize = 64;
 
 /// Midpoint-rule points per side of the sampling square for each node.
 const QUADRATURE_SIDE: usize = 64;
@@ -34,7 +34,7 @@ fn node(k: usize) -> f32 {
 }
 
 /// α from the scene's roughness ∈ [0, 1]: α = roughness².
-pub fn alpha_from_roughness(roughness: f32) -> f32 {
+pub(crate) fn alpha_from_roughness(roughness: f32) -> f32 {
     roughness * roughness
 }
 
@@ -58,7 +58,7 @@ impl Ggx {
     }
 
     /// Smith's Λ(ω); infinite at the horizon.
-    pub fn lambda(&self, w: Vec3) -> f32 {
+    pub(crate) fn lambda(&self, w: Vec3) -> f32 {
         let c2 = w.z * w.z;
         if c2 <= 0.0 {
             return f32::INFINITY;
@@ -68,18 +68,18 @@ impl Ggx {
     }
 
     /// G1(ω) = 1 / (1 + Λ(ω)).
-    pub fn g1(&self, w: Vec3) -> f32 {
+    pub(crate) fn g1(&self, w: Vec3) -> f32 {
         1.0 / (1.0 + self.lambda(w))
     }
 
     /// G2(ωo, ωi) = 1 / (1 + Λ(ωo) + Λ(ωi)), height-correlated.
-    pub fn g2(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub(crate) fn g2(&self, wo: Vec3, wi: Vec3) -> f32 {
         1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
     }
 
     /// A microfacet normal m visible from `wo` (wo.z > 0), drawn from
     /// D_ωo(m) (Heitz 2018, listing 1, with the concentric disk map).
-    pub fn sample_visible(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
+    pub(crate) fn sample_visible(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
         let a = self.alpha;
         // The view direction in the hemisphere configuration (α = 1).
         let wh = Vec3::new(a * wo.x, a * wo.y, wo.z).normalize();
@@ -157,7 +157,7 @@ impl RoughCoat {
     }
 
     /// E(μo) by an n × n midpoint rule over the sampling square.
-    pub fn albedo_quadrature(&self, mu: f32, n: usize) -> f64 {
+    pub(crate) fn albedo_quadrature(&self, mu: f32, n: usize) -> f64 {
         let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
         let mut sum = 0.0f64;
         for i in 0..n {
@@ -182,12 +182,12 @@ impl RoughCoat {
     }
 
     /// 2 ∫₀¹ E(μ) μ dμ: the fraction of uniform incident light reflected.
-    pub fn mean_albedo(&self) -> f32 {
+    pub(crate) fn mean_albedo(&self) -> f32 {
         self.mean
     }
 
     /// f(ωo, ωi) per steradian; 0 unless both are above the surface.
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub(crate) fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
         let Some(h) = half_vector(wo, wi) else {
             return 0.0;
         };

@@ -39,14 +39,14 @@ pub enum Material {
 impl Material {
     /// Whether this is a subsurface material.
     #[cfg(feature = "subsurface")]
-    pub fn is_subsurface(&self) -> bool {
+    pub(crate) fn is_subsurface(&self) -> bool {
         matches!(self, Material::Subsurface(_))
     }
 
     /// Whether this is a subsurface material: never, in a build without
     /// the `subsurface` feature.
     #[cfg(not(feature = "subsurface"))]
-    pub fn is_subsurface(&self) -> bool {
+    pub(crate) fn is_subsurface(&self) -> bool {
         false
     }
 }

@@ -60,7 +60,7 @@ impl PartialEq for Subsurface {
 impl Subsurface {
     /// The material of medium `params` sampled with `options`, everything
     /// derived from them built (an option out of its domain is refused).
-    pub fn from_options(
+    pub(crate) fn from_options(
         params: SubsurfaceParams,
         options: &EstimatorOptions,
     ) -> Result<Self, ParamError> {
@@ -290,7 +290,7 @@ pub struct SubsurfaceOverrides {
 impl Subsurface {
     /// Every sampling option, `key=value` separated by spaces, with the
     /// names of the option table (for the EXR header).
-    pub fn sampling_description(&self) -> String {
+    pub(crate) fn sampling_description(&self) -> String {
         let all: Vec<String> = OPTIONS
             .iter()
             .filter(|o| o.name != "curvature_correction")

@@ -15,12 +15,12 @@ pub fn cosine_hemisphere(u: [f32; 2]) -> Vec3 {
     Vec3::new(x, y, z)
 }
 
-pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+pub(crate) fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
     cos_theta.max(0.0) / PI
 }
 
 /// Uniform point on the unit disk, area-preserving (Shirley & Chiu 1997).
-pub fn concentric_disk(u: [f32; 2]) -> [f32; 2] {
+pub(crate) fn concentric_disk(u: [f32; 2]) -> [f32; 2] {
     let a = 2.0 * u[0] - 1.0;
     let b = 2.0 * u[1] - 1.0;
     if a == 0.0 && b == 0.0 {
@@ -44,7 +44,7 @@ pub fn concentric_disk(u: [f32; 2]) -> [f32; 2] {
 /// reduction for any float) is a visible share of the time outside ray
 /// queries.
 #[inline]
-pub fn sin_cos_quarter(x: f32) -> (f32, f32) {
+pub(crate) fn sin_cos_quarter(x: f32) -> (f32, f32) {
     let z = x * x;
     let s = x + x * z * ((-1.951_529_6e-4 * z + 8.332_161e-3) * z - 1.666_665_5e-1);
     let c = 1.0 - 0.5 * z + z * z * ((2.443_315_7e-5 * z - 1.388_731_6e-3) * z + 4.166_664_6e-2);
@@ -57,7 +57,7 @@ pub fn sin_cos_quarter(x: f32) -> (f32, f32) {
 /// before the polynomials is that of the remainder times π/2 — less than
 /// that of forming 2πu in f32.
 #[inline]
-pub fn sin_cos_turns(u: f32) -> (f32, f32) {
+pub(crate) fn sin_cos_turns(u: f32) -> (f32, f32) {
     let q = 4.0 * u;
     // u ≥ 0, so truncating q + ½ rounds to the nearest quarter turn.
     let k = (q + 0.5) as i32;
@@ -136,7 +136,7 @@ impl Distribution1D {
     }
     /// The index alone, for callers that stored its probability.
     #[inline]
-    pub fn sample_index(&self, u: f32) -> usize {
+    pub(crate) fn sample_index(&self, u: f32) -> usize {
         let target = u as f64 * self.total;
         // The first entry above target (the cdf never decreases); a scan
         // beats the binary search on the few entries of a typical light set
@@ -151,7 +151,7 @@ impl Distribution1D {
         };
         i.min(self.cdf.len() - 1)
     }
-    pub fn pmf(&self, i: usize) -> f32 {
+    pub(crate) fn pmf(&self, i: usize) -> f32 {
         let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
         ((self.cdf[i] - lo) / self.total) as f32
     }

@@ -60,7 +60,7 @@ impl Rng {
     }
 
     #[inline]
-    pub fn next_u64(&mut self) -> u64 {
+    pub(crate) fn next_u64(&mut self) -> u64 {
         self.counter += 1;
         mix64(mix64(self.key ^ self.counter.wrapping_mul(0x9e37_79b9_7f4a_7c15)) ^ self.key)
     }

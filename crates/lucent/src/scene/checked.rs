@@ -37,7 +37,7 @@ impl Cx<'_> {
     /// span's position in the text (see [`super::key_path`]).
     /// Some syntax errors come with an empty message (a key without a
     /// value); those are described here from the text at the span.
-    pub fn toml_error(&self, e: &toml::de::Error) -> InputError {
+    pub(crate) fn toml_error(&self, e: &toml::de::Error) -> InputError {
         // Syntax errors carry a multi-line message; keep it on one line.
         let mut msg = e.message().trim_end().replace('\n', "; ");
         let mut key = None;
@@ -68,7 +68,7 @@ impl Cx<'_> {
     /// comments included (all of U+0000–U+001F but tab and line ends, and
     /// U+007F): the `toml` crate reports one with no message, or as an
     /// "expected newline" that does not say what is wrong.
-    pub fn no_control_characters(&self) -> Res<()> {
+    pub(crate) fn no_control_characters(&self) -> Res<()> {
         let b = self.text.as_bytes();
         let bad = b.iter().enumerate().find(|&(i, &c)| {
             (c < 0x20 && c != b'\t' && c != b'\n' && !(c == b'\r' && b.get(i + 1) == Some(&b'\n')))
@@ -112,7 +112,7 @@ impl Cx<'_> {
     }
 
     /// A finite `Vec3` (finite also after narrowing to f32).
-    pub fn vec3(&self, v: &Spanned<Triple3>, field: &str) -> Res<Vec3> {
+    pub(crate) fn vec3(&self, v: &Spanned<Triple3>, field: &str) -> Res<Vec3> {
         let a = v.get_ref();
         let out = Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
         if !out.is_finite() {
@@ -149,7 +149,7 @@ impl Cx<'_> {
     }
 
     /// RGB with every component ≥ 0 (and ≤ 1 if `unit`).
-    pub fn rgb(&self, v: &Spanned<Triple3>, field: &str, unit: bool) -> Res<Vec3> {
+    pub(crate) fn rgb(&self, v: &Spanned<Triple3>, field: &str, unit: bool) -> Res<Vec3> {
         let c = self.vec3(v, field)?;
         let ok = c.min_element() >= 0.0 && (!unit || c.max_element() <= 1.0);
         if !ok {
@@ -168,7 +168,7 @@ impl Cx<'_> {
 
     /// Rejects keys (of the table `field`, present with their spans) that
     /// belong to other types than `kind`.
-    pub fn only_keys(
+    pub(crate) fn only_keys(
         &self,
         field: &str,
         kind: &str,

@@ -26,7 +26,7 @@ use serde::Deserialize;
 pub use toml::Spanned;
 
 /// Three numbers: a point, a direction or an RGB triple.
-pub type Triple = [f64; 3];
+pub(crate) type Triple = [f64; 3];
 
 /// Exactly `N` numbers, as a TOML array: unlike serde's `[T; N]`, which
 /// stops reading after `N` elements and ignores the rest, a wrong length is
@@ -35,7 +35,7 @@ pub type Triple = [f64; 3];
 pub struct Numbers<T, const N: usize>(pub [T; N]);
 
 /// A [`Triple`] as written in the file: exactly three numbers.
-pub type Triple3 = Numbers<f64, 3>;
+pub(crate) type Triple3 = Numbers<f64, 3>;
 
 impl<T, const N: usize> std::ops::Deref for Numbers<T, N> {
     type Target = [T; N];
@@ -193,7 +193,7 @@ pub struct MaterialDef {
 
 impl MaterialDef {
     /// The optional keys that are present, with their spans.
-    pub fn present_keys(&self) -> Vec<(&'static str, Range<usize>)> {
+    pub(crate) fn present_keys(&self) -> Vec<(&'static str, Range<usize>)> {
         let mut v = Vec::new();
         let mut add = |k: &'static str, span: Option<Range<usize>>| {
             if let Some(span) = span {
@@ -295,7 +295,7 @@ pub struct ShapeDef {
 
 impl ShapeDef {
     /// The type-specific keys that are present, with their spans.
-    pub fn present_type_keys(&self) -> Vec<(&'static str, Range<usize>)> {
+    pub(crate) fn present_type_keys(&self) -> Vec<(&'static str, Range<usize>)> {
         let mut v = Vec::new();
         if let Some(x) = &self.file {
             v.push(("file", x.span()));

@@ -29,7 +29,7 @@ pub fn line_of(text: &str, offset: usize) -> usize {
 /// follows table headers, keys, strings, comments and bracket nesting.
 /// Array-of-tables entries are numbered from 0. Values nested in inline
 /// tables are attributed to the enclosing key.
-pub fn key_path_at(text: &str, offset: usize) -> Option<String> {
+pub(crate) fn key_path_at(text: &str, offset: usize) -> Option<String> {
     let b = text.as_bytes();
     let mut header = String::new();
     let mut aot: HashMap<String, usize> = HashMap::new();
@@ -162,7 +162,7 @@ fn skip_value(b: &[u8], mut i: usize) -> usize {
 /// is (`red`, `skin-1`), else quoted with escapes (`"my red"`, `"a\nb"`),
 /// so that a field path never carries a raw newline, quote or control
 /// character into a message.
-pub fn key_segment(key: &str) -> String {
+pub(crate) fn key_segment(key: &str) -> String {
     let bare = !key.is_empty()
         && key
             .bytes()

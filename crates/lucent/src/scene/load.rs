@@ -29,23 +29,23 @@ use crate::geometry::Vec3;
 pub use super::obj::load_obj;
 
 /// Largest accepted image side, in pixels.
-pub const MAX_RESOLUTION: u32 = 16384;
+pub(crate) const MAX_RESOLUTION: u32 = 16384;
 
 /// Largest accepted image, in pixels (8192², or 16384 × 4096): a render
 /// holds about 111 bytes a pixel at its peak (two buffers of exact RGB
 /// sums, 48 bytes each, `crate::render`; the film, 12; the 3-byte
 /// preview), 7.4 GB at this bound; an allocation that fails is a runtime
 /// error, not an abort.
-pub const MAX_PIXELS: u64 = 1 << 26;
+pub(crate) const MAX_PIXELS: u64 = 1 << 26;
 
 /// Largest accepted scene file, in bytes: scenes are a few kB; anything
 /// near this is not a scene.
-pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+pub(crate) const MAX_SCENE_BYTES: u64 = 16 << 20;
 
 /// Largest accepted triangle count of a whole scene (2²⁵ ≈ 33.5 M):
 /// about 30 bytes a triangle in the meshes and 50–100 more in a backend's
 /// acceleration structure, a few GB at this bound.
-pub const MAX_TRIANGLES: u64 = 1 << 25;
+pub(crate) const MAX_TRIANGLES: u64 = 1 << 25;
 
 /// Reads and loads the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, InputError> {

@@ -17,13 +17,13 @@ use crate::error::InputError;
 use crate::geometry::{Mesh, Vec3};
 
 /// Highest accepted `subdivisions` for spheres: 20·4⁹ ≈ 5.2 M triangles.
-pub const MAX_SPHERE_SUBDIVISIONS: u32 = 9;
+pub(crate) const MAX_SPHERE_SUBDIVISIONS: u32 = 9;
 
 /// The largest OBJ file read (bytes): parsing holds the text, the OBJ
 /// library's index and position arrays and the mesh, at worst about eight
 /// times the file's size (a polygon `f 1 1 1 …` is one triangle per two
 /// bytes), so this bounds a mesh's memory to a few GB.
-pub const MAX_OBJ_BYTES: u64 = 512 << 20;
+pub(crate) const MAX_OBJ_BYTES: u64 = 512 << 20;
 
 /// The triangles a generated shape (sphere, quad, box) will have, known
 /// before its mesh is built; 0 for an OBJ (counted once read) and for an

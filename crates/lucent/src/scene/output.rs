@@ -42,7 +42,7 @@ pub struct Output {
 
 impl Output {
     /// The light groups' names, at least one.
-    pub fn group_names(&self) -> Vec<String> {
+    pub(crate) fn group_names(&self) -> Vec<String> {
         if self.light_groups.is_empty() {
             vec![DEFAULT_GROUP.to_string()]
         } else {
@@ -51,7 +51,7 @@ impl Output {
     }
 
     /// The name of material `i`: the scene's, else `materials[i]`.
-    pub fn material_name(&self, i: usize) -> String {
+    pub(crate) fn material_name(&self, i: usize) -> String {
         self.material_names
             .get(i)
             .cloned()

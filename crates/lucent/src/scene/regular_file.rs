@@ -23,7 +23,7 @@ pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<String>
 /// [`read_regular_file`]) of at most `max_bytes`: a larger one is refused
 /// before it is read, so its size (and what parsing it would allocate) is
 /// bounded.
-pub fn read_regular_bytes(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
+pub(crate) fn read_regular_bytes(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
     let meta = std::fs::metadata(path)?;
     if !meta.is_file() {
         return Err(std::io::Error::new(
@@ -59,7 +59,7 @@ pub fn read_regular_bytes(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8
 /// Where text stops being UTF-8: the 1-based line and column (in
 /// characters) of the first invalid byte, and that byte.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct NotUtf8 {
+pub(crate) struct NotUtf8 {
     pub line: usize,
     pub column: usize,
     pub byte: u8,
@@ -76,7 +76,7 @@ impl fmt::Display for NotUtf8 {
 }
 
 /// `bytes` as a `String`, or where they stop being UTF-8.
-pub fn utf8_text(bytes: Vec<u8>) -> Result<String, NotUtf8> {
+pub(crate) fn utf8_text(bytes: Vec<u8>) -> Result<String, NotUtf8> {
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let bytes = e.as_bytes();

@@ -23,7 +23,7 @@ impl Transform {
     /// (angle in degrees, axis) pairs, counter-clockwise about the axis
     /// (right-hand rule), applied first to last. Axes need not be unit
     /// length but must be non-zero; the caller validates that.
-    pub fn from_srt(scale: Vec3, rotations: &[(f32, Vec3)], translate: Vec3) -> Self {
+    pub(crate) fn from_srt(scale: Vec3, rotations: &[(f32, Vec3)], translate: Vec3) -> Self {
         let mut linear = Mat3::from_diagonal(scale);
         for &(deg, axis) in rotations {
             linear = Mat3::from_axis_angle(axis.normalize(), deg.to_radians()) * linear;
@@ -38,11 +38,11 @@ impl Transform {
     /// The matrix that maps normals: the inverse transpose of the linear
     /// part, so transformed normals stay perpendicular to transformed
     /// surfaces under non-uniform scale.
-    pub fn normal_matrix(&self) -> Mat3 {
+    pub(crate) fn normal_matrix(&self) -> Mat3 {
         self.linear.inverse().transpose()
     }
 
-    pub fn determinant(&self) -> f32 {
+    pub(crate) fn determinant(&self) -> f32 {
         self.linear.determinant()
     }
 

@@ -10,13 +10,13 @@ use crate::film::Sums;
 
 /// Where a render keeps its finished samples for `--resume` (at a signal,
 /// at checkpoints): `OUT.partial.exr` beside `OUT.exr`.
-pub fn checkpoint_path(output: &Path) -> PathBuf {
+pub(crate) fn checkpoint_path(output: &Path) -> PathBuf {
     output.with_extension("partial.exr")
 }
 
 /// Saves the sums at the end of a pass once `every` seconds passed since
 /// the last save, unless the render is about to finish (at `end`).
-pub struct Checkpoints<'a> {
+pub(crate) struct Checkpoints<'a> {
     pub path: &'a Path,
     pub every: Option<f64>,
     pub end: u32,
@@ -25,7 +25,7 @@ pub struct Checkpoints<'a> {
 
 impl Checkpoints<'_> {
     /// Called after every pass with its sums and their part header.
-    pub fn after_pass(&mut self, sums: &Sums, header: &Header) -> Result<(), Error> {
+    pub(crate) fn after_pass(&mut self, sums: &Sums, header: &Header) -> Result<(), Error> {
         match self.every {
             Some(every) if self.last.elapsed().as_secs_f64() >= every && sums.done < self.end => {
                 crate::film::commit_all(vec![part::stage(self.path, header, sums)?])?;

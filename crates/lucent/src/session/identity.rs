@@ -74,7 +74,7 @@ pub fn render_plan(
 /// scene file (`scene_text`) and its SHA-256, samples, seed, depth,
 /// backend and version, integrator, every subsurface material's sampling
 /// options (named by the objects that use it) and the render time.
-pub fn frame_header(
+pub(crate) fn frame_header(
     scene_path: &Path,
     scene_text: &str,
     scene: &Scene,

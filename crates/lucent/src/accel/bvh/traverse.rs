@@ -54,7 +54,7 @@ impl RayBox {
     }
 
     /// Whether the ray meets the box `b` (`[lo, hi]`) within [tmin, tmax].
-    pub fn hit1(&self, b: &[[f32; 3]; 2], tmin: f32, tmax: f32) -> bool {
+    pub(crate) fn hit1(&self, b: &[[f32; 3]; 2], tmin: f32, tmax: f32) -> bool {
         let mut lo = tmin;
         let mut hi = tmax;
         for a in 0..3 {
@@ -71,14 +71,14 @@ impl RayBox {
     /// portable one elsewhere or with the `bvh-portable` feature.
     #[cfg(all(target_arch = "x86_64", not(feature = "bvh-portable")))]
     #[inline(always)]
-    pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
+    pub(crate) fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
         self.hit_w_sse(n, tmin, tmax)
     }
 
     /// The same, on the portable box test (see above).
     #[cfg(any(not(target_arch = "x86_64"), feature = "bvh-portable"))]
     #[inline(always)]
-    pub fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
+    pub(crate) fn hit_w(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
         self.hit_w_portable(n, tmin, tmax)
     }
 
@@ -88,7 +88,7 @@ impl RayBox {
     /// `bvh-portable` feature (which makes the whole BVH use it).
     #[cfg(any(test, not(target_arch = "x86_64"), feature = "bvh-portable"))]
     #[inline(always)]
-    pub fn hit_w_portable(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
+    pub(crate) fn hit_w_portable(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
         let mut lo = [tmin; WIDTH];
         let mut hi = [tmax; WIDTH];
         for a in 0..3 {
@@ -116,7 +116,7 @@ impl RayBox {
     /// give bit-identical results.
     #[cfg(all(target_arch = "x86_64", any(test, not(feature = "bvh-portable"))))]
     #[inline(always)]
-    pub fn hit_w_sse(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
+    pub(crate) fn hit_w_sse(&self, n: &NodeW, tmin: f32, tmax: f32) -> ([f32; WIDTH], u32) {
         use std::arch::x86_64::*;
         const _: () = assert!(WIDTH.is_multiple_of(4));
         let mut out = [0f32; WIDTH];

@@ -18,68 +18,68 @@ use std::mem::{align_of, offset_of, size_of};
 pub const RTC_INVALID_GEOMETRY_ID: c_uint = u32::MAX;
 
 /// `RTC_MAX_INSTANCE_LEVEL_COUNT` of the installed library.
-pub const RTC_MAX_INSTANCE_LEVEL_COUNT: usize = 1;
+pub(crate) const RTC_MAX_INSTANCE_LEVEL_COUNT: usize = 1;
 
 #[repr(C)]
 pub struct RTCDeviceTy {
     _private: [u8; 0],
 }
 #[repr(C)]
-pub struct RTCSceneTy {
+pub(crate) struct RTCSceneTy {
     _private: [u8; 0],
 }
 #[repr(C)]
-pub struct RTCGeometryTy {
+pub(crate) struct RTCGeometryTy {
     _private: [u8; 0],
 }
-pub type RTCDevice = *mut RTCDeviceTy;
-pub type RTCScene = *mut RTCSceneTy;
-pub type RTCGeometry = *mut RTCGeometryTy;
+pub(crate) type RTCDevice = *mut RTCDeviceTy;
+pub(crate) type RTCScene = *mut RTCSceneTy;
+pub(crate) type RTCGeometry = *mut RTCGeometryTy;
 
 // C enums are `int`-sized on the x86-64 and AArch64 SysV ABIs; we pass them
 // as plain integers so an out-of-range value from C can never be an invalid
 // Rust enum.
-pub type RTCError = c_int;
-pub const RTC_ERROR_NONE: RTCError = 0;
-pub const RTC_ERROR_UNKNOWN: RTCError = 1;
-pub const RTC_ERROR_INVALID_ARGUMENT: RTCError = 2;
-pub const RTC_ERROR_INVALID_OPERATION: RTCError = 3;
-pub const RTC_ERROR_OUT_OF_MEMORY: RTCError = 4;
-pub const RTC_ERROR_UNSUPPORTED_CPU: RTCError = 5;
-pub const RTC_ERROR_CANCELLED: RTCError = 6;
+pub(crate) type RTCError = c_int;
+pub(crate) const RTC_ERROR_NONE: RTCError = 0;
+pub(crate) const RTC_ERROR_UNKNOWN: RTCError = 1;
+pub(crate) const RTC_ERROR_INVALID_ARGUMENT: RTCError = 2;
+pub(crate) const RTC_ERROR_INVALID_OPERATION: RTCError = 3;
+pub(crate) const RTC_ERROR_OUT_OF_MEMORY: RTCError = 4;
+pub(crate) const RTC_ERROR_UNSUPPORTED_CPU: RTCError = 5;
+pub(crate) const RTC_ERROR_CANCELLED: RTCError = 6;
 
-pub type RTCDeviceProperty = c_int;
-pub const RTC_DEVICE_PROPERTY_VERSION_MAJOR: RTCDeviceProperty = 1;
-pub const RTC_DEVICE_PROPERTY_VERSION_MINOR: RTCDeviceProperty = 2;
-pub const RTC_DEVICE_PROPERTY_VERSION_PATCH: RTCDeviceProperty = 3;
-pub const RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED: RTCDeviceProperty = 66;
-pub const RTC_DEVICE_PROPERTY_TRIANGLE_GEOMETRY_SUPPORTED: RTCDeviceProperty = 96;
+pub(crate) type RTCDeviceProperty = c_int;
+pub(crate) const RTC_DEVICE_PROPERTY_VERSION_MAJOR: RTCDeviceProperty = 1;
+pub(crate) const RTC_DEVICE_PROPERTY_VERSION_MINOR: RTCDeviceProperty = 2;
+pub(crate) const RTC_DEVICE_PROPERTY_VERSION_PATCH: RTCDeviceProperty = 3;
+pub(crate) const RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED: RTCDeviceProperty = 66;
+pub(crate) const RTC_DEVICE_PROPERTY_TRIANGLE_GEOMETRY_SUPPORTED: RTCDeviceProperty = 96;
 
-pub type RTCSceneFlags = c_int;
-pub const RTC_SCENE_FLAG_NONE: RTCSceneFlags = 0;
-pub const RTC_SCENE_FLAG_ROBUST: RTCSceneFlags = 1 << 2;
-pub const RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION: RTCSceneFlags = 1 << 3;
+pub(crate) type RTCSceneFlags = c_int;
+pub(crate) const RTC_SCENE_FLAG_NONE: RTCSceneFlags = 0;
+pub(crate) const RTC_SCENE_FLAG_ROBUST: RTCSceneFlags = 1 << 2;
+pub(crate) const RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION: RTCSceneFlags = 1 << 3;
 
-pub type RTCBuildQuality = c_int;
-pub const RTC_BUILD_QUALITY_LOW: RTCBuildQuality = 0;
-pub const RTC_BUILD_QUALITY_MEDIUM: RTCBuildQuality = 1;
-pub const RTC_BUILD_QUALITY_HIGH: RTCBuildQuality = 2;
+pub(crate) type RTCBuildQuality = c_int;
+pub(crate) const RTC_BUILD_QUALITY_LOW: RTCBuildQuality = 0;
+pub(crate) const RTC_BUILD_QUALITY_MEDIUM: RTCBuildQuality = 1;
+pub(crate) const RTC_BUILD_QUALITY_HIGH: RTCBuildQuality = 2;
 
-pub type RTCGeometryType = c_int;
-pub const RTC_GEOMETRY_TYPE_TRIANGLE: RTCGeometryType = 0;
+pub(crate) type RTCGeometryType = c_int;
+pub(crate) const RTC_GEOMETRY_TYPE_TRIANGLE: RTCGeometryType = 0;
 
-pub type RTCBufferType = c_int;
-pub const RTC_BUFFER_TYPE_INDEX: RTCBufferType = 0;
-pub const RTC_BUFFER_TYPE_VERTEX: RTCBufferType = 1;
+pub(crate) type RTCBufferType = c_int;
+pub(crate) const RTC_BUFFER_TYPE_INDEX: RTCBufferType = 0;
+pub(crate) const RTC_BUFFER_TYPE_VERTEX: RTCBufferType = 1;
 
-pub type RTCFormat = c_int;
-pub const RTC_FORMAT_UINT3: RTCFormat = 0x5003;
-pub const RTC_FORMAT_FLOAT3: RTCFormat = 0x9003;
+pub(crate) type RTCFormat = c_int;
+pub(crate) const RTC_FORMAT_UINT3: RTCFormat = 0x5003;
+pub(crate) const RTC_FORMAT_FLOAT3: RTCFormat = 0x9003;
 
-pub type RTCIntersectContextFlags = c_int;
+pub(crate) type RTCIntersectContextFlags = c_int;
 /// `RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT` is `(0 << 0)`, what
 /// `rtcInitIntersectContext` sets.
-pub const RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT: RTCIntersectContextFlags = 0;
+pub(crate) const RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT: RTCIntersectContextFlags = 0;
 
 /// `struct RTC_ALIGN(16) RTCRay`.
 #[repr(C, align(16))]
@@ -124,7 +124,7 @@ pub struct RTCRayHit {
 /// `RTCFilterFunctionN`: called by Embree for each candidate hit when a
 /// filter is installed. Embree does not unwind, so implementations must not
 /// panic.
-pub type RTCFilterFunctionN =
+pub(crate) type RTCFilterFunctionN =
     Option<unsafe extern "C" fn(args: *const RTCFilterFunctionNArguments)>;
 
 /// `struct RTCIntersectContext` (without `instStackSize`, present only when
@@ -180,32 +180,32 @@ pub struct RTCFilterFunctionNArguments {
 }
 
 /// `RTCErrorFunction`. Must not unwind into Embree.
-pub type RTCErrorFunction =
+pub(crate) type RTCErrorFunction =
     Option<unsafe extern "C" fn(user_ptr: *mut c_void, code: RTCError, str: *const c_char)>;
 
 extern "C" {
     pub fn rtcNewDevice(config: *const c_char) -> RTCDevice;
-    pub fn rtcReleaseDevice(device: RTCDevice);
-    pub fn rtcGetDeviceProperty(device: RTCDevice, prop: RTCDeviceProperty) -> isize;
-    pub fn rtcGetDeviceError(device: RTCDevice) -> RTCError;
-    pub fn rtcSetDeviceErrorFunction(
+    pub(crate) fn rtcReleaseDevice(device: RTCDevice);
+    pub(crate) fn rtcGetDeviceProperty(device: RTCDevice, prop: RTCDeviceProperty) -> isize;
+    pub(crate) fn rtcGetDeviceError(device: RTCDevice) -> RTCError;
+    pub(crate) fn rtcSetDeviceErrorFunction(
         device: RTCDevice,
         error: RTCErrorFunction,
         user_ptr: *mut c_void,
     );
 
-    pub fn rtcNewScene(device: RTCDevice) -> RTCScene;
-    pub fn rtcReleaseScene(scene: RTCScene);
-    pub fn rtcSetSceneFlags(scene: RTCScene, flags: RTCSceneFlags);
-    pub fn rtcGetSceneFlags(scene: RTCScene) -> RTCSceneFlags;
-    pub fn rtcSetSceneBuildQuality(scene: RTCScene, quality: RTCBuildQuality);
-    pub fn rtcAttachGeometryByID(scene: RTCScene, geometry: RTCGeometry, geom_id: c_uint);
-    pub fn rtcCommitScene(scene: RTCScene);
+    pub(crate) fn rtcNewScene(device: RTCDevice) -> RTCScene;
+    pub(crate) fn rtcReleaseScene(scene: RTCScene);
+    pub(crate) fn rtcSetSceneFlags(scene: RTCScene, flags: RTCSceneFlags);
+    pub(crate) fn rtcGetSceneFlags(scene: RTCScene) -> RTCSceneFlags;
+    pub(crate) fn rtcSetSceneBuildQuality(scene: RTCScene, quality: RTCBuildQuality);
+    pub(crate) fn rtcAttachGeometryByID(scene: RTCScene, geometry: RTCGeometry, geom_id: c_uint);
+    pub(crate) fn rtcCommitScene(scene: RTCScene);
 
-    pub fn rtcNewGeometry(device: RTCDevice, ty: RTCGeometryType) -> RTCGeometry;
-    pub fn rtcReleaseGeometry(geometry: RTCGeometry);
-    pub fn rtcSetGeometryBuildQuality(geometry: RTCGeometry, quality: RTCBuildQuality);
-    pub fn rtcSetSharedGeometryBuffer(
+    pub(crate) fn rtcNewGeometry(device: RTCDevice, ty: RTCGeometryType) -> RTCGeometry;
+    pub(crate) fn rtcReleaseGeometry(geometry: RTCGeometry);
+    pub(crate) fn rtcSetGeometryBuildQuality(geometry: RTCGeometry, quality: RTCBuildQuality);
+    pub(crate) fn rtcSetSharedGeometryBuffer(
         geometry: RTCGeometry,
         ty: RTCBufferType,
         slot: c_uint,
@@ -215,14 +215,18 @@ extern "C" {
         byte_stride: usize,
         item_count: usize,
     );
-    pub fn rtcCommitGeometry(geometry: RTCGeometry);
+    pub(crate) fn rtcCommitGeometry(geometry: RTCGeometry);
 
-    pub fn rtcIntersect1(
+    pub(crate) fn rtcIntersect1(
         scene: RTCScene,
         context: *mut RTCIntersectContext,
         rayhit: *mut RTCRayHit,
     );
-    pub fn rtcOccluded1(scene: RTCScene, context: *mut RTCIntersectContext, ray: *mut RTCRay);
+    pub(crate) fn rtcOccluded1(
+        scene: RTCScene,
+        context: *mut RTCIntersectContext,
+        ray: *mut RTCRay,
+    );
 }
 
 // Layout checks against the Embree 3.13.5 headers (x86-64 / AArch64).

@@ -22,7 +22,7 @@ use std::mem::{align_of, offset_of, size_of};
 pub const RTC_INVALID_GEOMETRY_ID: c_uint = u32::MAX;
 
 /// `RTC_MAX_INSTANCE_LEVEL_COUNT` of the release builds (`rtcore_config.h`).
-pub const RTC_MAX_INSTANCE_LEVEL_COUNT: usize = 1;
+pub(crate) const RTC_MAX_INSTANCE_LEVEL_COUNT: usize = 1;
 
 #[repr(C)]
 pub struct RTCDeviceTy {
@@ -36,60 +36,60 @@ pub struct RTCSceneTy {
 pub struct RTCGeometryTy {
     _private: [u8; 0],
 }
-pub type RTCDevice = *mut RTCDeviceTy;
-pub type RTCScene = *mut RTCSceneTy;
-pub type RTCGeometry = *mut RTCGeometryTy;
+pub(crate) type RTCDevice = *mut RTCDeviceTy;
+pub(crate) type RTCScene = *mut RTCSceneTy;
+pub(crate) type RTCGeometry = *mut RTCGeometryTy;
 
 // Enums are passed as plain `int`-sized integers (the SysV ABIs give these
 // enums 4 bytes), so a value from C can never be an invalid Rust enum.
 
 /// `enum RTCError` (`rtcore_device.h`).
-pub type RTCError = c_int;
-pub const RTC_ERROR_NONE: RTCError = 0;
+pub(crate) type RTCError = c_int;
+pub(crate) const RTC_ERROR_NONE: RTCError = 0;
 
 /// `enum RTCDeviceProperty` (`rtcore_device.h`).
-pub type RTCDeviceProperty = c_int;
-pub const RTC_DEVICE_PROPERTY_VERSION_MAJOR: RTCDeviceProperty = 1;
-pub const RTC_DEVICE_PROPERTY_VERSION_MINOR: RTCDeviceProperty = 2;
-pub const RTC_DEVICE_PROPERTY_VERSION_PATCH: RTCDeviceProperty = 3;
-pub const RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED: RTCDeviceProperty = 66;
-pub const RTC_DEVICE_PROPERTY_TRIANGLE_GEOMETRY_SUPPORTED: RTCDeviceProperty = 96;
+pub(crate) type RTCDeviceProperty = c_int;
+pub(crate) const RTC_DEVICE_PROPERTY_VERSION_MAJOR: RTCDeviceProperty = 1;
+pub(crate) const RTC_DEVICE_PROPERTY_VERSION_MINOR: RTCDeviceProperty = 2;
+pub(crate) const RTC_DEVICE_PROPERTY_VERSION_PATCH: RTCDeviceProperty = 3;
+pub(crate) const RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED: RTCDeviceProperty = 66;
+pub(crate) const RTC_DEVICE_PROPERTY_TRIANGLE_GEOMETRY_SUPPORTED: RTCDeviceProperty = 96;
 
 /// `enum RTCSceneFlags` (`rtcore_scene.h`).
-pub type RTCSceneFlags = c_int;
-pub const RTC_SCENE_FLAG_ROBUST: RTCSceneFlags = 1 << 2;
-pub const RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS: RTCSceneFlags = 1 << 3;
+pub(crate) type RTCSceneFlags = c_int;
+pub(crate) const RTC_SCENE_FLAG_ROBUST: RTCSceneFlags = 1 << 2;
+pub(crate) const RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS: RTCSceneFlags = 1 << 3;
 
 /// `enum RTCBuildQuality` (`rtcore_common.h`).
-pub type RTCBuildQuality = c_int;
-pub const RTC_BUILD_QUALITY_MEDIUM: RTCBuildQuality = 1;
+pub(crate) type RTCBuildQuality = c_int;
+pub(crate) const RTC_BUILD_QUALITY_MEDIUM: RTCBuildQuality = 1;
 
 /// `enum RTCGeometryType` (`rtcore_geometry.h`).
-pub type RTCGeometryType = c_int;
-pub const RTC_GEOMETRY_TYPE_TRIANGLE: RTCGeometryType = 0;
+pub(crate) type RTCGeometryType = c_int;
+pub(crate) const RTC_GEOMETRY_TYPE_TRIANGLE: RTCGeometryType = 0;
 
 /// `enum RTCBufferType` (`rtcore_buffer.h`).
-pub type RTCBufferType = c_int;
-pub const RTC_BUFFER_TYPE_INDEX: RTCBufferType = 0;
-pub const RTC_BUFFER_TYPE_VERTEX: RTCBufferType = 1;
+pub(crate) type RTCBufferType = c_int;
+pub(crate) const RTC_BUFFER_TYPE_INDEX: RTCBufferType = 0;
+pub(crate) const RTC_BUFFER_TYPE_VERTEX: RTCBufferType = 1;
 
 /// `enum RTCFormat` (`rtcore_common.h`).
-pub type RTCFormat = c_int;
-pub const RTC_FORMAT_UINT3: RTCFormat = 0x5003;
-pub const RTC_FORMAT_FLOAT3: RTCFormat = 0x9003;
+pub(crate) type RTCFormat = c_int;
+pub(crate) const RTC_FORMAT_UINT3: RTCFormat = 0x5003;
+pub(crate) const RTC_FORMAT_FLOAT3: RTCFormat = 0x9003;
 
 /// `enum RTCRayQueryFlags` (`rtcore_common.h`).
-pub type RTCRayQueryFlags = c_int;
+pub(crate) type RTCRayQueryFlags = c_int;
 /// `(0 << 16)`: what `rtcInitIntersectArguments` sets.
-pub const RTC_RAY_QUERY_FLAG_INCOHERENT: RTCRayQueryFlags = 0;
+pub(crate) const RTC_RAY_QUERY_FLAG_INCOHERENT: RTCRayQueryFlags = 0;
 /// `(1 << 1)`: run the argument filter on every geometry.
-pub const RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER: RTCRayQueryFlags = 1 << 1;
+pub(crate) const RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER: RTCRayQueryFlags = 1 << 1;
 
 /// `enum RTCFeatureFlags` (`rtcore_common.h`); only SYCL devices read it.
-pub type RTCFeatureFlags = c_uint;
+pub(crate) type RTCFeatureFlags = c_uint;
 /// `RTC_FEATURE_FLAG_ALL = 0xffffffff`, what `rtcInitIntersectArguments`
 /// sets.
-pub const RTC_FEATURE_FLAG_ALL: RTCFeatureFlags = 0xffff_ffff;
+pub(crate) const RTC_FEATURE_FLAG_ALL: RTCFeatureFlags = 0xffff_ffff;
 
 /// `struct RTC_ALIGN(16) RTCRay` (`rtcore_ray.h`; unchanged from Embree 3).
 #[repr(C, align(16))]
@@ -182,7 +182,7 @@ pub struct RTCFilterFunctionNArguments {
 
 /// `RTCFilterFunctionN`. Embree does not unwind: implementations must not
 /// panic.
-pub type RTCFilterFunctionN =
+pub(crate) type RTCFilterFunctionN =
     Option<unsafe extern "C" fn(args: *const RTCFilterFunctionNArguments)>;
 
 /// `struct RTCIntersectArguments` (`rtcore_scene.h`; no
@@ -249,7 +249,7 @@ impl Default for RTCOccludedArguments {
 }
 
 /// `RTCErrorFunction` (`rtcore_device.h`). Must not unwind into Embree.
-pub type RTCErrorFunction =
+pub(crate) type RTCErrorFunction =
     Option<unsafe extern "C" fn(user_ptr: *mut c_void, code: RTCError, str: *const c_char)>;
 
 // Layout checks against the Embree 4.3/4.4 headers (x86-64 / AArch64).

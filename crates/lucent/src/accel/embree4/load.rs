@@ -18,14 +18,14 @@ use super::ffi::*;
 use crate::error::Error;
 
 /// The environment variable naming the Embree 4 library to load.
-pub const ENV_VAR: &str = "LUCENT_EMBREE4";
+pub(crate) const ENV_VAR: &str = "LUCENT_EMBREE4";
 
 /// The names looked for without `LUCENT_EMBREE4`: the soname Embree 4's
 /// packages install, then the development symlink.
-pub const LIB_NAMES: [&str; 2] = ["libembree4.so.4", "libembree4.so"];
+pub(crate) const LIB_NAMES: [&str; 2] = ["libembree4.so.4", "libembree4.so"];
 
 /// The Embree 4 minor releases the binding was checked against.
-pub const KNOWN_MINORS: std::ops::RangeInclusive<u32> = 3..=4;
+pub(crate) const KNOWN_MINORS: std::ops::RangeInclusive<u32> = 3..=4;
 
 /// The Embree 4 functions lucent calls, looked up in the loaded library.
 /// Each pointer stays valid as long as `_lib`, which lives in a `static`
@@ -75,7 +75,10 @@ pub struct Api {
 
 /// Whether `version` is one the binding knows; the message says what was
 /// found and what is needed.
-pub fn check_version(path: &str, (major, minor, patch): (u32, u32, u32)) -> Result<(), String> {
+pub(crate) fn check_version(
+    path: &str,
+    (major, minor, patch): (u32, u32, u32),
+) -> Result<(), String> {
     let (lo, hi) = (KNOWN_MINORS.start(), KNOWN_MINORS.end());
     let need = format!("the embree4 backend needs Embree 4.{lo} to 4.{hi}");
     if major != 4 {
