@@ -29,7 +29,7 @@ pub enum Entry {
 }
 
 /// The direction (z < 0) of one walk entering the medium.
-pub fn enter(eta: f32, entry: Entry, rng: &mut impl Draw) -> Vec3 {
+pub(crate) fn enter(eta: f32, entry: Entry, rng: &mut impl Draw) -> Vec3 {
     loop {
         // wo: the direction the light comes from, +z = outside.
         let wo = match entry {

@@ -23,12 +23,12 @@ pub const FONT_PATHS: [&str; 3] = [
     "/usr/share/fonts/truetype/freefont/FreeSans.ttf",
 ];
 
-pub const FONT: &str = "sans-serif";
+pub(crate) const FONT: &str = "sans-serif";
 const W: u32 = 1200;
 const H: u32 = 800;
 
 /// Registers the plot font once per process.
-pub fn ensure_font() -> Result<(), String> {
+pub(crate) fn ensure_font() -> Result<(), String> {
     static DONE: OnceLock<Result<(), String>> = OnceLock::new();
     DONE.get_or_init(|| {
         let candidates: Vec<PathBuf> = std::env::var_os("LUCENT_FONT")
@@ -53,7 +53,7 @@ pub fn ensure_font() -> Result<(), String> {
     .clone()
 }
 
-pub type Res = Result<(), Box<dyn Error>>;
+pub(crate) type Res = Result<(), Box<dyn Error>>;
 
 /// Draws with `draw` into a W×H RGB buffer and writes it to `path` as PNG.
 pub fn png(
@@ -73,7 +73,7 @@ pub fn png(
     })
 }
 
-pub fn color(i: usize) -> RGBColor {
+pub(crate) fn color(i: usize) -> RGBColor {
     // Tableau-like, then darker variants: distinct for ~20 lines.
     const C: [(u8, u8, u8); 10] = [
         (31, 119, 180),
@@ -96,7 +96,7 @@ pub fn color(i: usize) -> RGBColor {
 }
 
 /// A log axis range covering `v` (positive values) with some margin.
-pub fn log_range(v: impl Iterator<Item = f64>) -> Option<std::ops::Range<f64>> {
+pub(crate) fn log_range(v: impl Iterator<Item = f64>) -> Option<std::ops::Range<f64>> {
     let (lo, hi) = v
         .filter(|x| x.is_finite() && *x > 0.0)
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {

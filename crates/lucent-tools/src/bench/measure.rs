@@ -131,7 +131,7 @@ pub fn time_queries(
 
 /// CPU time used by all threads of this process so far, in seconds
 /// (`CLOCK_PROCESS_CPUTIME_ID`; Linux only).
-pub fn process_cpu_seconds() -> Option<f64> {
+pub(crate) fn process_cpu_seconds() -> Option<f64> {
     #[cfg(all(target_os = "linux", target_pointer_width = "64"))]
     {
         #[repr(C)]
@@ -181,7 +181,7 @@ fn page_size() -> u64 {
 /// Returns freed heap memory to the kernel (glibc's `malloc_trim`), so that
 /// an RSS delta around a build measures the build rather than reuse of
 /// memory freed by the previous one. A no-op elsewhere.
-pub fn trim_heap() {
+pub(crate) fn trim_heap() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {
         extern "C" {

@@ -60,7 +60,7 @@ fn line_plot(path: &Path, title: &str, ylabel: &str, series: &[Series]) -> Resul
 /// `bench-build.png` (build seconds vs triangles) into `dir`, from the
 /// displaced-sphere rows; returns the paths written (none without such
 /// rows).
-pub fn write_plots(dir: &Path, rows: &[Row]) -> Result<Vec<PathBuf>, String> {
+pub(crate) fn write_plots(dir: &Path, rows: &[Row]) -> Result<Vec<PathBuf>, String> {
     let spheres: Vec<&Row> = rows.iter().filter(|r| r.mesh == "sphere").collect();
     if spheres.is_empty() {
         return Ok(Vec::new());

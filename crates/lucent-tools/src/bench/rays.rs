@@ -27,11 +27,11 @@ pub struct Query {
 
 /// Camera tiles are this many pixels on a side; a tile is
 /// `TILE * TILE` = 1024 consecutive queries.
-pub const TILE: usize = 32;
+pub(crate) const TILE: usize = 32;
 
 /// The centre and radius of a sphere enclosing `mesh` (the centre of its
 /// bounding box and half the box's diagonal).
-pub fn bounding_sphere(mesh: &Mesh) -> (Vec3, f32) {
+pub(crate) fn bounding_sphere(mesh: &Mesh) -> (Vec3, f32) {
     let (lo, hi) = mesh.positions().iter().fold(
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(lo, hi), &p| (lo.min(p), hi.max(p)),
@@ -114,7 +114,7 @@ pub fn camera_rays(mesh: &Mesh, n: usize) -> Vec<Query> {
 }
 
 /// Samples points uniformly by area on a mesh (a CDF over triangle areas).
-pub struct SurfaceSampler<'a> {
+pub(crate) struct SurfaceSampler<'a> {
     mesh: &'a Mesh,
     cdf: Vec<f64>,
 }

@@ -121,7 +121,7 @@ pub fn parse_threads(s: &str) -> Result<usize, String> {
 
 /// The most rays a query set may have: each set is held in memory with its
 /// results (about 40 bytes a ray), 800 MB at this bound.
-pub const MAX_RAYS: usize = 20_000_000;
+pub(crate) const MAX_RAYS: usize = 20_000_000;
 
 /// Parses a ray count: a positive integer up to `MAX_RAYS`, `k`/`M`
 /// suffixes allowed.

@@ -101,18 +101,18 @@ pub struct Config {
 
 /// "uniform", "table:N" (tail-spaced), "table-uniform:N", "analytic",
 /// "mixture": the names [`RadiusSampler::parse`] reads.
-pub fn radius_name(r: RadiusSampler) -> String {
+pub(crate) fn radius_name(r: RadiusSampler) -> String {
     r.name()
 }
 
-pub fn integrator_name(i: IntegratorKind) -> &'static str {
+pub(crate) fn integrator_name(i: IntegratorKind) -> &'static str {
     match i {
         IntegratorKind::Path => "diffusion",
         IntegratorKind::RandomWalk => "randomwalk",
     }
 }
 
-pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
+pub(crate) fn parse_integrator(s: &str) -> Option<IntegratorKind> {
     match s {
         "diffusion" | "path" => Some(IntegratorKind::Path),
         "randomwalk" | "random-walk" => Some(IntegratorKind::RandomWalk),
@@ -131,13 +131,13 @@ fn channel_name(c: ChannelStrategy) -> &'static str {
 /// The baseline's probe options: the recommended defaults (exact analytic
 /// radius sampling, N/T/B probes with MIS, all channels per sample, Rmax at
 /// the 0.999 quantile, no renormalization).
-pub fn baseline_probe() -> ProbeOptions {
+pub(crate) fn baseline_probe() -> ProbeOptions {
     ProbeOptions::default()
 }
 
 /// The Rmax quantile of the diffusion reference: far enough out that the
 /// truncation of the configurations (0.999 by default) shows as bias.
-pub const REFERENCE_RMAX_QUANTILE: f64 = 0.99999;
+pub(crate) const REFERENCE_RMAX_QUANTILE: f64 = 0.99999;
 
 fn full_probe(o: ProbeOptions) -> Overrides {
     Overrides {
@@ -161,7 +161,7 @@ fn full_probe(o: ProbeOptions) -> Overrides {
 /// and channels, Rmax at [`REFERENCE_RMAX_QUANTILE`], no level of detail
 /// (the full estimator at every hit); Fresnel choices are the scene's (they
 /// change the model, not the estimator).
-pub fn reference_overrides() -> Overrides {
+pub(crate) fn reference_overrides() -> Overrides {
     Overrides {
         lod: Some(LodMode::Off),
         ..full_probe(ProbeOptions {
@@ -456,7 +456,7 @@ pub fn apply(scene: &Scene, ov: &Overrides) -> Result<Scene, String> {
 }
 
 /// A one-line description of overrides for the report.
-pub fn describe(ov: &Overrides) -> String {
+pub(crate) fn describe(ov: &Overrides) -> String {
     let mut parts = Vec::new();
     if let Some(r) = ov.radius {
         parts.push(format!("radius {}", radius_name(r)));

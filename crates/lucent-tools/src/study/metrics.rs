@@ -14,8 +14,8 @@
 use lucent::film::Film;
 use lucent::geometry::Vec3;
 
-pub const REL_MSE_EPS: f64 = 0.01;
-pub const FIREFLY_FLOOR: f64 = 1e-3;
+pub(crate) const REL_MSE_EPS: f64 = 0.01;
+pub(crate) const FIREFLY_FLOOR: f64 = 1e-3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Metrics {
@@ -89,7 +89,7 @@ pub fn compare(img: &Film, reference: &Film, k: f64) -> Result<Metrics, String> 
 /// log-log interpolation: the time at which a ladder of (seconds, error)
 /// points, in increasing time, first reaches `target`; None if it never
 /// does (a biased configuration can plateau above it).
-pub fn time_to_reach(points: &[(f64, f64)], target: f64) -> Option<f64> {
+pub(crate) fn time_to_reach(points: &[(f64, f64)], target: f64) -> Option<f64> {
     let mut prev: Option<(f64, f64)> = None;
     for &(t, e) in points {
         if e <= target {

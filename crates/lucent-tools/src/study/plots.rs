@@ -203,7 +203,11 @@ fn bias_chart(
 }
 
 /// Writes every plot the rows support; returns their paths.
-pub fn write_all(dir: &Path, rows: &[Row], configs: &[Config]) -> Result<Vec<PathBuf>, String> {
+pub(crate) fn write_all(
+    dir: &Path,
+    rows: &[Row],
+    configs: &[Config],
+) -> Result<Vec<PathBuf>, String> {
     ensure_font()?;
     let mut out = Vec::new();
     let p = dir.join("error-vs-time.png");

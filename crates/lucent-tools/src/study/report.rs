@@ -25,7 +25,7 @@ fn ladder_of<'a>(rows: &'a [Row], config: &str) -> Vec<&'a Row> {
 }
 
 /// The command line that reproduces the study.
-pub fn command_line(s: &Settings) -> String {
+pub(crate) fn command_line(s: &Settings) -> String {
     let mut c = format!(
         "lucent study {} -o {}",
         s.scene.display(),

@@ -74,7 +74,7 @@ impl Row {
 
 /// The results file of a study directory, open for appending.
 #[derive(Debug)]
-pub struct Results {
+pub(crate) struct Results {
     path: PathBuf,
     rows: Vec<Row>,
     file: File,
@@ -140,7 +140,7 @@ impl Results {
     }
 
     /// Appends one row and flushes it to disk before returning.
-    pub fn append(&mut self, row: Row) -> Result<(), String> {
+    pub(crate) fn append(&mut self, row: Row) -> Result<(), String> {
         for s in [
             &row.config,
             &row.axis,

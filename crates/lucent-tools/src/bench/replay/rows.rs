@@ -67,11 +67,11 @@ pub struct MixRow {
 
 impl MixRow {
     /// End-to-end rate: the render's rays over its wall time, Mrays/s.
-    pub fn render_mrays(&self) -> f64 {
+    pub(crate) fn render_mrays(&self) -> f64 {
         self.render_rays as f64 / self.render_seconds / 1e6
     }
     /// Raw rate: the recorded queries over the replay's wall time.
-    pub fn raw_mrays(&self) -> f64 {
+    pub(crate) fn raw_mrays(&self) -> f64 {
         self.records as f64 / self.replay_seconds / 1e6
     }
     /// End-to-end over raw.
@@ -91,16 +91,16 @@ impl MixRow {
         Some(self.render_rays as f64 / rc / (self.records as f64 / qc))
     }
     /// Wall time per ray outside the queries, ns (render − replay, per ray).
-    pub fn other_ns_per_ray(&self) -> f64 {
+    pub(crate) fn other_ns_per_ray(&self) -> f64 {
         (self.render_seconds - self.replay_seconds) / self.render_rays as f64 * 1e9
     }
     /// Query wall time per ray, ns.
-    pub fn query_ns_per_ray(&self) -> f64 {
+    pub(crate) fn query_ns_per_ray(&self) -> f64 {
         self.replay_seconds / self.records as f64 * 1e9
     }
     /// The time per ray outside queries at which the ratio would be 0.7 at
     /// today's query cost: q · 0.3 / 0.7.
-    pub fn other_ns_for_target(&self, target: f64) -> f64 {
+    pub(crate) fn other_ns_for_target(&self, target: f64) -> f64 {
         self.query_ns_per_ray() * (1.0 - target) / target
     }
 }
