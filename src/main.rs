@@ -8,7 +8,6 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
-use lucent::farm::part;
 use lucent::film::cryptomatte;
 use lucent::film::exr_layers::{ExrCompression, Precision, Preview};
 use lucent::film::passes::PassSet;
@@ -21,6 +20,9 @@ use lucent::render::RenderOptions;
 use lucent::scene;
 use lucent::session;
 use lucent::Error;
+
+mod values;
+use values::{parse_aov, parse_checkpoint, parse_crop, parse_samples, parse_tile};
 
 #[derive(Parser)]
 #[command(
@@ -219,63 +221,6 @@ impl From<SplitArgs> for session::Split {
     }
 }
 
-/// A flag's value that does not parse.
-#[derive(Debug)]
-enum ValueError {
-    /// Not of the form `expected`.
-    Expected {
-        expected: &'static str,
-        found: String,
-    },
-    /// A problem the parser named.
-    Problem(String),
-}
-
-impl std::fmt::Display for ValueError {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        match self {
-            ValueError::Expected { expected, found } => {
-                write!(f, "expected {expected}, found \"{found}\"")
-            }
-            ValueError::Problem(p) => f.write_str(p),
-        }
-    }
-}
-
-impl std::error::Error for ValueError {}
-
-/// [`ValueError::Expected`] for the value `s`.
-fn expected(expected: &'static str, s: &str) -> ValueError {
-    ValueError::Expected {
-        expected,
-        found: s.into(),
-    }
-}
-
-fn parse_crop(s: &str) -> Result<Region, ValueError> {
-    Region::parse(s)
-        .filter(|r| !r.is_empty())
-        .ok_or_else(|| expected("X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1", s))
-}
-
-fn parse_tile(s: &str) -> Result<(u32, u32), ValueError> {
-    s.split_once('/')
-        .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)))
-        .filter(|&(i, n)| i < n)
-        .ok_or_else(|| expected("I/N with 0 ≤ I < N", s))
-}
-
-fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, ValueError> {
-    part::parse_samples(s).ok_or_else(|| expected("A..B with A < B", s))
-}
-
-fn parse_checkpoint(s: &str) -> Result<f64, ValueError> {
-    s.parse::<f64>()
-        .ok()
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .ok_or_else(|| expected("a positive number of seconds", s))
-}
-
 /// The subsurface sampling options, one flag per row of the option table
 /// (`lucent::materials::estimator_options`); each replaces every
 /// subsurface material's own.
@@ -401,10 +346,6 @@ impl FileArgs {
 enum ExplainArg {
     Text,
     Json,
-}
-
-fn parse_aov(s: &str) -> Result<PassSet, ValueError> {
-    PassSet::parse_list(s).map_err(|e| ValueError::Problem(e.problem()))
 }
 
 /// A build without the `subsurface` feature has no subsurface materials,
