@@ -26,9 +26,9 @@ mod helpers {
     /// Incoherent rays: origins uniform on the sphere of radius 3, each
     /// aimed at a uniform random point of the unit ball (so nearly all of
     /// them hit the displaced unit sphere, at random places). The generator
-    /// is shared with `lucent bench` (`lucent::tools::bench::rays`).
+    /// is shared with `lucent bench` (`lucent_tools::bench::rays`).
     pub fn incoherent_rays(n: usize, seed: u64) -> Vec<Ray> {
-        lucent::tools::bench::rays::incoherent_rays(n, seed, Vec3::ZERO, 1.0)
+        lucent_tools::bench::rays::incoherent_rays(n, seed, Vec3::ZERO, 1.0)
     }
 
     pub fn pool(threads: usize) -> rayon::ThreadPool {

@@ -1,6 +1,6 @@
-//! Generates `src/bssrdf/albedo_table.csv`, the total diffuse reflectance
+//! Generates `crates/lucent/src/bssrdf/albedo_table.csv`, the total diffuse reflectance
 //! of a semi-infinite medium behind a smooth dielectric boundary, by the
-//! random walk's physics (`lucent::tools::halfspace`; `docs/bssrdf.md` §9).
+//! random walk's physics (`lucent_tools::halfspace`; `docs/bssrdf.md` §9).
 //!
 //!     cargo run --release --example albedo_table [-- OUT.csv [--quick]]
 //!     cargo run --release --example albedo_table -- --similarity
@@ -11,7 +11,7 @@
 //!
 //! `scripts/albedo-table.sh` runs it. Deterministic for any thread count.
 
-use lucent::tools::halfspace::{albedo_from_reduced, generate, run, Batch, Entry, TableSettings};
+use lucent_tools::halfspace::{albedo_from_reduced, generate, run, Batch, Entry, TableSettings};
 use std::fmt::Write as _;
 
 fn main() {
@@ -20,7 +20,7 @@ fn main() {
         .iter()
         .find(|a| !a.starts_with("--"))
         .cloned()
-        .unwrap_or_else(|| "src/bssrdf/albedo_table.csv".into());
+        .unwrap_or_else(|| "crates/lucent/src/bssrdf/albedo_table.csv".into());
     let mut s = TableSettings::default();
     if args.iter().any(|a| a == "--similarity") {
         similarity(&s);
@@ -47,7 +47,7 @@ fn main() {
     );
     h(
         &mut csv,
-        "Made by `cargo run --release --example albedo_table` (lucent::tools::halfspace):",
+        "Made by `cargo run --release --example albedo_table` (lucent_tools::halfspace):",
     );
     h(
         &mut csv,

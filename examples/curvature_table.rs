@@ -1,8 +1,8 @@
-//! Generates `src/bssrdf/curvature_table.csv`: per (η, x = √(1 − α'), ρ)
+//! Generates `crates/lucent/src/bssrdf/curvature_table.csv`: per (η, x = √(1 − α'), ρ)
 //! the ratio h = (1 − A_sphere) / (1 − A_slab) of what a sphere of radius
 //! ρ diffusion lengths and the half-space of the same medium absorb under
 //! uniform light, by the random walk's physics
-//! (`lucent::tools::sphere_albedo`; `docs/bssrdf.md` §10).
+//! (`lucent_tools::sphere_albedo`; `docs/bssrdf.md` §10).
 //!
 //!     cargo run --release --example curvature_table [-- OUT.csv [--quick]]
 //!     cargo run --release --example curvature_table -- --check
@@ -14,7 +14,7 @@
 //! `scripts/curvature-table.sh` runs it. Deterministic for any thread count.
 
 use lucent::bssrdf::curvature_table::CurvatureTable;
-use lucent::tools::sphere_albedo::{escape, generate, Body, Settings};
+use lucent_tools::sphere_albedo::{escape, generate, Body, Settings};
 use std::fmt::Write as _;
 
 fn main() {
@@ -23,7 +23,7 @@ fn main() {
         .iter()
         .find(|a| !a.starts_with("--"))
         .cloned()
-        .unwrap_or_else(|| "src/bssrdf/curvature_table.csv".into());
+        .unwrap_or_else(|| "crates/lucent/src/bssrdf/curvature_table.csv".into());
     let mut s = Settings::default();
     if args.iter().any(|a| a == "--check") {
         check(&s);
@@ -50,7 +50,7 @@ fn main() {
         "lucent curvature table: what a sphere absorbs against the half-space of the",
         "same medium, both behind a smooth dielectric boundary, under uniform light",
         "(docs/bssrdf.md section 10). Made by `cargo run --release --example",
-        "curvature_table` (lucent::tools::sphere_albedo): the random walk's free",
+        "curvature_table` (lucent_tools::sphere_albedo): the random walk's free",
         "flights, isotropic scattering and dielectric boundary, analog absorption.",
         &format!(
             "seed {}, {} walks per sphere node, {} per half-space; {:.3e} events in {secs:.0} s.",

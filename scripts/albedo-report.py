@@ -30,7 +30,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LUCENT = os.environ.get("LUCENT", os.path.join(ROOT, "target/release/lucent"))
 MEAN = os.path.join(ROOT, "target/release/examples/image_mean")
 
-# Jensen et al. 2001 (src/bssrdf/params.rs PRESETS): sigma_s', sigma_a (1/mm).
+# Jensen et al. 2001 (crates/lucent/src/bssrdf/params.rs PRESETS): sigma_s', sigma_a (1/mm).
 PRESETS = {
     "apple": ([2.29, 2.39, 1.97], [0.0030, 0.0034, 0.046]),
     "chicken1": ([0.15, 0.21, 0.38], [0.015, 0.077, 0.19]),

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates src/bssrdf/albedo_table.csv, the albedo table of
+# Regenerates crates/lucent/src/bssrdf/albedo_table.csv, the albedo table of
 # docs/bssrdf.md §9 (total diffuse reflectance of a semi-infinite medium
 # behind a smooth dielectric boundary, by the random walk's physics).
 # Deterministic for any thread count: the same seed gives the same file.
@@ -11,4 +11,4 @@ cargo build --release --example albedo_table
 if [[ "${1:-}" == "--similarity" ]]; then
     exec target/release/examples/albedo_table --similarity
 fi
-target/release/examples/albedo_table src/bssrdf/albedo_table.csv "$@"
+target/release/examples/albedo_table crates/lucent/src/bssrdf/albedo_table.csv "$@"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Fails when a locked dependency needs a newer Rust than Cargo.toml's
-# `rust-version` says. Each package built for this host (Cargo.lock as is,
+# Fails when a locked dependency needs a newer Rust than the workspace's
+# `rust-version` (root Cargo.toml, shared by its three packages) says. Each package built for this host (Cargo.lock as is,
 # all features, dev-dependencies included) needs at least its own
 # `rust-version` and the first Rust of its edition (2018: 1.31, 2021: 1.56,
 # 2024: 1.85). Our own code is held to `rust-version` by clippy's
@@ -25,14 +25,17 @@ def show(v):
 
 
 meta = json.load(sys.stdin)
-root = next(p for p in meta["packages"] if p["id"] in meta["workspace_members"])
+ours_all = [p for p in meta["packages"] if p["id"] in meta["workspace_members"]]
+root = ours_all[0]
+if not all(p.get("rust_version") == root.get("rust_version") for p in ours_all):
+    sys.exit("check-msrv: the workspace's packages must share one rust-version")
 if not root.get("rust_version"):
     sys.exit("check-msrv: Cargo.toml has no rust-version")
 ours = ver(root["rust_version"])
 
 need = []
 for p in meta["packages"]:
-    if p["id"] == root["id"]:
+    if p["id"] in meta["workspace_members"]:
         continue
     floor = ver(EDITION_FLOOR[p["edition"]])
     why = "edition " + p["edition"]

@@ -6,7 +6,7 @@
 # docs/testing.md for the cost and how to split it into shards).
 #
 #   scripts/mutants.sh                      all core files
-#   scripts/mutants.sh --file src/accel/bvh/traverse.rs
+#   scripts/mutants.sh --file crates/lucent/src/accel/bvh/traverse.rs
 #   scripts/mutants.sh --shard 0/8          the first of 8 shards (k/n, k from 0)
 #   scripts/mutants.sh --list               only list the mutants
 #   scripts/mutants.sh --report [DIR]       only summarize an earlier run
@@ -40,7 +40,7 @@ usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; }
 
 # The core files, and the tests that cover them (the library's unit tests
 # and the scene-level tests of transport, subsurface and the BVH).
-CORE=(src/bssrdf src/integrator src/materials src/accel/bvh)
+CORE=(crates/lucent/src/bssrdf crates/lucent/src/integrator crates/lucent/src/materials crates/lucent/src/accel/bvh)
 # The smallest subsets that cover each folder (sample mode): the unit
 # tests, which cargo runs first and which stop the run when they catch the
 # mutant, then the group binaries (tests/README.md) whose scene-level tests
@@ -170,7 +170,10 @@ fi
 if [ ${#files[@]} -eq 0 ]; then
     files=("${CORE[@]}")
 fi
-args=()
+# The library's files are mutated, but most tests covering them are the
+# root package's (tests/): test the whole workspace, not only the package
+# that holds the mutated file.
+args=(--test-workspace=true)
 for f in "${files[@]}"; do
     if [ -d "$f" ]; then
         args+=(--file "$f/**/*.rs")
@@ -225,11 +228,11 @@ if [ -n "$sample" ]; then
         fi
         file="${m%%:*}"
         case "$file" in
-            src/accel/bvh/*) t=("${TESTS_BVH[@]}") ;;
-            src/bssrdf/*) t=("${TESTS_BSSRDF[@]}") ;;
-            src/materials/*) t=("${TESTS_MATERIALS[@]}") ;;
-            src/integrator/aov/*) t=("${TESTS_AOV[@]}") ;;
-            src/integrator/*) t=("${TESTS_INTEGRATOR[@]}") ;;
+            crates/lucent/src/accel/bvh/*) t=("${TESTS_BVH[@]}") ;;
+            crates/lucent/src/bssrdf/*) t=("${TESTS_BSSRDF[@]}") ;;
+            crates/lucent/src/materials/*) t=("${TESTS_MATERIALS[@]}") ;;
+            crates/lucent/src/integrator/aov/*) t=("${TESTS_AOV[@]}") ;;
+            crates/lucent/src/integrator/*) t=("${TESTS_INTEGRATOR[@]}") ;;
             *) t=("${TESTS[@]}") ;;
         esac
         if [ -n "${MUTANTS_TESTS:-}" ]; then t=("${TESTS[@]}"); fi

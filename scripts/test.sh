@@ -4,6 +4,8 @@
 # the default features (Embree 3, Embree 4 and our BVH, compared), then the BVH tests on
 # its portable (non-SSE) path, and lints and tests the build with no default
 # feature (`--no-default-features`: our BVH only, no subsurface support) too.
+# Every step covers the whole workspace: the library (crates/lucent), the
+# measuring tools (crates/lucent-tools) and the command line (the root).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -18,11 +20,11 @@ cargo fmt --all -- --check
 # rust-version covers every locked dependency; clippy's incompatible_msrv
 # (all targets, tests included: clippy.toml) holds our own code to it.
 scripts/check-msrv.sh
-cargo clippy --all-targets -- -D warnings
-cargo clippy --no-default-features --all-targets -- -D warnings
+cargo clippy --workspace --all-targets -- -D warnings
+cargo clippy --workspace --no-default-features --all-targets -- -D warnings
 # Broken intra-doc links are bugs in the docs the module headers promise.
-RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
-cargo test --all-targets
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps
+cargo test --workspace --all-targets
 
 # A real Slurm cluster of one node (this machine): a job array of parts and
 # a dependent merge, checked bitwise against one process. Needs root and
@@ -34,13 +36,13 @@ if [ "${LUCENT_SLURM_TEST:-}" = 1 ]; then
 fi
 
 # The BVH's portable box and triangle tests, which other architectures
-# run, forced on x86_64 (only lucent is rebuilt).
+# run, forced on x86_64 (only the workspace's packages are rebuilt).
 echo "--- BVH portable path (--features bvh-portable) ---"
-cargo test --features bvh-portable --lib
+cargo test --workspace --features bvh-portable --lib
 cargo test --features bvh-portable --test accel -- bvh_brute_force::
 
-# Same target dir: only lucent itself is rebuilt, the dependencies are
-# reused. The library's own tests, and the command-line tests whose
+# Same target dir: only the workspace's packages are rebuilt, the
+# dependencies are reused. The libraries' own tests, and the command-line tests whose
 # expectations depend on the features the binary has (`info`, `--accel
 # embree` refused with exit 2, a subsurface scene refused with exit 2); the
 # Embree and subsurface tests are not built here (required-features), the
@@ -48,5 +50,5 @@ cargo test --features bvh-portable --test accel -- bvh_brute_force::
 # no code depends on the two together, so the default build and this one
 # compile every gated item both ways (the cheapest addition: no third build).
 echo "--- No default features: BVH only, no subsurface (--no-default-features) ---"
-cargo test --no-default-features --lib
+cargo test --workspace --no-default-features --lib
 cargo test --no-default-features --test cli -- cli:: subsurface_feature::

@@ -8,9 +8,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
-use lucent::farm::part;
 use lucent::film::cryptomatte;
-use lucent::film::exr_layers::{self, ExrCompression, OutputOptions, Precision, Preview};
+use lucent::film::exr_layers::{ExrCompression, Precision, Preview};
 use lucent::film::passes::PassSet;
 use lucent::film::region::Region;
 use lucent::film::ToneMap;
@@ -21,6 +20,9 @@ use lucent::render::RenderOptions;
 use lucent::scene;
 use lucent::session;
 use lucent::Error;
+
+mod values;
+use values::{parse_aov, parse_checkpoint, parse_crop, parse_samples, parse_tile};
 
 #[derive(Parser)]
 #[command(
@@ -49,6 +51,24 @@ enum AccelArg {
     Bvh,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum ToneMapArg {
+    /// Clip each channel to [0, 1].
+    Clamp,
+    /// The ACES filmic curve fit of Narkowicz (2015): a soft shoulder so
+    /// bright lights keep detail instead of clipping.
+    Filmic,
+}
+
+impl From<ToneMapArg> for ToneMap {
+    fn from(t: ToneMapArg) -> ToneMap {
+        match t {
+            ToneMapArg::Clamp => ToneMap::Clamp,
+            ToneMapArg::Filmic => ToneMap::Filmic,
+        }
+    }
+}
+
 impl From<AccelArg> for Backend {
     fn from(a: AccelArg) -> Backend {
         match a {
@@ -73,7 +93,7 @@ enum Command {
         #[arg(long)]
         spp: Option<u32>,
         /// Worker threads, 1 to 1024 (default: all cores).
-        #[arg(long, value_parser = lucent::tools::bench::parse_threads)]
+        #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
         threads: Option<usize>,
         /// Random seed (default: the scene's `render.seed`).
         #[arg(long)]
@@ -85,7 +105,7 @@ enum Command {
         accel: Option<AccelArg>,
         /// Tone map of the PNG preview (the EXR is always linear).
         #[arg(long, value_enum, default_value = "filmic")]
-        tonemap: ToneMap,
+        tonemap: ToneMapArg,
         /// Exposure of the PNG preview in stops.
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         exposure: f32,
@@ -141,7 +161,7 @@ enum Command {
         output: PathBuf,
         /// Tone map of the PNG preview (the EXR is always linear).
         #[arg(long, value_enum, default_value = "filmic")]
-        tonemap: ToneMap,
+        tonemap: ToneMapArg,
         /// Exposure of the PNG preview in stops.
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         exposure: f32,
@@ -154,14 +174,14 @@ enum Command {
     /// rays; bench.csv, report.txt and plots in the output directory. With
     /// --scene: the render's end-to-end ray rate against the backend's raw
     /// rate on the render's own queries (render-mix.csv, render-mix.txt).
-    Bench(BenchArgs),
+    Bench(lucent_tools::bench::cli::BenchArgs),
     /// Print the build's ray-query backends and versions.
     Info,
     /// Measure error against time for every sampling choice of the
     /// subsurface estimator: results.csv, plots and report.md in the output
     /// directory (resumes from results.csv; see src/tools/study/mod.rs).
     #[cfg(feature = "subsurface")]
-    Study(StudyArgs),
+    Study(lucent_tools::study::cli::StudyArgs),
 }
 
 /// Splitting a frame into parts, checkpoints and resuming (docs/farm.md).
@@ -199,68 +219,6 @@ impl From<SplitArgs> for session::Split {
             resume: a.resume,
         }
     }
-}
-
-/// A flag's value that does not parse.
-#[derive(Debug)]
-enum ValueError {
-    /// Not of the form `expected`.
-    Expected {
-        expected: &'static str,
-        found: String,
-    },
-    /// Not one of the names of `what`.
-    #[cfg(feature = "subsurface")]
-    Unknown { what: &'static str, found: String },
-    /// A problem the parser named.
-    Problem(String),
-}
-
-impl std::fmt::Display for ValueError {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        match self {
-            ValueError::Expected { expected, found } => {
-                write!(f, "expected {expected}, found \"{found}\"")
-            }
-            #[cfg(feature = "subsurface")]
-            ValueError::Unknown { what, found } => write!(f, "unknown {what} \"{found}\""),
-            ValueError::Problem(p) => f.write_str(p),
-        }
-    }
-}
-
-impl std::error::Error for ValueError {}
-
-/// [`ValueError::Expected`] for the value `s`.
-fn expected(expected: &'static str, s: &str) -> ValueError {
-    ValueError::Expected {
-        expected,
-        found: s.into(),
-    }
-}
-
-fn parse_crop(s: &str) -> Result<Region, ValueError> {
-    Region::parse(s)
-        .filter(|r| !r.is_empty())
-        .ok_or_else(|| expected("X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1", s))
-}
-
-fn parse_tile(s: &str) -> Result<(u32, u32), ValueError> {
-    s.split_once('/')
-        .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)))
-        .filter(|&(i, n)| i < n)
-        .ok_or_else(|| expected("I/N with 0 ≤ I < N", s))
-}
-
-fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, ValueError> {
-    part::parse_samples(s).ok_or_else(|| expected("A..B with A < B", s))
-}
-
-fn parse_checkpoint(s: &str) -> Result<f64, ValueError> {
-    s.parse::<f64>()
-        .ok()
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .ok_or_else(|| expected("a positive number of seconds", s))
 }
 
 /// The subsurface sampling options, one flag per row of the option table
@@ -390,10 +348,6 @@ enum ExplainArg {
     Json,
 }
 
-fn parse_aov(s: &str) -> Result<PassSet, ValueError> {
-    PassSet::parse_list(s).map_err(|e| ValueError::Problem(e.problem()))
-}
-
 /// A build without the `subsurface` feature has no subsurface materials,
 /// and so no options that override them.
 #[cfg(not(feature = "subsurface"))]
@@ -443,7 +397,7 @@ fn main() -> ExitCode {
                 spp,
                 seed,
                 threads,
-                progress: !quiet,
+                progress: (!quiet).then(lucent_tools::progress::Bar::sink),
                 integrator,
                 stats,
             };
@@ -460,7 +414,10 @@ fn main() -> ExitCode {
                     overrides: subsurface.overrides(),
                     file,
                     split: split.into(),
-                    preview: Preview { tonemap, exposure },
+                    preview: Preview {
+                        tonemap: tonemap.into(),
+                        exposure,
+                    },
                 };
                 run_render(&r, quiet)
             })
@@ -471,12 +428,22 @@ fn main() -> ExitCode {
             tonemap,
             exposure,
             quiet,
-        } => run_merge(&parts, &output, tonemap, exposure, quiet),
+        } => {
+            let preview = Preview {
+                tonemap: tonemap.into(),
+                exposure,
+            };
+            session::merge_parts(&parts, &output, preview).map(|m| {
+                if !quiet {
+                    eprintln!("{}", m.summary(&output));
+                }
+            })
+        }
         #[cfg(feature = "subsurface")]
-        Command::Study(args) => run_study(args),
-        Command::Bench(args) => run_bench(args),
+        Command::Study(args) => lucent_tools::study::cli::run_study(args),
+        Command::Bench(args) => lucent_tools::bench::cli::run_bench(args),
         Command::Info => {
-            println!("{}", info());
+            println!("{}", session::build_info());
             Ok(())
         }
     };
@@ -551,45 +518,6 @@ fn run_explain(
     Ok(())
 }
 
-fn run_merge(
-    parts: &[PathBuf],
-    output: &Path,
-    tonemap: ToneMap,
-    exposure: f32,
-    quiet: bool,
-) -> Result<(), Error> {
-    session::check_exr_output(output)?;
-    let start = std::time::Instant::now();
-    let m = lucent::farm::merge::merge(parts)?;
-    let header = lucent::film::exr_attributes::FrameHeader {
-        spp: Some(m.identity.spp),
-        seed: Some(m.identity.seed),
-        ..Default::default()
-    };
-    let out = OutputOptions {
-        preview: Some(Preview { tonemap, exposure }),
-        ..m.output
-    };
-    exr_layers::write_frame(output, &m.film, &m.layers, &m.coverage, &header, &out)?;
-    if !quiet {
-        eprintln!(
-            "{}: {} parts merged, {}×{} at {} spp, {:.2} s{}",
-            output.display(),
-            parts.len(),
-            m.film.width,
-            m.film.height,
-            m.identity.spp,
-            start.elapsed().as_secs_f64(),
-            if m.counters.nonfinite > 0 {
-                format!(", {} non-finite samples discarded", m.counters.nonfinite)
-            } else {
-                String::new()
-            }
-        );
-    }
-    Ok(())
-}
-
 /// `s` with every control character (from a file name, an OBJ line or a
 /// key quoted in the message) shown as its escape: a message is one line,
 /// and input cannot send escape sequences to the terminal.
@@ -616,223 +544,4 @@ fn report_rejected_rays(n: u64) {
             accel::MAX_RAY_COMPONENT
         );
     }
-}
-
-#[cfg(feature = "subsurface")]
-#[derive(clap::Args)]
-struct StudyArgs {
-    /// The scene description (TOML; needs a subsurface material).
-    scene: PathBuf,
-    /// Output directory (created; default: study-<scene name>).
-    #[arg(short, long)]
-    output: Option<PathBuf>,
-    /// Small images, few configurations, short ladders: under two minutes.
-    #[arg(long)]
-    quick: bool,
-    /// Worker threads, 1 to 1024 (default: all cores).
-    #[arg(long, value_parser = lucent::tools::bench::parse_threads)]
-    threads: Option<usize>,
-    /// Integrator of the reference render: diffusion | randomwalk.
-    #[arg(long, default_value = "diffusion", value_parser = parse_study_integrator)]
-    reference: lucent::integrator::IntegratorKind,
-    /// Samples per pixel of the reference (default 4096, quick 512).
-    #[arg(long)]
-    reference_spp: Option<u32>,
-    /// Largest sample count of the ladder 1, 2, 4, … (default 128, quick 16).
-    #[arg(long)]
-    max_spp: Option<u32>,
-    /// Image width in pixels, aspect kept (default 128, quick 48).
-    #[arg(long)]
-    width: Option<u32>,
-    /// Base seed (default: the scene's).
-    #[arg(long)]
-    seed: Option<u64>,
-    /// Firefly threshold: pixels above K times the reference.
-    #[arg(long, default_value_t = 10.0)]
-    firefly_k: f64,
-    /// Only these axes (comma separated: radius, rmax, axes, channel,
-    /// renormalize, exit_sw, specular, backend, integrator, boundary, lod,
-    /// variance); the baseline always runs.
-    #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
-    only: Vec<lucent::tools::study::Axis>,
-    /// No progress bars.
-    #[arg(short, long)]
-    quiet: bool,
-}
-
-#[cfg(feature = "subsurface")]
-fn parse_study_integrator(s: &str) -> Result<lucent::integrator::IntegratorKind, ValueError> {
-    lucent::tools::study::config::parse_integrator(s)
-        .ok_or_else(|| expected("diffusion or randomwalk", s))
-}
-
-#[cfg(feature = "subsurface")]
-fn parse_study_axis(s: &str) -> Result<lucent::tools::study::Axis, ValueError> {
-    lucent::tools::study::Axis::parse(s).ok_or_else(|| ValueError::Unknown {
-        what: "axis",
-        found: s.into(),
-    })
-}
-
-#[cfg(feature = "subsurface")]
-fn run_study(a: StudyArgs) -> Result<(), Error> {
-    use lucent::tools::study;
-    let out = a.output.clone().unwrap_or_else(|| {
-        let stem = a
-            .scene
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        PathBuf::from(format!("study-{stem}"))
-    });
-    let mut s = study::Settings::new(&a.scene, out, a.quick);
-    s.threads = a.threads;
-    s.reference = a.reference;
-    s.reference_spp = a.reference_spp.unwrap_or(s.reference_spp);
-    s.max_spp = a.max_spp.unwrap_or(s.max_spp);
-    s.width = a.width.unwrap_or(s.width);
-    s.seed = a.seed;
-    s.firefly_k = a.firefly_k;
-    s.only = a.only;
-    s.progress = !a.quiet;
-    let o = study::run(&s)?;
-    if !a.quiet {
-        eprintln!(
-            "{}: {} configurations, {} rows ({} rendered now), reference {} at {} spp",
-            o.report.display(),
-            o.configs.len(),
-            o.rows.len(),
-            o.rendered_rows,
-            study::config::integrator_name(o.reference.integrator),
-            o.reference.spp
-        );
-    }
-    Ok(())
-}
-
-#[derive(clap::Args)]
-struct BenchArgs {
-    /// Output directory for bench.csv, report.txt and the plots.
-    #[arg(short, long, default_value = "bench")]
-    output: PathBuf,
-    /// Sizes up to 80k triangles, 16k rays, short timing: under a minute.
-    #[arg(long)]
-    quick: bool,
-    /// Triangle counts, comma separated (1k, 16k, 1.3M; each becomes the
-    /// displaced sphere of 20·4^level triangles nearest to it).
-    #[arg(long, value_delimiter = ',', value_parser = lucent::tools::bench::parse_size)]
-    sizes: Vec<usize>,
-    /// Thread counts, comma separated (default: 1 and all cores).
-    #[arg(long, value_delimiter = ',', value_parser = lucent::tools::bench::parse_threads)]
-    threads: Vec<usize>,
-    /// Rays per query set (default 500000, quick 16384).
-    #[arg(long, value_parser = lucent::tools::bench::parse_rays)]
-    rays: Option<usize>,
-    /// Backends to measure: bvh | embree (the best available) | embree3 |
-    /// embree4 | both (every backend available; the default).
-    #[arg(long, value_enum)]
-    accel: Option<BenchAccelArg>,
-    /// Render this scene, record its ray queries and replay them on the bare
-    /// backend: end-to-end against raw ray rate (instead of the meshes).
-    #[arg(long, conflicts_with_all = ["quick", "sizes", "rays"])]
-    scene: Option<PathBuf>,
-    /// Samples per pixel of the scene's renders (with --scene; default 2).
-    #[arg(long, requires = "scene")]
-    spp: Option<u32>,
-    /// No progress bar.
-    #[arg(short, long)]
-    quiet: bool,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum BenchAccelArg {
-    Bvh,
-    Embree,
-    Embree3,
-    Embree4,
-    Both,
-}
-
-/// The backends `--accel` asks for, each concrete (`embree` resolved); one
-/// this process lacks is bad input, with why and how to get it.
-fn bench_backends(a: Option<BenchAccelArg>) -> Result<Vec<Backend>, Error> {
-    let want = match a {
-        None | Some(BenchAccelArg::Both) => return Ok(lucent::tools::bench::available_backends()),
-        Some(BenchAccelArg::Bvh) => Backend::Bvh,
-        Some(BenchAccelArg::Embree) => Backend::Embree,
-        Some(BenchAccelArg::Embree3) => Backend::Embree3,
-        Some(BenchAccelArg::Embree4) => Backend::Embree4,
-    };
-    Ok(vec![want.resolve()?])
-}
-
-fn run_bench(a: BenchArgs) -> Result<(), Error> {
-    use lucent::tools::bench;
-    let backends = bench_backends(a.accel)?;
-    if let Some(scene) = &a.scene {
-        let mut s = bench::replay::Settings::new(scene, &a.output);
-        s.spp = a.spp.unwrap_or(s.spp);
-        if !a.threads.is_empty() {
-            s.threads = a.threads;
-        }
-        s.backends = backends;
-        s.progress = !a.quiet;
-        let o = bench::replay::run(&s)?;
-        print!("{}", o.report);
-        if !a.quiet {
-            eprintln!("{} rows in {}", o.rows.len(), o.csv.display());
-        }
-        return Ok(());
-    }
-    let mut s = bench::Settings::new(&a.output, a.quick);
-    s.backends = backends;
-    if !a.sizes.is_empty() {
-        s.sizes = a.sizes;
-    }
-    if !a.threads.is_empty() {
-        s.threads = a.threads;
-    }
-    s.rays = a.rays.unwrap_or(s.rays);
-    s.progress = !a.quiet;
-    let o = bench::run(&s)?;
-    print!("{}", o.report);
-    if !a.quiet {
-        eprintln!(
-            "{} rows in {}; plots: {}",
-            o.rows.len(),
-            o.csv.display(),
-            o.plots
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    Ok(())
-}
-
-fn info() -> String {
-    let names: Vec<&str> = Backend::all_available().iter().map(|b| b.name()).collect();
-    let mut s = format!(
-        "lucent {}\nbackends: {}",
-        env!("CARGO_PKG_VERSION"),
-        names.join(", ")
-    );
-    for line in accel::embree_report() {
-        s.push('\n');
-        s.push_str(&line);
-    }
-    let default = Backend::default_available();
-    s.push_str(&format!("\ndefault backend: {}", default.name()));
-    if let Ok(b) = default.resolve() {
-        if b != default {
-            s.push_str(&format!(" ({})", b.name()));
-        }
-    }
-    s.push_str(if cfg!(feature = "subsurface") {
-        "\nsubsurface: yes"
-    } else {
-        "\nsubsurface: no (built without the `subsurface` feature)"
-    });
-    s
 }

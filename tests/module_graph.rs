@@ -1,7 +1,8 @@
-//! The layering of `src/`, checked from the source text: the modules form a
-//! directed acyclic graph, the subsurface math (`bssrdf`) knows nothing of
-//! ray queries, integrators or materials, and the renderer never reaches
-//! into the measuring tools.
+//! The layering of the library (`crates/lucent/src/`) and the measuring
+//! tools (`crates/lucent-tools/src/`), checked from the source text: the
+//! modules form a directed acyclic graph, the subsurface math (`bssrdf`)
+//! knows nothing of ray queries, integrators or materials, and the library
+//! depends on no command-line, plotting or progress-bar crate.
 //!
 //! An edge A → B is any path `crate::B…` written in a file of module A
 //! (imports and fully qualified paths alike, comments excluded), so a
@@ -253,8 +254,8 @@ fn non_test_code(text: &str) -> String {
     code
 }
 
-/// Top-level module of a file under src/: `src/bssrdf/probe.rs` → bssrdf,
-/// `src/render.rs` → render; None for the crate roots.
+/// Top-level module of a file under a crate's src/: `src/bssrdf/probe.rs`
+/// → bssrdf, `src/render.rs` → render; None for the crate roots.
 fn top_module(src: &Path, file: &Path) -> Option<String> {
     let rel = file.strip_prefix(src).unwrap();
     let first = rel.components().next()?.as_os_str().to_str()?.to_string();
@@ -311,12 +312,28 @@ fn find_cycle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>>
 
 struct Source {
     src: PathBuf,
+    /// Prefixed to paths relative to `src` in [`KNOTS`]: "" for the
+    /// library, "tools/" for the measuring tools.
+    label: &'static str,
     files: Vec<(PathBuf, String)>,
 }
 
 impl Source {
+    /// The library's modules.
     fn load() -> Self {
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        Source::load_crate("lucent", "")
+    }
+
+    /// The library's modules and the tools' (each crate on its own).
+    fn both() -> [Self; 2] {
+        [Source::load(), Source::load_crate("lucent-tools", "tools/")]
+    }
+
+    fn load_crate(name: &str, label: &'static str) -> Self {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("crates")
+            .join(name)
+            .join("src");
         let files = rust_files(&src)
             .into_iter()
             // a unit-test module kept in its own file (`probe/tests.rs`)
@@ -326,7 +343,7 @@ impl Source {
                 (f, non_test_code(&text))
             })
             .collect();
-        Source { src, files }
+        Source { src, label, files }
     }
 
     /// Top-level module → the top-level modules its files name.
@@ -396,7 +413,12 @@ fn the_scanner_reads_paths_groups_and_skips_comments_and_strings() {
 
 #[test]
 fn top_level_modules_form_a_dag() {
-    let s = Source::load();
+    for s in Source::both() {
+        top_level_modules_of_a_crate_form_a_dag(&s);
+    }
+}
+
+fn top_level_modules_of_a_crate_form_a_dag(s: &Source) {
     let g = s.top_graph();
     assert!(g.len() > 5, "scanned too few modules: {g:?}");
     if let Some(cycle) = find_cycle(&g) {
@@ -412,7 +434,8 @@ fn top_level_modules_form_a_dag() {
             })
             .collect();
         panic!(
-            "import cycle among modules of src/:\n  {}",
+            "import cycle among modules of {}:\n  {}",
+            s.src.display(),
             edges.join("\n  ")
         );
     }
@@ -420,7 +443,12 @@ fn top_level_modules_form_a_dag() {
 
 #[test]
 fn sibling_files_form_a_dag_in_every_folder() {
-    let s = Source::load();
+    for s in Source::both() {
+        sibling_files_of_a_crate_form_a_dag(&s);
+    }
+}
+
+fn sibling_files_of_a_crate_form_a_dag(s: &Source) {
     let mut by_dir: BTreeMap<PathBuf, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
     for (f, code) in &s.files {
         let stem = f.file_stem().unwrap().to_str().unwrap().to_string();
@@ -463,26 +491,28 @@ fn the_subsurface_math_knows_no_ray_queries_integrators_or_materials() {
     }
 }
 
+/// The mistake: the library depending on the command line's argument
+/// parser, the tools' plotting or a progress bar (a render reports its
+/// progress through `lucent::progress::Progress` instead).
 #[test]
-fn the_renderer_never_imports_the_measuring_tools() {
-    let s = Source::load();
-    let g = s.top_graph();
-    let tools = ["tools", "bench", "study", "plot"];
-    for (m, deps) in &g {
-        if tools.contains(&m.as_str()) {
-            continue;
-        }
-        for t in tools {
+fn the_library_depends_on_no_cli_plotting_or_progress_bar_crate() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/lucent/Cargo.toml");
+    let manifest = std::fs::read_to_string(&path).unwrap();
+    for (n, line) in manifest.lines().enumerate() {
+        let name = line.split(['=', '.']).next().unwrap_or("").trim();
+        for forbidden in ["clap", "plotters", "indicatif", "lucent-tools"] {
             assert!(
-                !deps.contains(t),
-                "renderer module `{m}` imports the measuring tool `{t}`: {}",
-                s.files_naming(m, t).join(", ")
+                name != forbidden,
+                "{}:{}: the library must not depend on `{forbidden}`",
+                path.display(),
+                n + 1
             );
         }
     }
 }
 
-/// Hubs (relative to src/) whose own code and children still use each
+/// Hubs (relative to the library's src/, or the tools' src/ as `tools/…`)
+/// whose own code and children still use each
 /// other: [`a_mod_rs_and_its_children_form_a_dag`] holds every other hub to
 /// the rule, and these to staying on this list only while knotted.
 const KNOTS: [&str; 6] = [
@@ -507,7 +537,6 @@ const KNOTS: [&str; 6] = [
 /// still be knotted (untie one, and the test asks to strike it off).
 #[test]
 fn a_mod_rs_and_its_children_form_a_dag() {
-    let s = Source::load();
     let parse = |text: &str| Hub::parse(&code_only(text));
     // The scanner on a hub's shape: declarations and re-exports are not
     // uses; code naming a child or a re-exported name is.
@@ -522,6 +551,25 @@ fn a_mod_rs_and_its_children_form_a_dag() {
     assert!(parse("pub mod a;\npub use a::A;\n").uses().is_empty());
     let mut bad = Vec::new();
     let mut knotted = BTreeSet::new();
+    for s in Source::both() {
+        hubs_of_a_crate(&s, &mut bad, &mut knotted);
+    }
+    let untied: Vec<_> = KNOTS.iter().filter(|k| !knotted.contains(**k)).collect();
+    assert!(
+        untied.is_empty(),
+        "no longer knotted, strike off KNOTS: {untied:?}"
+    );
+    assert!(
+        bad.is_empty(),
+        "a mod.rs and its children form a cycle:\n  {}",
+        bad.join("\n  ")
+    );
+}
+
+/// Adds to `bad` each `mod.rs` of `s` knotted with its children (outside
+/// [`KNOTS`]), and to `knotted` each hub of [`KNOTS`] still knotted.
+fn hubs_of_a_crate(s: &Source, bad: &mut Vec<String>, knotted: &mut BTreeSet<String>) {
+    let parse = |text: &str| Hub::parse(&code_only(text));
     for (f, code) in &s.files {
         if f.file_name().is_none_or(|n| n != "mod.rs") {
             continue;
@@ -557,7 +605,7 @@ fn a_mod_rs_and_its_children_form_a_dag() {
                 }
             }
         }
-        let rel = f.strip_prefix(&s.src).unwrap().display().to_string();
+        let rel = format!("{}{}", s.label, f.strip_prefix(&s.src).unwrap().display());
         match find_cycle(&g) {
             Some(_) if KNOTS.contains(&rel.as_str()) => {
                 knotted.insert(rel);
@@ -566,16 +614,6 @@ fn a_mod_rs_and_its_children_form_a_dag() {
             None => {}
         }
     }
-    let untied: Vec<_> = KNOTS.iter().filter(|k| !knotted.contains(**k)).collect();
-    assert!(
-        untied.is_empty(),
-        "no longer knotted, strike off KNOTS: {untied:?}"
-    );
-    assert!(
-        bad.is_empty(),
-        "a mod.rs and its children form a cycle:\n  {}",
-        bad.join("\n  ")
-    );
 }
 
 #[test]

@@ -11,7 +11,7 @@ fn rust_layout_matches_embree_headers() {
     use std::fmt::Write;
     use std::process::Command;
 
-    let include = env!("LUCENT_EMBREE_INCLUDE");
+    let include = lucent::accel::embree::ffi::INCLUDE_DIR;
     let table = lucent::accel::embree::ffi::layout_table();
     assert!(table.len() > 30, "layout table suspiciously short");
 

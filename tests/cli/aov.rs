@@ -1,4 +1,4 @@
-//! The passes (AOVs) the integrator measures (`src/integrator/aov/`),
+//! The passes (AOVs) the integrator measures (`crates/lucent/src/integrator/aov/`),
 //! through the scene loader and `render_passes`:
 //!
 //! - the light paths and the light groups each sum to the beauty, pixel by

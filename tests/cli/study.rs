@@ -10,8 +10,8 @@ use std::time::Instant;
 
 use lucent::film::Film;
 use lucent::materials::Material;
-use lucent::tools::study::results::Row;
-use lucent::tools::study::{self, config, Axis, Settings};
+use lucent_tools::study::results::Row;
+use lucent_tools::study::{self, config, Axis, Settings};
 
 use common::mean_se;
 
@@ -90,7 +90,7 @@ fn slab_exact_samplers_are_unbiased_and_outputs_exist() {
     // Exact samplers (analytic = baseline, mixture) and the tabulated
     // inverse at both sizes: |mean − A·CDF(Rmax)| within noise. lucent's
     // table divides by the table's own density, so unlike the course report's it is
-    // unbiased at every size (src/bssrdf/radius.rs).
+    // unbiased at every size (crates/lucent/src/bssrdf/radius.rs).
     for name in [
         "baseline",
         "radius=mixture",

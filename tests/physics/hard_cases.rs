@@ -6,7 +6,7 @@
 //! (`RenderStats::counters.nonfinite == 0`; the renderer drops NaN/inf
 //! samples, so a NaN would otherwise only show up as a darker pixel), every
 //! pixel is finite and ≥ 0, and every pixel is ≤ a stated bound. The bounds
-//! come from `ProbeAxes::Mis3`'s documented weight bound (src/bssrdf/probe.rs):
+//! come from `ProbeAxes::Mis3`'s documented weight bound (crates/lucent/src/bssrdf/probe.rs):
 //! one probe hit weighs at most 4√3 · n_active · A_max (/ CDF(Rmax) when
 //! renormalizing) times the number of distinct hits on the probe segment, and
 //! a distinct hit is a distinct triangle, so `total ≤ triangle count`. Under

@@ -810,8 +810,8 @@ fn diffuse_boundary_is_deterministic_across_thread_counts() {
 /// and applying its overrides sets it on every subsurface material.
 #[test]
 fn study_matrix_has_the_other_boundary() {
-    use lucent::tools::study::config::{apply, matrix};
-    use lucent::tools::study::Axis;
+    use lucent_tools::study::config::{apply, matrix};
+    use lucent_tools::study::Axis;
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slab-uniform.toml");
     let s = lucent::scene::load(&path).unwrap();
     let full = matrix(&s, false, &[Backend::Bvh]).unwrap();

@@ -456,7 +456,7 @@ fn a_study_refuses_a_directory_it_cannot_resume_before_writing_in_it() {
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slab-uniform.toml");
     let out = dir.path().join("study");
     fs::create_dir(&out).unwrap();
-    let header = lucent::tools::study::results::HEADER;
+    let header = lucent_tools::study::results::HEADER;
     for (csv, want) in [
         ("not,our,header\n1,2,3\n".to_string(), "unexpected header"),
         (

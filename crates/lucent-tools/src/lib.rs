@@ -1,0 +1,30 @@
+//! lucent's measuring tools: what the renderer costs and how accurate it
+//! is, in a crate of their own so the renderer library reads (and builds)
+//! without them.
+//!
+//! - [`bench`](mod@bench) (`lucent bench`): the ray-query backends side by side on
+//!   generated meshes and ray sets, and (`--scene`) a render's own queries
+//!   recorded and replayed on the bare backend.
+//! - [`study`] (`lucent study`): the subsurface estimator's sampling
+//!   choices rendered at a ladder of sample counts against a long
+//!   reference: error against time.
+//! - [`halfspace`]: the albedo table's generator — the random walk's
+//!   physics in a plane-parallel half-space (`docs/bssrdf.md` §9).
+//! - [`sphere_albedo`]: the curvature table's generator — the same physics
+//!   in a sphere, against the half-space (`docs/bssrdf.md` §10).
+//! - [`plot`]: the PNG canvas, font, palette and log axes both draw with.
+//! - [`progress`]: a render's [`lucent::progress::Progress`] drawn as a bar
+//!   on stderr (indicatif).
+//!
+//! The tools use the renderer, never the other way round: the library
+//! `lucent` does not depend on this crate.
+
+pub mod bench;
+#[cfg(feature = "subsurface")]
+pub mod halfspace;
+pub mod plot;
+pub mod progress;
+#[cfg(feature = "subsurface")]
+pub mod sphere_albedo;
+#[cfg(feature = "subsurface")]
+pub mod study;

@@ -1,0 +1,495 @@
+//! The configuration matrix of a study: a baseline and, for every sampling
+//! choice of the subsurface estimator, variations that change that one
+//! choice and nothing else (one axis at a time, not the cross product: the
+//! cross product of the axes below is thousands of renders, and the axes
+//! interact little enough that one-at-a-time answers "what does this choice
+//! cost and buy").
+//!
+//! A configuration is applied by rebuilding every subsurface material of
+//! the scene with the new options ([`apply`]); the ray-query backend and the
+//! integrator are chosen at render time.
+
+use lucent::accel::Backend;
+use lucent::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, RadiusSampler, TableSpacing};
+use lucent::integrator::IntegratorKind;
+use lucent::materials::{LodMode, Material, WalkBoundary};
+use lucent::scene::Scene;
+
+/// Which choice a configuration varies from the baseline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Axis {
+    Baseline,
+    Radius,
+    RmaxQuantile,
+    Axes,
+    Channel,
+    Renormalize,
+    ExitSw,
+    Specular,
+    Backend,
+    Integrator,
+    /// The random walk with the diffuse Fresnel boundary (another model).
+    Boundary,
+    /// Subsurface level of detail off (the baseline keeps the scene's,
+    /// `auto` by default; `lucent::materials::lod`).
+    Lod,
+    /// The variance reduction at the camera vertex: the scene's (by
+    /// default the plane control variate, which the baseline keeps)
+    /// against the others of none, the control variate, the antithetic
+    /// probe pair and both
+    /// (`lucent::integrator::control_variate`).
+    Variance,
+}
+
+impl Axis {
+    pub const ALL: [Axis; 13] = [
+        Axis::Baseline,
+        Axis::Radius,
+        Axis::RmaxQuantile,
+        Axis::Axes,
+        Axis::Channel,
+        Axis::Renormalize,
+        Axis::ExitSw,
+        Axis::Specular,
+        Axis::Backend,
+        Axis::Integrator,
+        Axis::Boundary,
+        Axis::Lod,
+        Axis::Variance,
+    ];
+
+    /// The name used in configuration names and the CSV.
+    pub fn name(self) -> &'static str {
+        match self {
+            Axis::Baseline => "baseline",
+            Axis::Radius => "radius",
+            Axis::RmaxQuantile => "rmax",
+            Axis::Axes => "axes",
+            Axis::Channel => "channel",
+            Axis::Renormalize => "renormalize",
+            Axis::ExitSw => "exit_sw",
+            Axis::Specular => "specular",
+            Axis::Backend => "backend",
+            Axis::Integrator => "integrator",
+            Axis::Boundary => "boundary",
+            Axis::Lod => "lod",
+            Axis::Variance => "variance",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Axis> {
+        Axis::ALL.into_iter().find(|a| a.name() == s)
+    }
+}
+
+/// Sampling choices for every subsurface material; `None` keeps the
+/// material's own setting (the same overrides `lucent render` takes).
+pub use lucent::materials::SubsurfaceOverrides as Overrides;
+
+/// One row group of the study: what is rendered and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    /// Unique, stable name: "baseline" or "axis=value"; the CSV key.
+    pub name: String,
+    pub axis: Axis,
+    /// The varied value as text (the baseline's own value on the baseline).
+    pub value: String,
+    pub overrides: Overrides,
+    pub backend: Backend,
+    pub integrator: IntegratorKind,
+}
+
+/// "uniform", "table:N" (tail-spaced), "table-uniform:N", "analytic",
+/// "mixture": the names [`RadiusSampler::parse`] reads.
+pub(crate) fn radius_name(r: RadiusSampler) -> String {
+    r.name()
+}
+
+pub(crate) fn integrator_name(i: IntegratorKind) -> &'static str {
+    match i {
+        IntegratorKind::Path => "diffusion",
+        IntegratorKind::RandomWalk => "randomwalk",
+    }
+}
+
+pub(crate) fn parse_integrator(s: &str) -> Option<IntegratorKind> {
+    match s {
+        "diffusion" | "path" => Some(IntegratorKind::Path),
+        "randomwalk" | "random-walk" => Some(IntegratorKind::RandomWalk),
+        _ => None,
+    }
+}
+
+fn axes_name(a: ProbeAxes) -> &'static str {
+    a.name()
+}
+
+fn channel_name(c: ChannelStrategy) -> &'static str {
+    c.name()
+}
+
+/// The baseline's probe options: the recommended defaults (exact analytic
+/// radius sampling, N/T/B probes with MIS, all channels per sample, Rmax at
+/// the 0.999 quantile, no renormalization).
+pub(crate) fn baseline_probe() -> ProbeOptions {
+    ProbeOptions::default()
+}
+
+/// The Rmax quantile of the diffusion reference: far enough out that the
+/// truncation of the configurations (0.999 by default) shows as bias.
+pub(crate) const REFERENCE_RMAX_QUANTILE: f64 = 0.99999;
+
+fn full_probe(o: ProbeOptions) -> Overrides {
+    Overrides {
+        radius: Some(o.radius),
+        rmax_quantile: Some(o.rmax_quantile),
+        axes: Some(o.axes),
+        channel: Some(o.channel),
+        renormalize: Some(o.renormalize),
+        exit_sw: None,
+        specular: None,
+        boundary: None,
+        roughness: None,
+        lod: None,
+        // the scene's own variance reduction (the variance axis varies it)
+        control_variate: None,
+        probe_pair: None,
+    }
+}
+
+/// The overrides of the diffusion reference: the exact sampler, MIS axes
+/// and channels, Rmax at [`REFERENCE_RMAX_QUANTILE`], no level of detail
+/// (the full estimator at every hit); Fresnel choices are the scene's (they
+/// change the model, not the estimator).
+pub(crate) fn reference_overrides() -> Overrides {
+    Overrides {
+        lod: Some(LodMode::Off),
+        ..full_probe(ProbeOptions {
+            rmax_quantile: REFERENCE_RMAX_QUANTILE,
+            ..baseline_probe()
+        })
+    }
+}
+
+/// The first subsurface material's (exit_sw, specular): the scene's model
+/// choices, which the baseline keeps and the Fresnel axes flip.
+fn scene_fresnel(scene: &Scene) -> Option<(bool, bool)> {
+    scene.materials.iter().find_map(|m| match m {
+        Material::Subsurface(ss) => Some((ss.exit_sw(), ss.specular())),
+        _ => None,
+    })
+}
+
+/// The first subsurface material's (control_variate, probe_pair).
+fn scene_variance(scene: &Scene) -> (bool, bool) {
+    scene
+        .materials
+        .iter()
+        .find_map(|m| match m {
+            Material::Subsurface(ss) => Some((ss.control_variate(), ss.probe_pair())),
+            _ => None,
+        })
+        .unwrap_or((true, false))
+}
+
+/// The first subsurface material's random-walk boundary.
+fn scene_boundary(scene: &Scene) -> WalkBoundary {
+    scene
+        .materials
+        .iter()
+        .find_map(|m| match m {
+            Material::Subsurface(ss) => Some(ss.boundary()),
+            _ => None,
+        })
+        .unwrap_or_default()
+}
+
+/// The configurations being built: the baseline first, then one per value
+/// of each axis in the order they are added.
+struct Matrix {
+    out: Vec<Config>,
+    /// The baseline's overrides, which every variation starts from.
+    base: Overrides,
+    base_backend: Backend,
+}
+
+impl Matrix {
+    fn add(
+        &mut self,
+        axis: Axis,
+        value: String,
+        ov: Overrides,
+        backend: Backend,
+        integrator: IntegratorKind,
+    ) {
+        self.out.push(Config {
+            name: format!("{}={value}", axis.name()),
+            axis,
+            value,
+            overrides: ov,
+            backend,
+            integrator,
+        });
+    }
+
+    /// A variation of the estimator: other overrides, the baseline's
+    /// backend, the path tracer.
+    fn vary(&mut self, axis: Axis, value: String, ov: Overrides) {
+        let backend = self.base_backend;
+        self.add(axis, value, ov, backend, IntegratorKind::Path);
+    }
+}
+
+/// The radius samplers of the radius axis.
+fn radius_values(quick: bool) -> Vec<RadiusSampler> {
+    let tu = |size| RadiusSampler::Table {
+        size,
+        spacing: TableSpacing::Uniform,
+    };
+    let tt = |size| RadiusSampler::Table {
+        size,
+        spacing: TableSpacing::Tail,
+    };
+    if quick {
+        vec![
+            RadiusSampler::Uniform,
+            tu(16),
+            tu(1024),
+            RadiusSampler::Mixture,
+        ]
+    } else {
+        vec![
+            RadiusSampler::Uniform,
+            tu(16),
+            tu(64),
+            tu(256),
+            tu(1024),
+            tt(16),
+            tt(256),
+            tt(1024),
+            RadiusSampler::Mixture,
+        ]
+    }
+}
+
+/// The configurations of a study of `scene`. `quick` keeps a few values per
+/// axis (enough for the ordering facts the tests check). `backends[0]` is
+/// the baseline's backend; each further one gets a backend row.
+pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Config>, String> {
+    let (exit_sw, specular) =
+        scene_fresnel(scene).ok_or("the scene has no subsurface material: nothing to study")?;
+    let base_probe = baseline_probe();
+    let base_backend = backends[0];
+    let mut base_ov = full_probe(base_probe);
+    base_ov.exit_sw = Some(exit_sw);
+    base_ov.specular = Some(specular);
+    let mut m = Matrix {
+        out: vec![Config {
+            name: "baseline".into(),
+            axis: Axis::Baseline,
+            value: String::new(),
+            overrides: base_ov,
+            backend: base_backend,
+            integrator: IntegratorKind::Path,
+        }],
+        base: base_ov,
+        base_backend,
+    };
+    for r in radius_values(quick) {
+        m.vary(
+            Axis::Radius,
+            radius_name(r),
+            Overrides {
+                radius: Some(r),
+                ..m.base
+            },
+        );
+    }
+    let quantiles: &[f64] = if quick {
+        &[0.99]
+    } else {
+        &[0.9, 0.99, 0.997, 0.9999]
+    };
+    for &q in quantiles {
+        m.vary(
+            Axis::RmaxQuantile,
+            format!("{q}"),
+            Overrides {
+                rmax_quantile: Some(q),
+                ..m.base
+            },
+        );
+    }
+    // every other axis rule (normal-only and mis3 for the default)
+    for other_axes in ProbeAxes::ALL.into_iter().filter(|&a| a != base_probe.axes) {
+        m.vary(
+            Axis::Axes,
+            axes_name(other_axes).into(),
+            Overrides {
+                axes: Some(other_axes),
+                ..m.base
+            },
+        );
+    }
+    let other_channel = match base_probe.channel {
+        ChannelStrategy::Single => ChannelStrategy::Mis,
+        ChannelStrategy::Mis => ChannelStrategy::Single,
+    };
+    m.vary(
+        Axis::Channel,
+        channel_name(other_channel).into(),
+        Overrides {
+            channel: Some(other_channel),
+            ..m.base
+        },
+    );
+    if !quick {
+        let r = !base_probe.renormalize;
+        m.vary(
+            Axis::Renormalize,
+            r.to_string(),
+            Overrides {
+                renormalize: Some(r),
+                ..m.base
+            },
+        );
+    }
+    m.vary(
+        Axis::ExitSw,
+        (!exit_sw).to_string(),
+        Overrides {
+            exit_sw: Some(!exit_sw),
+            ..m.base
+        },
+    );
+    if !quick {
+        m.vary(
+            Axis::Specular,
+            (!specular).to_string(),
+            Overrides {
+                specular: Some(!specular),
+                ..m.base
+            },
+        );
+    }
+    // Level of detail off: what the probe estimator costs where the
+    // baseline shades with albedo A (the same configuration when LOD never
+    // triggers).
+    m.vary(
+        Axis::Lod,
+        LodMode::Off.name().into(),
+        Overrides {
+            lod: Some(LodMode::Off),
+            ..m.base
+        },
+    );
+    // The variance reduction at the camera vertex, each choice other than
+    // the scene's (the default: the control variate alone); the quick
+    // study keeps the pair.
+    let own = scene_variance(scene);
+    let variance: &[(&str, bool, bool)] = if quick {
+        &[("pair", false, true)]
+    } else {
+        &[
+            ("none", false, false),
+            ("control-variate", true, false),
+            ("pair", false, true),
+            ("pair+control-variate", true, true),
+        ]
+    };
+    for &(name, cv, pair) in variance.iter().filter(|v| (v.1, v.2) != own) {
+        m.vary(
+            Axis::Variance,
+            name.into(),
+            Overrides {
+                control_variate: Some(cv),
+                probe_pair: Some(pair),
+                ..m.base
+            },
+        );
+    }
+    for &b in &backends[1..] {
+        m.add(
+            Axis::Backend,
+            b.name().into(),
+            base_ov,
+            b,
+            IntegratorKind::Path,
+        );
+    }
+    m.add(
+        Axis::Integrator,
+        integrator_name(IntegratorKind::RandomWalk).into(),
+        base_ov,
+        base_backend,
+        IntegratorKind::RandomWalk,
+    );
+    if !quick {
+        // The random walk with the other boundary model (the scene's own is
+        // in the integrator row): a different model, so its "bias" against
+        // a random-walk reference of the scene's boundary is the models'
+        // difference.
+        let other = match scene_boundary(scene) {
+            WalkBoundary::Dielectric => WalkBoundary::Diffuse { exit_nee: true },
+            WalkBoundary::Diffuse { .. } => WalkBoundary::Dielectric,
+        };
+        m.add(
+            Axis::Boundary,
+            other.name().into(),
+            Overrides {
+                boundary: Some(other),
+                ..base_ov
+            },
+            base_backend,
+            IntegratorKind::RandomWalk,
+        );
+    }
+    Ok(m.out)
+}
+
+/// `scene` with every subsurface material rebuilt with `ov` applied to its
+/// own options (its medium parameters unchanged).
+pub fn apply(scene: &Scene, ov: &Overrides) -> Result<Scene, String> {
+    let mut out = scene.clone();
+    ov.apply_all(&mut out.materials)?;
+    Ok(out)
+}
+
+/// A one-line description of overrides for the report.
+pub(crate) fn describe(ov: &Overrides) -> String {
+    let mut parts = Vec::new();
+    if let Some(r) = ov.radius {
+        parts.push(format!("radius {}", radius_name(r)));
+    }
+    if let Some(q) = ov.rmax_quantile {
+        parts.push(format!("Rmax quantile {q}"));
+    }
+    if let Some(a) = ov.axes {
+        parts.push(format!("axes {}", axes_name(a)));
+    }
+    if let Some(c) = ov.channel {
+        parts.push(format!("channel {}", channel_name(c)));
+    }
+    if let Some(r) = ov.renormalize {
+        parts.push(format!("renormalize {r}"));
+    }
+    if let Some(e) = ov.exit_sw {
+        parts.push(format!("exit_sw {e}"));
+    }
+    if let Some(s) = ov.specular {
+        parts.push(format!("specular {s}"));
+    }
+    if let Some(b) = ov.boundary {
+        parts.push(format!("random-walk boundary {}", b.name()));
+    }
+    if let Some(l) = ov.lod {
+        parts.push(format!("level of detail {}", l.name()));
+    }
+    if let Some(c) = ov.control_variate {
+        parts.push(format!("control variate {c}"));
+    }
+    if let Some(p) = ov.probe_pair {
+        parts.push(format!("probe pair {p}"));
+    }
+    parts.join(", ")
+}

@@ -1,0 +1,214 @@
+//! `results.csv`: one row per (configuration, sample count), the study's
+//! durable state. Rows are appended and flushed to disk one at a time, so an
+//! interrupted study loses at most the row being rendered; on restart the
+//! file is read back, a torn last line is dropped (the valid rows are
+//! rewritten atomically first) and only missing rows are rendered.
+
+use std::fs::{self, File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use lucent::film::atomic_write;
+
+pub const HEADER: &str =
+    "config,axis,value,backend,integrator,spp,seconds,rmse,relmse,bias,bias_stderr,fireflies";
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub config: String,
+    pub axis: String,
+    pub value: String,
+    pub backend: String,
+    pub integrator: String,
+    pub spp: u32,
+    /// Wall-clock render time of all samples up to this count.
+    pub seconds: f64,
+    pub rmse: f64,
+    pub rel_mse: f64,
+    pub bias: f64,
+    pub bias_stderr: f64,
+    pub fireflies: u64,
+}
+
+impl Row {
+    fn to_line(&self) -> String {
+        // `{}` prints the shortest decimal that reads back to the same f64.
+        format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{}",
+            self.config,
+            self.axis,
+            self.value,
+            self.backend,
+            self.integrator,
+            self.spp,
+            self.seconds,
+            self.rmse,
+            self.rel_mse,
+            self.bias,
+            self.bias_stderr,
+            self.fireflies
+        )
+    }
+
+    fn parse(line: &str) -> Option<Row> {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() != 12 {
+            return None;
+        }
+        Some(Row {
+            config: f[0].into(),
+            axis: f[1].into(),
+            value: f[2].into(),
+            backend: f[3].into(),
+            integrator: f[4].into(),
+            spp: f[5].parse().ok()?,
+            seconds: f[6].parse().ok()?,
+            rmse: f[7].parse().ok()?,
+            rel_mse: f[8].parse().ok()?,
+            bias: f[9].parse().ok()?,
+            bias_stderr: f[10].parse().ok()?,
+            fireflies: f[11].parse().ok()?,
+        })
+    }
+}
+
+/// The results file of a study directory, open for appending.
+#[derive(Debug)]
+pub(crate) struct Results {
+    path: PathBuf,
+    rows: Vec<Row>,
+    file: File,
+}
+
+impl Results {
+    /// Opens `path`, reading the rows already there. A file with another
+    /// header is an error (it is not ours to overwrite); unparseable lines
+    /// (a row torn by an interruption) are dropped.
+    pub fn open(path: &Path) -> Result<Results, String> {
+        let rows = Self::read(path)?;
+        // Rewrite what was valid, so appends start after a complete line.
+        let mut text = format!("{HEADER}\n");
+        for r in &rows {
+            text.push_str(&r.to_line());
+            text.push('\n');
+        }
+        atomic_write(path, |tmp| fs::write(tmp, &text).map_err(|e| e.to_string()))?;
+        let file = OpenOptions::new()
+            .append(true)
+            .open(path)
+            .map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+        Ok(Results {
+            path: path.to_path_buf(),
+            rows,
+            file,
+        })
+    }
+
+    /// The rows of the results file at `path` (none if there is no file),
+    /// or why it cannot be resumed; reads only, so a study can refuse a
+    /// directory before it writes anything in it.
+    pub fn read(path: &Path) -> Result<Vec<Row>, String> {
+        let mut rows = Vec::new();
+        if path.exists() {
+            let text = fs::read_to_string(path)
+                .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+            let mut lines = text.lines();
+            match lines.next() {
+                Some(h) if h.trim_end() == HEADER => {}
+                None => {}
+                Some(h) => {
+                    return Err(format!(
+                        "{}: unexpected header \"{h}\"; not a results file of this version of lucent study \
+                         (move it away or choose another output directory)",
+                        path.display()
+                    ))
+                }
+            }
+            rows.extend(lines.filter_map(Row::parse));
+        }
+        Ok(rows)
+    }
+
+    pub fn rows(&self) -> &[Row] {
+        &self.rows
+    }
+
+    pub fn get(&self, config: &str, spp: u32) -> Option<&Row> {
+        self.rows
+            .iter()
+            .find(|r| r.config == config && r.spp == spp)
+    }
+
+    /// Appends one row and flushes it to disk before returning.
+    pub(crate) fn append(&mut self, row: Row) -> Result<(), String> {
+        for s in [
+            &row.config,
+            &row.axis,
+            &row.value,
+            &row.backend,
+            &row.integrator,
+        ] {
+            if s.contains(',') || s.contains('\n') {
+                return Err(format!("results: field \"{s}\" contains a separator"));
+            }
+        }
+        let line = format!("{}\n", row.to_line());
+        self.file
+            .write_all(line.as_bytes())
+            .and_then(|()| self.file.sync_data())
+            .map_err(|e| format!("cannot append to {}: {e}", self.path.display()))?;
+        self.rows.push(row);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(config: &str, spp: u32) -> Row {
+        Row {
+            config: config.into(),
+            axis: "radius".into(),
+            value: "table:16".into(),
+            backend: "bvh".into(),
+            integrator: "diffusion".into(),
+            spp,
+            seconds: 0.1 + spp as f64 / 3.0,
+            rmse: 1.0 / 3.0,
+            rel_mse: 1e-7,
+            bias: -0.000123456789,
+            bias_stderr: 2.5e-5,
+            fireflies: 7,
+        }
+    }
+
+    #[test]
+    fn rows_round_trip_and_torn_lines_are_dropped() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("results.csv");
+        {
+            let mut r = Results::open(&p).unwrap();
+            r.append(row("radius=table:16", 1)).unwrap();
+            r.append(row("radius=table:16", 2)).unwrap();
+            assert!(r.append(row("a,b", 4)).is_err());
+        }
+        // simulate an interruption in the middle of a row
+        let mut f = OpenOptions::new().append(true).open(&p).unwrap();
+        f.write_all(b"radius=table:16,radius,table:16,bvh,diff")
+            .unwrap();
+        drop(f);
+        let mut r = Results::open(&p).unwrap();
+        assert_eq!(
+            r.rows(),
+            &[row("radius=table:16", 1), row("radius=table:16", 2)]
+        );
+        assert!(r.get("radius=table:16", 2).is_some() && r.get("radius=table:16", 4).is_none());
+        r.append(row("x", 4)).unwrap();
+        let text = fs::read_to_string(&p).unwrap();
+        assert_eq!(text.lines().count(), 4);
+        assert!(text.ends_with('\n'));
+        fs::write(&p, "something,else\n").unwrap();
+        assert!(Results::open(&p).unwrap_err().contains("unexpected header"));
+    }
+}

@@ -1,0 +1,160 @@
+//! Resuming a study: nothing already rendered is rendered again.
+//!
+//! The running mean after each rung of a configuration's ladder is kept in
+//! `DIR/state/<config>-<spp>.exr` (only the last finished rung's, also
+//! after the last rung, so a rerun with a larger `max_spp` extends the
+//! ladder); a configuration resumes after the last rung whose CSV row and
+//! running mean both exist and below which every row exists. Rows are
+//! only resumed under the settings that made them ([`check_results_key`]).
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use super::config::{self, Config};
+use super::reference::ReferenceInfo;
+use super::results::Results;
+use super::runtime;
+use super::settings::Settings;
+use lucent::film::{self, Film};
+use lucent::scene::Scene;
+use lucent::Error;
+
+/// A configuration name as a file name: "radius=table:16" → "radius_table_16".
+pub fn slug(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Where the running mean of `config` after `spp` samples is kept.
+pub(super) fn state_path(dir: &Path, config: &str, spp: u32) -> PathBuf {
+    dir.join("state")
+        .join(format!("{}-{spp}.exr", slug(config)))
+}
+
+/// Rows in `results.csv` are only comparable (and only resumable) under the
+/// settings that made them: the same reference (which covers the scene,
+/// resolution and reference settings), base seed and firefly factor. They
+/// are recorded in `DIR/results.key` next to the CSV; a directory holding
+/// rows made under other settings is refused rather than mixed. Thread
+/// count, ladder length and the axis filter may change between runs.
+///
+/// Only reads: [`write_results_key`] records the key once the reference
+/// exists. A study checks this before it writes anything, so a directory
+/// it refuses is left as it was.
+pub(super) fn check_results_key(
+    s: &Settings,
+    reference_hash: u64,
+    seed: u64,
+    scene: &Scene,
+) -> Result<(), Error> {
+    let key = results_key(s, reference_hash, seed, scene);
+    let key_path = s.out_dir.join("results.key");
+    let csv = s.out_dir.join("results.csv");
+    let has_rows = fs::read_to_string(&csv)
+        .map(|t| t.lines().count() > 1)
+        .unwrap_or(false);
+    match fs::read_to_string(&key_path) {
+        Ok(old) if old == key => return Ok(()),
+        Ok(old) if has_rows => {
+            return Err(Error::Input(format!(
+                "{} holds results made with other settings ({}), not ({}); choose another output directory",
+                csv.display(),
+                old.trim(),
+                key.trim()
+            )))
+        }
+        Err(_) if has_rows => {
+            return Err(Error::Input(format!(
+                "{} has rows but no results.key: cannot tell which settings made them; choose another output directory",
+                csv.display()
+            )))
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// The line `results.key` holds for these settings.
+fn results_key(s: &Settings, reference_hash: u64, seed: u64, scene: &Scene) -> String {
+    format!(
+        "reference={reference_hash:016x} seed={seed} firefly_k={} resolution={}x{}\n",
+        s.firefly_k, scene.camera.width, scene.camera.height
+    )
+}
+
+/// Records the settings of the rows in `results.csv` (see
+/// [`check_results_key`]).
+pub(super) fn write_results_key(
+    s: &Settings,
+    r: &ReferenceInfo,
+    seed: u64,
+    scene: &Scene,
+) -> Result<(), Error> {
+    let key = results_key(s, r.hash, seed, scene);
+    let key_path = s.out_dir.join("results.key");
+    if fs::read_to_string(&key_path).is_ok_and(|old| old == key) {
+        return Ok(());
+    }
+    film::atomic_write(&key_path, |tmp| {
+        fs::write(tmp, &key).map_err(|e| e.to_string())
+    })
+    .map_err(runtime)
+}
+
+/// One configuration still to render: where it resumes, and its running
+/// mean so far.
+pub(super) struct Job<'c> {
+    pub(super) config: &'c Config,
+    /// The scene with the configuration's overrides applied.
+    pub(super) scene: Scene,
+    /// Index of the first rung to render.
+    pub(super) start: usize,
+    /// The running mean after rung `start - 1` and its cumulative seconds.
+    pub(super) acc: Option<(Film, f64)>,
+}
+
+/// The configurations with rungs left to render, each with its resume
+/// point.
+pub(super) fn jobs<'c>(
+    s: &Settings,
+    scene: &Scene,
+    configs: &'c [Config],
+    spps: &[u32],
+    results: &Results,
+) -> Result<Vec<Job<'c>>, Error> {
+    let mut jobs = Vec::new();
+    for c in configs {
+        if spps.iter().all(|&n| results.get(&c.name, n).is_some()) {
+            continue;
+        }
+        // Resume from the last rung whose row and running mean both exist
+        // and below which every row exists.
+        let (mut start, mut acc) = (0, None);
+        for (j, &n) in spps.iter().enumerate() {
+            let Some(row) = results.get(&c.name, n) else {
+                break;
+            };
+            if let Ok(f) = Film::read_exr(&state_path(&s.out_dir, &c.name, n)) {
+                if (f.width, f.height) == (scene.camera.width, scene.camera.height) {
+                    start = j + 1;
+                    acc = Some((f, row.seconds));
+                }
+            }
+        }
+        let scene = config::apply(scene, &c.overrides).map_err(Error::Input)?;
+        jobs.push(Job {
+            config: c,
+            scene,
+            start,
+            acc,
+        });
+    }
+    Ok(jobs)
+}

@@ -1,0 +1,421 @@
+//! The subsurface material: a smooth dielectric boundary over a medium whose
+//! multiple scattering is the Christensen–Burley normalized-diffusion
+//! profile (see [`crate::bssrdf`] and `docs/bssrdf.md`).
+//!
+//! Following a camera path, light leaves the object at xo (where the path
+//! arrives) after entering at xi (found by a probe ray). The separable
+//! BSSRDF splits into
+//!
+//!   S(xi, ωi; xo, ωo) = Ft(xo, ωo) · Rd(|xo − xi|) · Sw(ωi)
+//!
+//! where Ft = 1 − Fr is always applied at xo, optionally as the complement
+//! of a specular reflection layer, and the lobe at xi is either the
+//! normalized Fresnel lobe Sw (pbrt-v3 §11.4) or a plain cosine lobe 1/π.
+//!
+//! **The coat.** The boundary is smooth (`roughness` = 0, a mirror) or a
+//! rough GGX dielectric ([`super::microfacet`], α = roughness²). For a rough
+//! coat, Fr(μo) becomes the coat's directional albedo E(μo): the coat
+//! reflects with its microfacet BRDF, and 1 − E(μo) of the light enters
+//! the medium; the entry lobe becomes (1 − E(μi)) / ((1 − Ē) π) with
+//! Ē = 2 ∫ E μ dμ, so that S stays reciprocal and the lobe integrates to 1
+//! against cos θ. A white medium (A = 1) under a coat therefore reflects
+//! E + (1 − E) = 1 of uniform light (`docs/bssrdf.md` §6). `specular`
+//! says whether the coat's reflection is rendered; without it the path is
+//! weighted by the transmitted fraction (1 − Fr or 1 − E) and the reflected
+//! light is lost, for either roughness.
+
+use super::estimator_options::{CurvatureMode, EstimatorOptions, WalkBoundary, OPTIONS};
+use super::lod::{LodMode, LodRule};
+use super::microfacet::{alpha_from_roughness, RoughCoat, SMOOTH_ALPHA};
+use crate::bssrdf::curvature_correction::CurvatureCorrection;
+use crate::bssrdf::{sw_normalization, ProbeOptions, ProbeSampler, SubsurfaceParams};
+use crate::error::{Constraint, Param, ParamError};
+use crate::geometry::Vec3;
+
+/// A subsurface material: its medium, its sampling options and what is
+/// derived from them once (the probe sampler, the coat, the curvature
+/// correction, the LOD rule), private so that they cannot disagree.
+#[derive(Clone, Debug)]
+pub struct Subsurface {
+    params: SubsurfaceParams,
+    options: EstimatorOptions,
+    probe: ProbeSampler,
+    /// The rough coat, when α ≥ [`SMOOTH_ALPHA`]; None: the smooth one.
+    coat: Option<RoughCoat>,
+    /// c = 1 − 2 FM1(1/η), Sw's normalization (for a rough coat, 1 − Ē).
+    sw_c: f32,
+    /// The correction, when the mode is on and the parameters record a
+    /// medium.
+    curvature: Option<CurvatureCorrection>,
+    /// The level-of-detail rule ([`super::lod`]).
+    lod: LodRule,
+}
+
+impl PartialEq for Subsurface {
+    fn eq(&self, o: &Self) -> bool {
+        self.params == o.params && self.options == o.options
+    }
+}
+
+impl Subsurface {
+    /// The material of medium `params` sampled with `options`, everything
+    /// derived from them built (an option out of its domain is refused).
+    pub(crate) fn from_options(
+        params: SubsurfaceParams,
+        options: &EstimatorOptions,
+    ) -> Result<Self, ParamError> {
+        let roughness = options.roughness;
+        if !(0.0..=1.0).contains(&roughness) {
+            return Err(ParamError::new(
+                Param::Roughness,
+                roughness,
+                Constraint::UnitInterval,
+            ));
+        }
+        let probe = ProbeSampler::new(&params, &options.probe)?;
+        let curvature = curvature_for(&params, &probe, options.curvature);
+        let lod = LodRule::new(
+            options.lod,
+            options.lod_threshold,
+            probe.rmax(),
+            probe.planar_reflectance(),
+        );
+        let alpha = alpha_from_roughness(roughness);
+        let coat = (alpha >= SMOOTH_ALPHA).then(|| RoughCoat::new(alpha, params.eta));
+        let sw_c = match &coat {
+            Some(c) => 1.0 - c.mean_albedo(),
+            None => sw_normalization(params.eta),
+        };
+        Ok(Subsurface {
+            params,
+            options: *options,
+            probe,
+            coat,
+            sw_c,
+            curvature,
+            lod,
+        })
+    }
+
+    /// The material with probe options `opts`, the lobe `exit_sw` and the
+    /// coat's reflection `specular`; every other option its default.
+    pub fn new(
+        params: SubsurfaceParams,
+        opts: &ProbeOptions,
+        exit_sw: bool,
+        specular: bool,
+    ) -> Result<Self, ParamError> {
+        let options = EstimatorOptions {
+            probe: *opts,
+            exit_sw,
+            specular,
+            ..EstimatorOptions::default()
+        };
+        Self::from_options(params, &options)
+    }
+
+    /// The same medium sampled with `options`.
+    pub fn with_options(&self, options: &EstimatorOptions) -> Result<Self, ParamError> {
+        Self::from_options(self.params, options)
+    }
+
+    /// The material with level-of-detail `mode` and footprint-to-Rmax
+    /// `threshold` (finite, > 0; the scene loader checks it).
+    pub fn with_lod(self, mode: LodMode, threshold: f32) -> Self {
+        let options = EstimatorOptions {
+            lod: mode,
+            lod_threshold: threshold,
+            ..self.options
+        };
+        self.with_options(&options)
+            .expect("options already accepted")
+    }
+
+    /// The material with the curvature correction `mode`.
+    pub fn with_curvature_mode(self, mode: CurvatureMode) -> Self {
+        let options = EstimatorOptions {
+            curvature: mode,
+            ..self.options
+        };
+        self.with_options(&options)
+            .expect("options already accepted")
+    }
+
+    /// The material with a coat of `roughness` ∈ [0, 1] (NaN is refused);
+    /// below α = [`SMOOTH_ALPHA`] the coat is the smooth one.
+    pub fn with_roughness(self, roughness: f32) -> Result<Self, ParamError> {
+        let options = EstimatorOptions {
+            roughness,
+            ..self.options
+        };
+        self.with_options(&options)
+    }
+
+    /// The medium's parameters.
+    #[inline]
+    pub fn params(&self) -> &SubsurfaceParams {
+        &self.params
+    }
+
+    /// Every sampling option.
+    #[inline]
+    pub fn options(&self) -> &EstimatorOptions {
+        &self.options
+    }
+
+    /// The probe sampler.
+    #[inline]
+    pub fn probe(&self) -> &ProbeSampler {
+        &self.probe
+    }
+
+    /// Whether the entry point's lobe is the normalized Fresnel lobe Sw
+    /// (else 1/π).
+    #[inline]
+    pub fn exit_sw(&self) -> bool {
+        self.options.exit_sw
+    }
+
+    /// Whether the coat's reflection is rendered (else the path is
+    /// weighted by the transmitted fraction and the reflected part lost).
+    #[inline]
+    pub fn specular(&self) -> bool {
+        self.options.specular
+    }
+
+    /// The coat's roughness in [0, 1] (α = roughness²); 0 is a mirror.
+    #[inline]
+    pub fn roughness(&self) -> f32 {
+        self.options.roughness
+    }
+
+    /// The boundary the random-walk integrator simulates (the diffusion
+    /// estimator ignores it).
+    #[inline]
+    pub fn boundary(&self) -> WalkBoundary {
+        self.options.boundary
+    }
+
+    /// At the camera vertex, the plane control variate on the entry
+    /// point's light sample (`integrator::control_variate`).
+    #[inline]
+    pub fn control_variate(&self) -> bool {
+        self.options.control_variate
+    }
+
+    /// At the camera vertex, an antithetic pair of probes instead of one
+    /// (`integrator::path`, `PAIR_DEPTH`).
+    #[inline]
+    pub fn probe_pair(&self) -> bool {
+        self.options.probe_pair
+    }
+
+    /// The level-of-detail rule.
+    #[inline]
+    pub fn lod(&self) -> &LodRule {
+        &self.lod
+    }
+
+    /// The curvature correction of the diffusion weight, if on.
+    #[inline]
+    pub fn curvature_correction(&self) -> Option<&CurvatureCorrection> {
+        self.curvature.as_ref()
+    }
+
+    /// The rough coat, or None for a smooth one.
+    pub fn rough_coat(&self) -> Option<&RoughCoat> {
+        self.coat.as_ref()
+    }
+
+    pub fn eta(&self) -> f32 {
+        self.params.eta
+    }
+
+    /// The entry-point lobe value per steradian for a direction with cosine
+    /// `cos` to the outward normal: Sw(ω) or 1/π.
+    pub fn lobe(&self, cos: f32) -> f32 {
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        if self.options.exit_sw {
+            match &self.coat {
+                Some(c) => (1.0 - c.albedo(cos)) * std::f32::consts::FRAC_1_PI / self.sw_c,
+                None => crate::bssrdf::sw(cos, self.params.eta, self.sw_c),
+            }
+        } else {
+            std::f32::consts::FRAC_1_PI
+        }
+    }
+
+    /// The albedo A per channel (for previews and tests).
+    pub fn albedo(&self) -> Vec3 {
+        let a = self.params.albedo;
+        Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
+    }
+}
+
+/// The correction for `mode`. The table is embedded and checked by the
+/// unit tests of `bssrdf::curvature_table`, so a failure to load it is a
+/// build defect, not bad input; the message names the file, line and field.
+fn curvature_for(
+    params: &SubsurfaceParams,
+    probe: &ProbeSampler,
+    mode: CurvatureMode,
+) -> Option<CurvatureCorrection> {
+    match mode {
+        CurvatureMode::Off => None,
+        CurvatureMode::Auto => CurvatureCorrection::new(params, probe)
+            .unwrap_or_else(|e| panic!("embedded curvature table: {e}")),
+    }
+}
+
+/// Sampling choices that replace a material's own (from the command line
+/// or a study configuration); `None` keeps the material's setting.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SubsurfaceOverrides {
+    pub radius: Option<crate::bssrdf::RadiusSampler>,
+    pub rmax_quantile: Option<f64>,
+    pub axes: Option<crate::bssrdf::ProbeAxes>,
+    pub channel: Option<crate::bssrdf::ChannelStrategy>,
+    pub renormalize: Option<bool>,
+    pub exit_sw: Option<bool>,
+    pub specular: Option<bool>,
+    pub boundary: Option<WalkBoundary>,
+    pub roughness: Option<f32>,
+    pub lod: Option<LodMode>,
+    pub control_variate: Option<bool>,
+    pub probe_pair: Option<bool>,
+}
+
+impl Subsurface {
+    /// Every sampling option, `key=value` separated by spaces, with the
+    /// names of the option table (for the EXR header).
+    pub(crate) fn sampling_description(&self) -> String {
+        let all: Vec<String> = OPTIONS
+            .iter()
+            .filter(|o| o.name != "curvature_correction")
+            .map(|o| format!("{}={}", o.name, (o.get)(&self.options)))
+            .collect();
+        all.join(" ")
+    }
+}
+
+impl SubsurfaceOverrides {
+    /// The options given, `key=value` separated by spaces in a fixed
+    /// order, with the names the scene format and the command line use (a
+    /// part's identity: stable across builds, unlike `Debug`).
+    pub fn canonical(&self) -> String {
+        let pairs: [(&str, Option<String>); 12] = [
+            ("radius", self.radius.map(|r| r.name())),
+            ("rmax_quantile", self.rmax_quantile.map(|q| q.to_string())),
+            ("axes", self.axes.map(|a| a.name().into())),
+            ("channel", self.channel.map(|c| c.name().into())),
+            ("renormalize", self.renormalize.map(|b| b.to_string())),
+            ("exit_sw", self.exit_sw.map(|b| b.to_string())),
+            ("specular", self.specular.map(|b| b.to_string())),
+            ("boundary", self.boundary.map(|b| b.name().into())),
+            ("roughness", self.roughness.map(|r| r.to_string())),
+            ("lod", self.lod.map(|l| l.name().into())),
+            (
+                "control_variate",
+                self.control_variate.map(|b| b.to_string()),
+            ),
+            ("probe_pair", self.probe_pair.map(|b| b.to_string())),
+        ];
+        let given: Vec<String> = pairs
+            .into_iter()
+            .filter_map(|(k, v)| Some(format!("{k}={}", v?)))
+            .collect();
+        given.join(" ")
+    }
+
+    pub fn is_empty(&self) -> bool {
+        *self == SubsurfaceOverrides::default()
+    }
+
+    /// `o` with these choices applied.
+    pub fn over(&self, o: &EstimatorOptions) -> EstimatorOptions {
+        let p = &o.probe;
+        EstimatorOptions {
+            probe: ProbeOptions {
+                radius: self.radius.unwrap_or(p.radius),
+                rmax_quantile: self.rmax_quantile.unwrap_or(p.rmax_quantile),
+                axes: self.axes.unwrap_or(p.axes),
+                channel: self.channel.unwrap_or(p.channel),
+                renormalize: self.renormalize.unwrap_or(p.renormalize),
+            },
+            exit_sw: self.exit_sw.unwrap_or(o.exit_sw),
+            specular: self.specular.unwrap_or(o.specular),
+            roughness: self.roughness.unwrap_or(o.roughness),
+            boundary: self.boundary.unwrap_or(o.boundary),
+            lod: self.lod.unwrap_or(o.lod),
+            control_variate: self.control_variate.unwrap_or(o.control_variate),
+            probe_pair: self.probe_pair.unwrap_or(o.probe_pair),
+            ..*o
+        }
+    }
+
+    /// The material with these choices applied (its parameters unchanged).
+    pub fn apply(&self, ss: &Subsurface) -> Result<Subsurface, ParamError> {
+        ss.with_options(&self.over(&ss.options))
+    }
+
+    /// Applies the overrides to every subsurface material of `materials`.
+    pub fn apply_all(&self, materials: &mut [super::Material]) -> Result<(), ParamError> {
+        for m in materials.iter_mut() {
+            if let super::Material::Subsurface(ss) = m {
+                *ss = std::sync::Arc::new(self.apply(ss)?);
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bssrdf::{Fit, ProbeAxes, RadiusSampler};
+
+    #[test]
+    fn overrides_replace_only_what_they_name() {
+        let p = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
+        let ss = Subsurface::new(p, &ProbeOptions::default(), true, true).unwrap();
+        let ov = SubsurfaceOverrides {
+            axes: Some(ProbeAxes::Normal),
+            specular: Some(false),
+            ..Default::default()
+        };
+        let out = ov.apply(&ss).unwrap();
+        assert_eq!(out.probe().options().axes, ProbeAxes::Normal);
+        assert_eq!(out.probe().options().radius, RadiusSampler::Analytic);
+        assert!(out.exit_sw() && !out.specular());
+        assert_eq!(out.params(), ss.params());
+        assert_eq!(out.boundary(), WalkBoundary::Dielectric);
+        let walk = SubsurfaceOverrides {
+            boundary: WalkBoundary::parse("Diffuse"),
+            ..Default::default()
+        }
+        .apply(&out)
+        .unwrap();
+        assert_eq!(walk.boundary(), WalkBoundary::Diffuse { exit_nee: true });
+        assert!(walk != out && walk.exit_sw() && !walk.specular());
+        assert_eq!(WalkBoundary::parse("lambert"), None);
+        let bad = SubsurfaceOverrides {
+            rmax_quantile: Some(1.5),
+            ..Default::default()
+        };
+        assert!(bad.apply(&ss).is_err());
+        // the identity names options as the scene format does, not as Debug
+        assert_eq!(ov.canonical(), "axes=normal specular=false");
+        assert_eq!(SubsurfaceOverrides::default().canonical(), "");
+        // lobe: Sw integrates to 1 against cos; the plain lobe is 1/π
+        assert_eq!(out.lobe(-0.1), 0.0);
+        let plain = SubsurfaceOverrides {
+            exit_sw: Some(false),
+            ..Default::default()
+        }
+        .apply(&ss)
+        .unwrap();
+        assert_eq!(plain.lobe(0.3), std::f32::consts::FRAC_1_PI);
+    }
+}

@@ -1,0 +1,141 @@
+//! What a render's outputs record about it: a part's [`Identity`] (what
+//! must agree for parts to merge or a render to resume) and a frame's EXR
+//! header (docs/output.md).
+
+use std::path::Path;
+
+use crate::accel::Backend;
+use crate::error::Error;
+use crate::farm::part::{self, Identity};
+use crate::film::exr_layers::{FrameHeader, OutputOptions};
+use crate::film::pass_layout::Layout;
+use crate::film::passes::PassSet;
+use crate::integrator::{plan, IntegratorKind};
+use crate::render::Settings;
+use crate::scene::Scene;
+
+/// The integrator's name on the command line and in headers.
+pub fn integrator_name(i: IntegratorKind) -> &'static str {
+    match i {
+        IntegratorKind::Path => "path",
+        #[cfg(feature = "subsurface")]
+        IntegratorKind::RandomWalk => "randomwalk",
+    }
+}
+
+/// The identity of a render of `scene` (read from `scene_bytes`) with
+/// `settings` on `backend`, the subsurface `options` (canonical text),
+/// passes `layout` and file options `out`.
+pub fn identity(
+    scene_bytes: &[u8],
+    scene: &Scene,
+    settings: &Settings,
+    backend: Backend,
+    options: &str,
+    layout: Option<&Layout>,
+    out: &OutputOptions,
+) -> Identity {
+    Identity {
+        passes: part::passes_text(layout),
+        names: part::names_text(layout),
+        output: part::output_text(out),
+        version: env!("CARGO_PKG_VERSION").into(),
+        scene_hash: crate::farm::scene_hash(scene_bytes, scene),
+        seed: settings.seed,
+        spp: settings.spp,
+        options: format!(
+            "accel={} integrator={} {options}",
+            backend.name(),
+            integrator_name(settings.integrator)
+        )
+        .trim_end()
+        .into(),
+        frame: (scene.camera.width, scene.camera.height),
+    }
+}
+
+/// The plan a render of `scene` with `integrator` and `passes` follows.
+pub fn render_plan(
+    scene: &Scene,
+    integrator: IntegratorKind,
+    passes: PassSet,
+) -> plan::Explanation {
+    plan::Explanation::new(
+        scene,
+        &plan::PlanOptions {
+            integrator,
+            passes,
+            ..plan::PlanOptions::default()
+        },
+    )
+}
+
+/// What the EXR header records about this render (docs/output.md): the
+/// scene file (`scene_text`) and its SHA-256, samples, seed, depth,
+/// backend and version, integrator, every subsurface material's sampling
+/// options (named by the objects that use it) and the render time.
+pub(crate) fn frame_header(
+    scene_path: &Path,
+    scene_text: &str,
+    scene: &Scene,
+    accel_name: &str,
+    backend: Backend,
+    settings: &Settings,
+    seconds: f64,
+) -> Result<FrameHeader, Error> {
+    use sha2::{Digest, Sha256};
+    let sha: String = Sha256::digest(scene_text.as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    Ok(FrameHeader {
+        scene_path: Some(scene_path.display().to_string()),
+        scene_sha256: Some(sha),
+        spp: Some(settings.spp),
+        seed: Some(settings.seed),
+        max_depth: Some(settings.max_depth),
+        backend: Some(accel_name.into()),
+        backend_version: Some(backend_version(backend)?),
+        integrator: Some(integrator_name(settings.integrator).into()),
+        sampling: sampling(scene),
+        plan: Some(render_plan(scene, settings.integrator, PassSet::EMPTY).to_json()),
+        render_seconds: Some(seconds),
+    })
+}
+
+/// Each subsurface material's sampling options, named by the objects
+/// that use it (materials no object uses are left out).
+fn sampling(scene: &Scene) -> Vec<(String, String)> {
+    #[cfg_attr(not(feature = "subsurface"), allow(unused_mut))]
+    let mut sampling = Vec::new();
+    #[cfg(feature = "subsurface")]
+    for (i, m) in scene.materials.iter().enumerate() {
+        let crate::materials::Material::Subsurface(ss) = m else {
+            continue;
+        };
+        let users: Vec<&str> = scene
+            .objects
+            .iter()
+            .filter(|o| o.material == i)
+            .map(|o| o.name.as_str())
+            .collect();
+        if !users.is_empty() {
+            sampling.push((users.join(","), ss.sampling_description()));
+        }
+    }
+    #[cfg(not(feature = "subsurface"))]
+    let _ = scene;
+    sampling
+}
+
+/// The backend's version: the Embree in use (the one `backend` resolves
+/// to), or lucent's for its own BVH.
+pub fn backend_version(backend: Backend) -> Result<String, Error> {
+    Ok(match backend.resolve()? {
+        #[cfg(feature = "embree")]
+        Backend::Embree3 => format!("Embree {}", crate::accel::embree::version()),
+        #[cfg(feature = "embree4")]
+        Backend::Embree4 => format!("Embree {}", crate::accel::embree4::version()?),
+        _ => format!("lucent {}", env!("CARGO_PKG_VERSION")),
+    })
+}

@@ -1,0 +1,32 @@
+//! What this build of lucent can do (`lucent info`): its ray-query
+//! backends, the default one, and whether it has subsurface scattering.
+
+use crate::accel::{self, Backend};
+
+/// A few lines: the version, the backends available (and why an Embree is
+/// missing), the default backend and the subsurface feature.
+pub fn build_info() -> String {
+    let names: Vec<&str> = Backend::all_available().iter().map(|b| b.name()).collect();
+    let mut s = format!(
+        "lucent {}\nbackends: {}",
+        env!("CARGO_PKG_VERSION"),
+        names.join(", ")
+    );
+    for line in accel::embree_report() {
+        s.push('\n');
+        s.push_str(&line);
+    }
+    let default = Backend::default_available();
+    s.push_str(&format!("\ndefault backend: {}", default.name()));
+    if let Ok(b) = default.resolve() {
+        if b != default {
+            s.push_str(&format!(" ({})", b.name()));
+        }
+    }
+    s.push_str(if cfg!(feature = "subsurface") {
+        "\nsubsurface: yes"
+    } else {
+        "\nsubsurface: no (built without the `subsurface` feature)"
+    });
+    s
+}

@@ -1,0 +1,22 @@
+//! A render as `lucent render` runs it: the scene loaded and the command
+//! line's overrides applied, the settings resolved once
+//! ([`crate::render::Settings`]), the frame or part rendered, checkpoints
+//! kept and a stopped render resumed, and the output written
+//! (docs/farm.md, docs/output.md).
+
+pub mod checkpoint;
+pub mod identity;
+mod info;
+mod merge;
+pub mod output;
+pub mod overrides;
+pub mod request;
+pub mod resume;
+mod run;
+
+pub use info::build_info;
+pub use merge::{merge_parts, MergedFrame};
+pub use output::check_exr_output;
+pub use overrides::Overrides;
+pub use request::{Request, Split};
+pub use run::{run, stop_if_interrupted, Outcome};
