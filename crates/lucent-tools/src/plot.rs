@@ -27,28 +27,69 @@ pub(crate) const FONT: &str = "sans-serif";
 const W: u32 = 1200;
 const H: u32 = 800;
 
+/// Why the plot font cannot be used. Kept for the process (the font is
+/// looked for once), hence `Clone` and the messages as text.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum FontError {
+    /// Neither `$LUCENT_FONT` nor any of [`FONT_PATHS`] is a file.
+    #[error(
+        "no TrueType font for the plots: looked for {}; run scripts/install-deps.sh \
+         (installs fonts-dejavu-core) or set LUCENT_FONT to a .ttf file",
+        FONT_PATHS.join(", ")
+    )]
+    Missing,
+    /// The font file found cannot be read.
+    #[error("cannot read font {}: {problem}", path.display())]
+    Read { path: PathBuf, problem: String },
+    /// The font file found is not a font plotters can use.
+    #[error("{}: not a TrueType font plotters can read", path.display())]
+    NotTrueType { path: PathBuf },
+}
+
+/// Why a plot was not written.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// The plot font cannot be used.
+    #[error(transparent)]
+    Font(#[from] FontError),
+    /// The canvas could not be cleared.
+    #[error("{0}")]
+    Canvas(String),
+    /// Drawing the chart into `path` failed.
+    #[error("plot {}: {problem}", path.display())]
+    Draw { path: PathBuf, problem: String },
+    /// The drawn buffer does not make an image of the canvas's size.
+    #[error("bad plot buffer")]
+    Buffer,
+    /// A chart was asked for with no positive values to draw.
+    #[error("no data to plot")]
+    NoData,
+    /// The PNG file could not be written (`cannot write PATH: …`).
+    #[error(transparent)]
+    Write(#[from] lucent::Error),
+}
+
 /// Registers the plot font once per process.
-pub(crate) fn ensure_font() -> Result<(), String> {
-    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
+pub(crate) fn ensure_font() -> Result<(), FontError> {
+    static DONE: OnceLock<Result<(), FontError>> = OnceLock::new();
     DONE.get_or_init(|| {
         let candidates: Vec<PathBuf> = std::env::var_os("LUCENT_FONT")
             .map(PathBuf::from)
             .into_iter()
             .chain(FONT_PATHS.iter().map(PathBuf::from))
             .collect();
-        let path = candidates.iter().find(|p| p.is_file()).ok_or_else(|| {
-            format!(
-                "no TrueType font for the plots: looked for {}; run scripts/install-deps.sh \
-                 (installs fonts-dejavu-core) or set LUCENT_FONT to a .ttf file",
-                FONT_PATHS.join(", ")
-            )
+        let path = candidates
+            .iter()
+            .find(|p| p.is_file())
+            .ok_or(FontError::Missing)?;
+        let bytes = std::fs::read(path).map_err(|e| FontError::Read {
+            path: path.clone(),
+            problem: e.to_string(),
         })?;
-        let bytes =
-            std::fs::read(path).map_err(|e| format!("cannot read font {}: {e}", path.display()))?;
         // plotters keeps fonts for the process's lifetime; this is read once.
         let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
         register_font(FONT, FontStyle::Normal, bytes)
-            .map_err(|_| format!("{}: not a TrueType font plotters can read", path.display()))
+            .map_err(|_| FontError::NotTrueType { path: path.clone() })
     })
     .clone()
 }
@@ -59,18 +100,23 @@ pub(crate) type Res = Result<(), Box<dyn Error>>;
 pub fn png(
     path: &Path,
     draw: impl FnOnce(DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Res,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let mut buf = vec![0u8; (W * H * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (W, H)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        draw(root).map_err(|e| format!("plot {}: {e}", path.display()))?;
+        root.fill(&WHITE)
+            .map_err(|e| PlotError::Canvas(e.to_string()))?;
+        draw(root).map_err(|e| PlotError::Draw {
+            path: path.to_path_buf(),
+            problem: e.to_string(),
+        })?;
     }
-    let img = image::RgbImage::from_raw(W, H, buf).ok_or("bad plot buffer")?;
+    let img = image::RgbImage::from_raw(W, H, buf).ok_or(PlotError::Buffer)?;
     atomic_write(path, |tmp| {
         img.save_with_format(tmp, image::ImageFormat::Png)
             .map_err(|e| e.to_string())
-    })
+    })?;
+    Ok(())
 }
 
 pub(crate) fn color(i: usize) -> RGBColor {

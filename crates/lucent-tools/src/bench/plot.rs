@@ -8,16 +8,16 @@ use std::path::{Path, PathBuf};
 use plotters::prelude::*;
 
 use super::{QueryKind, Row};
-use crate::plot::{color, ensure_font, log_range, png, FONT};
+use crate::plot::{color, ensure_font, log_range, png, PlotError, FONT};
 
 type Series = (String, Vec<(f64, f64)>);
 
 /// Draws a log-log line plot of `series` into `path`.
-fn line_plot(path: &Path, title: &str, ylabel: &str, series: &[Series]) -> Result<(), String> {
+fn line_plot(path: &Path, title: &str, ylabel: &str, series: &[Series]) -> Result<(), PlotError> {
     let xr =
-        log_range(series.iter().flat_map(|s| s.1.iter().map(|p| p.0))).ok_or("no data to plot")?;
+        log_range(series.iter().flat_map(|s| s.1.iter().map(|p| p.0))).ok_or(PlotError::NoData)?;
     let yr =
-        log_range(series.iter().flat_map(|s| s.1.iter().map(|p| p.1))).ok_or("no data to plot")?;
+        log_range(series.iter().flat_map(|s| s.1.iter().map(|p| p.1))).ok_or(PlotError::NoData)?;
     png(path, |root| {
         let mut chart = ChartBuilder::on(&root)
             .caption(title, (FONT, 22))
@@ -60,7 +60,7 @@ fn line_plot(path: &Path, title: &str, ylabel: &str, series: &[Series]) -> Resul
 /// `bench-build.png` (build seconds vs triangles) into `dir`, from the
 /// displaced-sphere rows; returns the paths written (none without such
 /// rows).
-pub(crate) fn write_plots(dir: &Path, rows: &[Row]) -> Result<Vec<PathBuf>, String> {
+pub(crate) fn write_plots(dir: &Path, rows: &[Row]) -> Result<Vec<PathBuf>, PlotError> {
     let spheres: Vec<&Row> = rows.iter().filter(|r| r.mesh == "sphere").collect();
     if spheres.is_empty() {
         return Ok(Vec::new());

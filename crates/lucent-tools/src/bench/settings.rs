@@ -88,34 +88,46 @@ pub fn available_backends() -> Vec<Backend> {
     Backend::all_available()
 }
 
+/// A count on the command line that cannot be used; each names the text
+/// given. clap's `value_parser`s return it as is.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CountError {
+    /// Not a number (with an optional `k`/`M` suffix).
+    #[error("\"{0}\" is not a triangle count (examples: 1000, 16k, 1.3M)")]
+    Size(String),
+    /// A triangle count outside 20 to 25M.
+    #[error("size \"{0}\" out of range: between 20 and 25M triangles")]
+    SizeRange(String),
+    /// Not a thread count from 1 to [`MAX_THREADS`].
+    #[error("\"{0}\" is not a thread count (1 to {max})", max = MAX_THREADS)]
+    Threads(String),
+    /// Not a ray count from 1 to `MAX_RAYS`.
+    #[error("\"{0}\" is not a ray count from 1 to 20M (examples: 100000, 500k, 2M)")]
+    Rays(String),
+}
+
 /// Parses a triangle count: `1000`, `16k`, `1.3M`.
-pub fn parse_size(s: &str) -> Result<usize, String> {
+pub fn parse_size(s: &str) -> Result<usize, CountError> {
     let t = s.trim();
     let (num, mul) = match t.chars().last() {
         Some('k' | 'K') => (&t[..t.len() - 1], 1e3),
         Some('m' | 'M') => (&t[..t.len() - 1], 1e6),
         _ => (t, 1.0),
     };
-    let v: f64 = num
-        .parse()
-        .map_err(|_| format!("\"{s}\" is not a triangle count (examples: 1000, 16k, 1.3M)"))?;
+    let v: f64 = num.parse().map_err(|_| CountError::Size(s.to_string()))?;
     let n = (v * mul).round();
     if !(20.0..=25e6).contains(&n) {
-        return Err(format!(
-            "size \"{s}\" out of range: between 20 and 25M triangles"
-        ));
+        return Err(CountError::SizeRange(s.to_string()));
     }
     Ok(n as usize)
 }
 
 /// Parses a thread count: 1 to [`MAX_THREADS`] (1024); `render` and
 /// `study` parse `--threads` with it too.
-pub fn parse_threads(s: &str) -> Result<usize, String> {
+pub fn parse_threads(s: &str) -> Result<usize, CountError> {
     match s.trim().parse::<usize>() {
         Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
-        _ => Err(format!(
-            "\"{s}\" is not a thread count (1 to {MAX_THREADS})"
-        )),
+        _ => Err(CountError::Threads(s.to_string())),
     }
 }
 
@@ -125,7 +137,7 @@ pub(crate) const MAX_RAYS: usize = 20_000_000;
 
 /// Parses a ray count: a positive integer up to `MAX_RAYS`, `k`/`M`
 /// suffixes allowed.
-pub fn parse_rays(s: &str) -> Result<usize, String> {
+pub fn parse_rays(s: &str) -> Result<usize, CountError> {
     let t = s.trim();
     let (num, mul) = match t.chars().last() {
         Some('k' | 'K') => (&t[..t.len() - 1], 1e3),
@@ -136,9 +148,7 @@ pub fn parse_rays(s: &str) -> Result<usize, String> {
         Ok(v) if (v * mul).round() >= 1.0 && v * mul <= MAX_RAYS as f64 => {
             Ok((v * mul).round() as usize)
         }
-        _ => Err(format!(
-            "\"{s}\" is not a ray count from 1 to 20M (examples: 100000, 500k, 2M)"
-        )),
+        _ => Err(CountError::Rays(s.to_string())),
     }
 }
 
@@ -179,5 +189,14 @@ mod tests {
         assert!(parse_rays("0").is_err() && parse_rays("nan").is_err());
         assert_eq!(parse_rays("20M"), Ok(MAX_RAYS));
         assert!(parse_rays("20000001").is_err() && parse_rays("1e9").is_err());
+        // the messages clap shows after the argument's name
+        assert_eq!(
+            parse_size("10").unwrap_err().to_string(),
+            "size \"10\" out of range: between 20 and 25M triangles"
+        );
+        assert_eq!(
+            parse_threads("0").unwrap_err().to_string(),
+            "\"0\" is not a thread count (1 to 1024)"
+        );
     }
 }

@@ -49,13 +49,24 @@ pub struct StudyArgs {
     quiet: bool,
 }
 
-fn parse_study_integrator(s: &str) -> Result<IntegratorKind, String> {
-    super::config::parse_integrator(s)
-        .ok_or_else(|| format!("expected diffusion or randomwalk, found \"{s}\""))
+/// A value of `lucent study`'s arguments that clap cannot take (clap shows
+/// the message after the argument's name).
+#[derive(Debug, PartialEq, thiserror::Error)]
+pub enum ArgError {
+    /// `--reference` is not an integrator a study can use.
+    #[error("expected diffusion or randomwalk, found \"{0}\"")]
+    Integrator(String),
+    /// An `--only` value is not an axis of the matrix.
+    #[error("unknown axis \"{0}\"")]
+    Axis(String),
 }
 
-fn parse_study_axis(s: &str) -> Result<super::Axis, String> {
-    super::Axis::parse(s).ok_or_else(|| format!("unknown axis \"{s}\""))
+fn parse_study_integrator(s: &str) -> Result<IntegratorKind, ArgError> {
+    super::config::parse_integrator(s).ok_or_else(|| ArgError::Integrator(s.to_string()))
+}
+
+fn parse_study_axis(s: &str) -> Result<super::Axis, ArgError> {
+    super::Axis::parse(s).ok_or_else(|| ArgError::Axis(s.to_string()))
 }
 
 /// Runs the study `a` asks for and says where its report is (unless

@@ -11,6 +11,7 @@
 
 use lucent::accel::Backend;
 use lucent::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, RadiusSampler, TableSpacing};
+use lucent::error::ParamError;
 use lucent::integrator::IntegratorKind;
 use lucent::materials::{LodMode, Material, WalkBoundary};
 use lucent::scene::Scene;
@@ -272,12 +273,26 @@ fn radius_values(quick: bool) -> Vec<RadiusSampler> {
     }
 }
 
+/// Why a study's configurations cannot be made.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// There is nothing the study could vary.
+    #[error("the scene has no subsurface material: nothing to study")]
+    NoSubsurface,
+    /// A configuration's options do not fit a material of the scene.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+}
+
 /// The configurations of a study of `scene`. `quick` keeps a few values per
 /// axis (enough for the ordering facts the tests check). `backends[0]` is
 /// the baseline's backend; each further one gets a backend row.
-pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Config>, String> {
-    let (exit_sw, specular) =
-        scene_fresnel(scene).ok_or("the scene has no subsurface material: nothing to study")?;
+pub fn matrix(
+    scene: &Scene,
+    quick: bool,
+    backends: &[Backend],
+) -> Result<Vec<Config>, ConfigError> {
+    let (exit_sw, specular) = scene_fresnel(scene).ok_or(ConfigError::NoSubsurface)?;
     let base_probe = baseline_probe();
     let base_backend = backends[0];
     let mut base_ov = full_probe(base_probe);
@@ -449,7 +464,7 @@ pub fn matrix(scene: &Scene, quick: bool, backends: &[Backend]) -> Result<Vec<Co
 
 /// `scene` with every subsurface material rebuilt with `ov` applied to its
 /// own options (its medium parameters unchanged).
-pub fn apply(scene: &Scene, ov: &Overrides) -> Result<Scene, String> {
+pub fn apply(scene: &Scene, ov: &Overrides) -> Result<Scene, ConfigError> {
     let mut out = scene.clone();
     ov.apply_all(&mut out.materials)?;
     Ok(out)

@@ -26,21 +26,37 @@ pub struct Metrics {
     pub fireflies: u64,
 }
 
+/// Why two images cannot be compared.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MetricsError {
+    /// The image and the reference differ in size.
+    #[error("image is {}x{} but the reference is {}x{}", image.0, image.1, reference.0, reference.1)]
+    SizeMismatch {
+        /// Width and height of the image.
+        image: (u32, u32),
+        /// Width and height of the reference.
+        reference: (u32, u32),
+    },
+    /// The images have no pixels.
+    #[error("empty image")]
+    Empty,
+}
+
 fn lum(p: Vec3) -> f64 {
     0.2126 * p.x as f64 + 0.7152 * p.y as f64 + 0.0722 * p.z as f64
 }
 
 /// Compares `img` with `reference` (same size); `k` is the firefly factor.
-pub fn compare(img: &Film, reference: &Film, k: f64) -> Result<Metrics, String> {
+pub fn compare(img: &Film, reference: &Film, k: f64) -> Result<Metrics, MetricsError> {
     if (img.width, img.height) != (reference.width, reference.height) {
-        return Err(format!(
-            "image is {}x{} but the reference is {}x{}",
-            img.width, img.height, reference.width, reference.height
-        ));
+        return Err(MetricsError::SizeMismatch {
+            image: (img.width, img.height),
+            reference: (reference.width, reference.height),
+        });
     }
     let n = img.pixels.len();
     if n == 0 {
-        return Err("empty image".into());
+        return Err(MetricsError::Empty);
     }
     let mean_ref_lum = reference.pixels.iter().map(|&p| lum(p)).sum::<f64>() / n as f64;
     let floor = FIREFLY_FLOOR * mean_ref_lum;

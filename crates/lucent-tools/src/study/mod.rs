@@ -120,14 +120,14 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
         backends.push(Backend::Bvh);
     }
     let configs: Vec<Config> = config::matrix(&scene, s.quick, &backends)
-        .map_err(Error::Input)?
+        .map_err(|e| Error::Input(e.to_string()))?
         .into_iter()
         .filter(|c| c.axis == Axis::Baseline || s.only.is_empty() || s.only.contains(&c.axis))
         .collect();
     // A directory whose results cannot be resumed is refused before
     // anything is written in it (no state/, no cached reference).
     let csv = s.out_dir.join("results.csv");
-    Results::read(&csv).map_err(Error::Input)?;
+    Results::read(&csv).map_err(|e| Error::Input(e.to_string()))?;
     let hash = reference::hash_for(s, &scene, &scene_text, seed);
     resume::check_results_key(s, hash, seed, &scene)?;
     fs::create_dir_all(s.out_dir.join("state"))

@@ -18,7 +18,7 @@ use plotters::prelude::*;
 
 use super::config::{Axis, Config};
 use super::results::Row;
-use crate::plot::{color, ensure_font, log_range, png, FONT};
+use crate::plot::{color, ensure_font, log_range, png, PlotError, FONT};
 
 /// (x, bias %, 2σ %) points of one labelled series.
 type BiasSeries = (String, Vec<(f64, f64, f64)>);
@@ -46,7 +46,7 @@ fn last_row<'a>(rows: &'a [Row], config: &str) -> Option<&'a Row> {
     rows_of(rows, config).last().copied()
 }
 
-fn error_vs_time(path: &Path, rows: &[Row], configs: &[Config]) -> Result<bool, String> {
+fn error_vs_time(path: &Path, rows: &[Row], configs: &[Config]) -> Result<bool, PlotError> {
     let Some(xr) = log_range(rows.iter().map(|r| r.seconds)) else {
         return Ok(false);
     };
@@ -128,7 +128,7 @@ fn bias_chart(
     x_desc: &str,
     series: &[BiasSeries],
     hline: Option<(String, f64)>,
-) -> Result<bool, String> {
+) -> Result<bool, PlotError> {
     if series.iter().all(|(_, p)| p.is_empty()) {
         return Ok(false);
     }
@@ -207,7 +207,7 @@ pub(crate) fn write_all(
     dir: &Path,
     rows: &[Row],
     configs: &[Config],
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Vec<PathBuf>, PlotError> {
     ensure_font()?;
     let mut out = Vec::new();
     let p = dir.join("error-vs-time.png");

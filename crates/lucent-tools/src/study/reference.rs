@@ -142,7 +142,7 @@ pub(super) fn reference(
             return Ok((film, info));
         }
     }
-    let ref_scene = config::apply(scene, &overrides).map_err(Error::Input)?;
+    let ref_scene = config::apply(scene, &overrides).map_err(|e| Error::Input(e.to_string()))?;
     if s.progress {
         eprintln!(
             "reference: {} at {} spp, {}x{} → {}",

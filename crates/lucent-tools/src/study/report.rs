@@ -67,7 +67,8 @@ fn fmt_opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
     v.map(f).unwrap_or_else(|| "—".into())
 }
 
-/// Writes `DIR/report.md`; returns its path.
+/// Writes `DIR/report.md`; returns its path, or why it could not be written
+/// (`cannot write PATH: …`).
 pub fn write(
     s: &Settings,
     scene: &Scene,
@@ -76,7 +77,7 @@ pub fn write(
     reference: &ReferenceInfo,
     plots: &[PathBuf],
     run_seconds: f64,
-) -> Result<PathBuf, String> {
+) -> Result<PathBuf, lucent::Error> {
     let path = s.out_dir.join("report.md");
     let name = s
         .scene

@@ -13,6 +13,42 @@ use lucent::film::atomic_write;
 pub const HEADER: &str =
     "config,axis,value,backend,integrator,spp,seconds,rmse,relmse,bias,bias_stderr,fireflies";
 
+/// Why a results file cannot be read, written or appended to.
+#[derive(Debug, thiserror::Error)]
+pub enum ResultsError {
+    /// The file exists but cannot be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The file starts with another header: not ours to overwrite.
+    #[error(
+        "{}: unexpected header \"{header}\"; not a results file of this version of lucent study \
+         (move it away or choose another output directory)",
+        path.display()
+    )]
+    Header { path: PathBuf, header: String },
+    /// The valid rows could not be rewritten (`cannot write PATH: …`).
+    #[error(transparent)]
+    Write(#[from] lucent::Error),
+    /// The rewritten file cannot be opened for appending.
+    #[error("cannot open {}: {source}", path.display())]
+    Open {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// A text field of a row would break the CSV.
+    #[error("results: field \"{field}\" contains a separator")]
+    Separator { field: String },
+    /// A row could not be appended and flushed.
+    #[error("cannot append to {}: {source}", path.display())]
+    Append {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
     pub config: String,
@@ -84,7 +120,7 @@ impl Results {
     /// Opens `path`, reading the rows already there. A file with another
     /// header is an error (it is not ours to overwrite); unparseable lines
     /// (a row torn by an interruption) are dropped.
-    pub fn open(path: &Path) -> Result<Results, String> {
+    pub fn open(path: &Path) -> Result<Results, ResultsError> {
         let rows = Self::read(path)?;
         // Rewrite what was valid, so appends start after a complete line.
         let mut text = format!("{HEADER}\n");
@@ -96,7 +132,10 @@ impl Results {
         let file = OpenOptions::new()
             .append(true)
             .open(path)
-            .map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+            .map_err(|source| ResultsError::Open {
+                path: path.to_path_buf(),
+                source,
+            })?;
         Ok(Results {
             path: path.to_path_buf(),
             rows,
@@ -107,21 +146,22 @@ impl Results {
     /// The rows of the results file at `path` (none if there is no file),
     /// or why it cannot be resumed; reads only, so a study can refuse a
     /// directory before it writes anything in it.
-    pub fn read(path: &Path) -> Result<Vec<Row>, String> {
+    pub fn read(path: &Path) -> Result<Vec<Row>, ResultsError> {
         let mut rows = Vec::new();
         if path.exists() {
-            let text = fs::read_to_string(path)
-                .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+            let text = fs::read_to_string(path).map_err(|source| ResultsError::Read {
+                path: path.to_path_buf(),
+                source,
+            })?;
             let mut lines = text.lines();
             match lines.next() {
                 Some(h) if h.trim_end() == HEADER => {}
                 None => {}
                 Some(h) => {
-                    return Err(format!(
-                        "{}: unexpected header \"{h}\"; not a results file of this version of lucent study \
-                         (move it away or choose another output directory)",
-                        path.display()
-                    ))
+                    return Err(ResultsError::Header {
+                        path: path.to_path_buf(),
+                        header: h.to_string(),
+                    })
                 }
             }
             rows.extend(lines.filter_map(Row::parse));
@@ -140,7 +180,7 @@ impl Results {
     }
 
     /// Appends one row and flushes it to disk before returning.
-    pub(crate) fn append(&mut self, row: Row) -> Result<(), String> {
+    pub(crate) fn append(&mut self, row: Row) -> Result<(), ResultsError> {
         for s in [
             &row.config,
             &row.axis,
@@ -149,14 +189,17 @@ impl Results {
             &row.integrator,
         ] {
             if s.contains(',') || s.contains('\n') {
-                return Err(format!("results: field \"{s}\" contains a separator"));
+                return Err(ResultsError::Separator { field: s.clone() });
             }
         }
         let line = format!("{}\n", row.to_line());
         self.file
             .write_all(line.as_bytes())
             .and_then(|()| self.file.sync_data())
-            .map_err(|e| format!("cannot append to {}: {e}", self.path.display()))?;
+            .map_err(|source| ResultsError::Append {
+                path: self.path.clone(),
+                source,
+            })?;
         self.rows.push(row);
         Ok(())
     }
@@ -209,6 +252,9 @@ mod tests {
         assert_eq!(text.lines().count(), 4);
         assert!(text.ends_with('\n'));
         fs::write(&p, "something,else\n").unwrap();
-        assert!(Results::open(&p).unwrap_err().contains("unexpected header"));
+        assert!(Results::open(&p)
+            .unwrap_err()
+            .to_string()
+            .contains("unexpected header"));
     }
 }

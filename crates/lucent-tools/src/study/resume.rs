@@ -148,7 +148,7 @@ pub(super) fn jobs<'c>(
                 }
             }
         }
-        let scene = config::apply(scene, &c.overrides).map_err(Error::Input)?;
+        let scene = config::apply(scene, &c.overrides).map_err(|e| Error::Input(e.to_string()))?;
         jobs.push(Job {
             config: c,
             scene,

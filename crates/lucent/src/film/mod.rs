@@ -302,13 +302,14 @@ fn roll_back(done: Vec<(&Path, Option<PathBuf>)>) {
     }
 }
 
-/// [`write_atomically`] with the error as its message (`cannot write PATH:
-/// …`), for the tools (plots, study, bench) that still report strings.
+/// [`write_atomically`] under the name the tools (plots, study, bench) call
+/// it by: a failed write is an [`Error::Write`] (`cannot write PATH: …`),
+/// a pending signal an [`Error::Interrupted`].
 pub fn atomic_write<E: Display>(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), E>,
-) -> Result<(), String> {
-    write_atomically(path, write).map_err(String::from)
+) -> Result<(), Error> {
+    write_atomically(path, write)
 }
 
 fn temp_path(path: &Path) -> PathBuf {

@@ -108,6 +108,6 @@ pub(super) fn write_csv(
     lucent::film::atomic_write(&csv, |tmp| {
         std::fs::write(tmp, &text).map_err(|e| e.to_string())
     })
-    .map_err(Error::Runtime)?;
+    .map_err(|e| Error::Runtime(e.to_string()))?;
     Ok(csv)
 }
