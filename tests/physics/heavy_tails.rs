@@ -11,9 +11,10 @@
 //! the lamp (entry lobe → coat at grazing incidence, Fr near 1 → lamp) is a
 //! caustic a path tracer finds only through the entry lobe's direction
 //! (docs/accuracy.md, "Real meshes"). With `specular = false` both scenes
-//! pass (68× and 97×), with `axes = "normal"` or a tangent floor ε_min of
-//! 0.0002 too: at this size the probe weights alone make no tail. Run it
-//! with `--ignored` after a change to the coat or the path's caustics.
+//! pass (68× and 97×), and still pass with the coat off and
+//! `axes = "normal"` or a tangent floor ε_min of 0.0002: at this size the
+//! probe weights alone make no tail. Run it with `--ignored` after a
+//! change to the coat or the path's caustics.
 
 use std::path::{Path, PathBuf};
 
