@@ -19,6 +19,8 @@ mod furnace;
 #[cfg(feature = "subsurface")]
 mod hard_cases;
 #[cfg(feature = "subsurface")]
+mod heavy_tails;
+#[cfg(feature = "subsurface")]
 mod lod;
 #[cfg(feature = "subsurface")]
 mod params_edges;
