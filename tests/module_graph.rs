@@ -515,10 +515,9 @@ fn the_library_depends_on_no_cli_plotting_or_progress_bar_crate() {
 /// whose own code and children still use each
 /// other: [`a_mod_rs_and_its_children_form_a_dag`] holds every other hub to
 /// the rule, and these to staying on this list only while knotted.
-const KNOTS: [&str; 6] = [
+const KNOTS: [&str; 5] = [
     "accel/embree4/mod.rs",
     "accel/mod.rs",
-    "materials/mod.rs",
     "scene/mod.rs",
     "tools/bench/replay/mod.rs",
     "tools/study/mod.rs",

@@ -614,6 +614,56 @@ fn cases() -> Vec<Case> {
         obj_case("obj zero normal", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n", "zero-length normal", Some("vn")),
         obj_case("obj without faces", "# only vertices\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", "no triangles", None),
         obj_case("obj empty", "", "no triangles", None),
+        // --- the glossy materials
+        case(
+            "unknown metal",
+            format!("{CAM}[materials.m]\ntype = \"conductor\"\nmetal = \"unobtainium\"\n"),
+            "unknown metal \"unobtainium\"; expected one of \"gold\"",
+            Some("metal ="),
+            Some("materials.m.metal"),
+        ),
+        case(
+            "conductor with metal and n",
+            format!("{CAM}[materials.m]\ntype = \"conductor\"\nmetal = \"gold\"\nn = [1, 1, 1]\nk = [2, 2, 2]\n"),
+            "`metal` cannot be combined with `n` and `k`",
+            Some("metal ="),
+            Some("materials.m.metal"),
+        ),
+        case(
+            "conductor without k",
+            format!("{CAM}[materials.m]\ntype = \"conductor\"\nn = [1, 1, 1]\n"),
+            "missing field `k`",
+            Some("[materials.m]"),
+            Some("materials.m.k"),
+        ),
+        case(
+            "conductor with n = 0",
+            format!("{CAM}[materials.m]\ntype = \"conductor\"\nn = [1, 0, 1]\nk = [2, 2, 2]\n"),
+            "expected RGB components > 0",
+            Some("n = [1, 0"),
+            Some("materials.m.n"),
+        ),
+        case(
+            "roughness out of range",
+            format!("{CAM}[materials.m]\ntype = \"plastic\"\nalbedo = [0.5, 0.5, 0.5]\nroughness = 1.5\n"),
+            "expected a number in [0, 1], found 1.5",
+            Some("roughness ="),
+            Some("materials.m.roughness"),
+        ),
+        case(
+            "plastic without albedo",
+            format!("{CAM}[materials.m]\ntype = \"plastic\"\nroughness = 0.5\n"),
+            "missing field `albedo`",
+            Some("[materials.m]"),
+            Some("materials.m.albedo"),
+        ),
+        case(
+            "diffuse with roughness",
+            format!("{CAM}[materials.m]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\nroughness = 0.5\n"),
+            "roughness",
+            Some("roughness ="),
+            Some("materials.m.roughness"),
+        ),
     ]
 }
 

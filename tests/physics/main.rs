@@ -16,6 +16,7 @@ mod culling;
 mod curvature;
 mod dielectric;
 mod furnace;
+mod glossy;
 #[cfg(feature = "subsurface")]
 mod hard_cases;
 #[cfg(feature = "subsurface")]

@@ -26,6 +26,7 @@ pub mod culling;
 pub mod diffuse_boundary;
 pub mod effects;
 pub mod footprint;
+mod glossy;
 pub mod interaction;
 pub mod kind;
 mod lobe;

@@ -187,7 +187,6 @@ fn next<'v, 's, R: Recorder, T: Clock>(
             path.go_on(b, path.from, at.cone_specular);
             Next::Bounce
         }
-        #[cfg(feature = "subsurface")]
         Scatter::Absorbed => Next::End,
         #[cfg(feature = "subsurface")]
         Scatter::Coated(c) => resolve::<R, T>(ctx, c, at, path, l, st, stack),
@@ -251,6 +250,9 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
             path.from = ctx.leaving_towards(at.si, next.d);
             Scatter::Continue(next, e)
         }
+        Material::RoughDielectric(d) => super::glossy::rough_dielectric(ctx, d, at, path, st.rng),
+        Material::Conductor(c) => super::glossy::conductor(ctx, c, at, path, st.rec),
+        Material::Plastic(p) => super::glossy::plastic(ctx, p, at, path, st.rng, st.rec),
         #[cfg(feature = "subsurface")]
         Material::Subsurface(ss) => {
             path.from = None;

@@ -73,7 +73,6 @@ impl SubsurfaceScatter for NoSubsurface {
 pub(crate) enum Scatter<'a> {
     Vertex(Vertex<'a>),
     Continue(Ray, Event),
-    #[cfg(feature = "subsurface")]
     Absorbed,
     /// A subsurface hit under a coat, or with more than one vertex.
     #[cfg(feature = "subsurface")]

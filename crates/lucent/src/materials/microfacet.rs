@@ -79,7 +79,15 @@ impl Ggx {
 
     /// A microfacet normal m visible from `wo` (wo.z > 0), drawn from
     /// D_ωo(m) (Heitz 2018, listing 1, with the concentric disk map).
+    #[inline(always)]
     pub(crate) fn sample_visible(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
+        self.visible_from_disk(wo, concentric_disk(u))
+    }
+
+    /// The visible normal of [`Ggx::sample_visible`] for the point `p` of
+    /// the unit disk (uniform points give D_ωo).
+    #[inline(always)]
+    pub(crate) fn visible_from_disk(&self, wo: Vec3, p: [f32; 2]) -> Vec3 {
         let a = self.alpha;
         // The view direction in the hemisphere configuration (α = 1).
         let wh = Vec3::new(a * wo.x, a * wo.y, wo.z).normalize();
@@ -90,7 +98,7 @@ impl Ggx {
         };
         let t2 = wh.cross(t1);
         // A uniform disk point, warped onto the projected visible half.
-        let [px, py] = concentric_disk(u);
+        let [px, py] = p;
         let h = (1.0 - px * px).max(0.0).sqrt();
         let s = 0.5 * (1.0 + wh.z);
         let py = (1.0 - s) * h + s * py;

@@ -1,25 +1,33 @@
-//! Surface materials: Lambertian, smooth dielectric and subsurface (a
-//! dielectric boundary over the Burley BSSRDF); each variant's scattering
-//! lives in its own file. Fresnel reflectance is [`crate::fresnel`], shared
+//! Surface materials: Lambertian, smooth and rough dielectric, conductor,
+//! coated diffuse ("plastic") and subsurface (a dielectric boundary over
+//! the Burley BSSRDF); each variant's scattering lives in its own file. Fresnel reflectance is [`crate::fresnel`], shared
 //! with the BSSRDF.
 
+pub mod albedo_table;
+pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 #[cfg(feature = "subsurface")]
 pub mod estimator_options;
+#[cfg(test)]
+mod lobe_checks;
 pub mod lod;
-#[cfg(feature = "subsurface")]
+pub mod metals;
 pub mod microfacet;
+pub mod plastic;
+pub mod rough_dielectric;
 #[cfg(feature = "subsurface")]
 pub mod subsurface;
 
-#[cfg(feature = "subsurface")]
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
+pub use conductor::Conductor;
 #[cfg(feature = "subsurface")]
 pub use estimator_options::{CurvatureMode, EstimatorOptions, WalkBoundary, OPTIONS};
 pub use lod::LodMode;
+pub use plastic::Plastic;
+pub use rough_dielectric::RoughDielectric;
 #[cfg(feature = "subsurface")]
 pub use subsurface::{Subsurface, SubsurfaceOverrides};
 
@@ -30,6 +38,13 @@ pub enum Material {
     /// A smooth dielectric interface with relative index of refraction η
     /// (inside over outside): specular reflection and refraction.
     Dielectric { eta: f32 },
+    /// A rough dielectric interface (GGX): glossy reflection and
+    /// refraction.
+    RoughDielectric(RoughDielectric),
+    /// A metal: GGX reflection with a complex index of refraction.
+    Conductor(Arc<Conductor>),
+    /// A dielectric coat over a Lambertian base.
+    Plastic(Arc<Plastic>),
     /// A dielectric boundary over a scattering medium: the Burley BSSRDF
     /// (only with the `subsurface` feature).
     #[cfg(feature = "subsurface")]

@@ -140,6 +140,8 @@ pub enum MaterialKind {
     Diffuse,
     Dielectric,
     Subsurface,
+    Conductor,
+    Plastic,
 }
 
 impl MaterialKind {
@@ -148,6 +150,8 @@ impl MaterialKind {
             MaterialKind::Diffuse => "diffuse",
             MaterialKind::Dielectric => "dielectric",
             MaterialKind::Subsurface => "subsurface",
+            MaterialKind::Conductor => "conductor",
+            MaterialKind::Plastic => "plastic",
         }
     }
 }
@@ -189,6 +193,11 @@ pub struct MaterialDef {
     // subsurface: variance reduction at the camera vertex
     pub control_variate: Option<Spanned<bool>>,
     pub probe_pair: Option<Spanned<bool>>,
+    // conductor: a named metal, or its complex index n + ik per channel
+    // (`roughness` above serves the conductor, plastic and dielectric too)
+    pub metal: Option<Spanned<String>>,
+    pub n: Option<Spanned<Triple3>>,
+    pub k: Option<Spanned<Triple3>>,
 }
 
 impl MaterialDef {
@@ -201,6 +210,9 @@ impl MaterialDef {
             }
         };
         add("albedo", self.albedo.as_ref().map(|x| x.span()));
+        add("metal", self.metal.as_ref().map(|x| x.span()));
+        add("n", self.n.as_ref().map(|x| x.span()));
+        add("k", self.k.as_ref().map(|x| x.span()));
         add("eta", self.eta.as_ref().map(|x| x.span()));
         add("preset", self.preset.as_ref().map(|x| x.span()));
         add(

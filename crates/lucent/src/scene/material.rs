@@ -15,6 +15,7 @@ use super::checked::{Cx, Res};
 #[cfg(feature = "subsurface")]
 use super::format::Triple3;
 use super::format::{MaterialDef, MaterialKind, Spanned};
+use super::glossy_material;
 use super::key_path::key_segment;
 #[cfg(feature = "subsurface")]
 use super::MAX_SUBSURFACE_RADIUS;
@@ -81,11 +82,20 @@ pub(super) fn material(
             })
         }
         MaterialKind::Dielectric => {
-            cx.only_keys(&field, kind.name(), d.present_keys(), &["eta"])?;
+            cx.only_keys(&field, kind.name(), d.present_keys(), &["eta", "roughness"])?;
             let e = d.eta.as_ref().ok_or_else(|| missing("eta"))?;
-            Ok(Material::Dielectric {
-                eta: cx.positive(e, &format!("{field}.eta"))?,
-            })
+            let eta = cx.positive(e, &format!("{field}.eta"))?;
+            glossy_material::dielectric(cx, &field, d, eta)
+        }
+        MaterialKind::Conductor => {
+            let keys = ["metal", "n", "k", "roughness"];
+            cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
+            glossy_material::conductor(cx, &field, m)
+        }
+        MaterialKind::Plastic => {
+            let keys = ["albedo", "eta", "roughness"];
+            cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
+            glossy_material::plastic(cx, &field, m)
         }
         // Refused where the type is named: nothing of the material is read.
         #[cfg(not(feature = "subsurface"))]

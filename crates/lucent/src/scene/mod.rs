@@ -6,6 +6,7 @@
 pub mod camera;
 mod checked;
 pub mod format;
+mod glossy_material;
 pub mod key_path;
 pub mod load;
 mod material;

@@ -9,7 +9,7 @@ mod subsurface;
 use super::aov::Event;
 use super::interaction::offset_along;
 use crate::geometry::{Frame, Ray, Vec3};
-use crate::materials::diffuse;
+use crate::materials::{diffuse, Conductor, Plastic};
 pub(crate) use sample::LobeSample;
 #[cfg(feature = "subsurface")]
 pub(crate) use subsurface::SubsurfaceLobe;
@@ -50,6 +50,10 @@ impl SubsurfaceLobe<'_> {
 pub(crate) enum Lobe<'a> {
     /// Lambertian reflection, ρ/π.
     Diffuse(Vec3),
+    /// A rough conductor's GGX reflection.
+    Conductor(&'a Conductor),
+    /// A plastic's coat and base (the base alone under a smooth coat).
+    Plastic(&'a Plastic),
     /// A subsurface material's or medium's lobe.
     #[cfg_attr(not(feature = "subsurface"), allow(dead_code))]
     Subsurface(SubsurfaceLobe<'a>),
@@ -59,7 +63,8 @@ impl Lobe<'_> {
     /// The light-path class of scattering by this lobe ([`super::aov`]).
     pub(crate) fn event(&self) -> Event {
         match self {
-            Lobe::Diffuse(_) => Event::Diffuse,
+            Lobe::Diffuse(_) | Lobe::Plastic(_) => Event::Diffuse,
+            Lobe::Conductor(_) => Event::Specular,
             Lobe::Subsurface(s) => s.event(),
         }
     }
@@ -68,6 +73,8 @@ impl Lobe<'_> {
     pub(crate) fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             Lobe::Diffuse(albedo) => diffuse::eval(*albedo, wo, wi),
+            Lobe::Conductor(c) => c.eval(wo, wi),
+            Lobe::Plastic(p) => p.eval(wo, wi),
             Lobe::Subsurface(s) => s.eval(wo, wi),
         }
     }
@@ -76,6 +83,8 @@ impl Lobe<'_> {
     pub(crate) fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             Lobe::Diffuse(_) => diffuse::pdf(wo, wi),
+            Lobe::Conductor(c) => c.pdf(wo, wi),
+            Lobe::Plastic(p) => p.pdf(wo, wi),
             Lobe::Subsurface(s) => s.pdf(wo, wi),
         }
     }
@@ -85,6 +94,8 @@ impl Lobe<'_> {
     pub(crate) fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<LobeSample> {
         match self {
             Lobe::Diffuse(albedo) => diffuse::sample(*albedo, wo, u).map(LobeSample::new),
+            Lobe::Conductor(c) => c.sample(wo, u).map(LobeSample::glossy),
+            Lobe::Plastic(p) => p.sample(wo, u).map(LobeSample::glossy),
             Lobe::Subsurface(s) => s.sample(wo, u),
         }
     }

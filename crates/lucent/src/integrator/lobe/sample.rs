@@ -15,4 +15,12 @@ impl LobeSample {
     pub(crate) fn new((wi, weight, pdf): (Vec3, Vec3, f32)) -> Self {
         LobeSample { wi, weight, pdf }
     }
+
+    pub(crate) fn glossy(s: crate::materials::conductor::GlossySample) -> Self {
+        LobeSample {
+            wi: s.wi,
+            weight: s.weight,
+            pdf: s.pdf,
+        }
+    }
 }

@@ -129,7 +129,9 @@ fn base_plan(scene: &Scene, i: usize, m: &Material) -> MaterialPlan {
         name: material_name(scene, i),
         kind: match m {
             Material::Diffuse { .. } => "diffuse",
-            Material::Dielectric { .. } => "dielectric",
+            Material::Dielectric { .. } | Material::RoughDielectric(_) => "dielectric",
+            Material::Conductor(_) => "conductor",
+            Material::Plastic(_) => "plastic",
             #[cfg(feature = "subsurface")]
             Material::Subsurface(_) => "subsurface",
         }
@@ -162,6 +164,22 @@ pub(super) fn material_rows(scene: &Scene, opts: &PlanOptions, area_lights: bool
                 rows.specular_materials.push(mname.clone());
                 rows.specular_why
                     .push(format!("{mname}: Fresnel reflection or refraction"));
+            }
+            Material::RoughDielectric(_) if used => {
+                rows.specular_materials.push(mname.clone());
+                rows.specular_why.push(format!(
+                    "{mname}: rough reflection and refraction, sampled by the interface alone"
+                ));
+            }
+            Material::Conductor(c) if used && c.is_smooth() => {
+                rows.specular_materials.push(mname.clone());
+                rows.specular_why
+                    .push(format!("{mname}: mirror reflection (roughness 0)"));
+            }
+            Material::Plastic(p) if used && p.is_smooth() => {
+                rows.specular_materials.push(mname.clone());
+                rows.specular_why
+                    .push(format!("{mname}: the mirror coat (roughness 0)"));
             }
             #[cfg(feature = "subsurface")]
             Material::Subsurface(_) if !used => {
