@@ -112,10 +112,7 @@ pub fn png(
         })?;
     }
     let img = image::RgbImage::from_raw(W, H, buf).ok_or(PlotError::Buffer)?;
-    atomic_write(path, |tmp| {
-        img.save_with_format(tmp, image::ImageFormat::Png)
-            .map_err(|e| e.to_string())
-    })?;
+    atomic_write(path, |tmp| lucent::film::write_png(&img, tmp))?;
     Ok(())
 }
 

@@ -11,6 +11,7 @@
 //! probe options).
 
 use std::fs;
+use std::io::Write as _;
 use std::path::PathBuf;
 
 use super::config::{self, Overrides};
@@ -144,7 +145,8 @@ pub(super) fn reference(
     }
     let ref_scene = config::apply(scene, &overrides).map_err(|e| Error::Input(e.to_string()))?;
     if s.progress {
-        eprintln!(
+        let _ = writeln!(
+            std::io::stderr(),
             "reference: {} at {} spp, {}x{} → {}",
             config::integrator_name(s.reference),
             s.reference_spp,
@@ -173,7 +175,9 @@ pub(super) fn reference(
         config::describe(&overrides),
         stats.threads
     );
-    film::atomic_write(&meta, |tmp| fs::write(tmp, text).map_err(|e| e.to_string()))
-        .map_err(runtime)?;
+    film::atomic_write(&meta, |tmp| {
+        std::io::Write::write_all(tmp, text.as_bytes()).map_err(|e| e.to_string())
+    })
+    .map_err(runtime)?;
     Ok((film, info))
 }

@@ -128,7 +128,9 @@ impl Results {
             text.push_str(&r.to_line());
             text.push('\n');
         }
-        atomic_write(path, |tmp| fs::write(tmp, &text).map_err(|e| e.to_string()))?;
+        atomic_write(path, |tmp| {
+            std::io::Write::write_all(tmp, text.as_bytes()).map_err(|e| e.to_string())
+        })?;
         let file = OpenOptions::new()
             .append(true)
             .open(path)

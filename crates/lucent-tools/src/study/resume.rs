@@ -103,7 +103,7 @@ pub(super) fn write_results_key(
         return Ok(());
     }
     film::atomic_write(&key_path, |tmp| {
-        fs::write(tmp, &key).map_err(|e| e.to_string())
+        std::io::Write::write_all(tmp, key.as_bytes()).map_err(|e| e.to_string())
     })
     .map_err(runtime)
 }

@@ -95,7 +95,7 @@ impl Film {
             line_order: LineOrder::Increasing,
         };
         let image = Image::from_encoded_channels((w, self.height as usize), encoding, channels);
-        Staged::write(path, |tmp| image.write().non_parallel().to_file(tmp))
+        Staged::write(path, |tmp| image.write().non_parallel().to_unbuffered(tmp))
     }
 
     /// The EXR at `exr` and its PNG preview beside it
@@ -155,11 +155,16 @@ impl Film {
                 problem: "bad film size".into(),
             }
         })?;
-        Staged::write(path, |tmp| {
-            img.save_with_format(tmp, image::ImageFormat::Png)
-                .map_err(|e| e.to_string())
-        })
+        Staged::write(path, |tmp| write_png(&img, tmp))
     }
+}
+
+/// Encodes `img` as PNG into `file`.
+pub fn write_png(img: &image::RgbImage, file: &mut fs::File) -> Result<(), String> {
+    let mut w = std::io::BufWriter::new(file);
+    img.write_to(&mut w, image::ImageFormat::Png)
+        .map_err(|e| e.to_string())?;
+    std::io::Write::flush(&mut w).map_err(|e| e.to_string())
 }
 
 /// The error of an allocation that failed: what it was for and its size.
@@ -170,13 +175,13 @@ pub(crate) fn out_of_memory(what: &str, bytes: usize) -> Error {
     ))
 }
 
-/// Runs `write` on a temporary path next to `path`, then renames it into
-/// place; on any failure the temporary file is removed and nothing appears
-/// under `path`. `write` reports its failure as any displayable error; the
-/// error names `path` and carries that text.
+/// Runs `write` on a temporary file next to `path` ([`Staged::write`]),
+/// then renames it into place; on any failure the temporary file is
+/// removed and nothing appears under `path`. `write` reports its failure as
+/// any displayable error; the error names `path` and carries that text.
 pub fn write_atomically<E: Display>(
     path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), E>,
+    write: impl FnOnce(&mut fs::File) -> Result<(), E>,
 ) -> Result<(), Error> {
     commit_all(vec![Staged::write(path, write)?])
 }
@@ -193,21 +198,43 @@ pub struct Staged {
 }
 
 impl Staged {
-    /// Runs `write` on the temporary path of `path`; on failure the
-    /// temporary file is removed and the error names `path`.
+    /// Runs `write` on a temporary file created for it beside `path`; on
+    /// failure the temporary file is removed and the error names `path`.
+    ///
+    /// The temporary file is created exclusively (`O_CREAT|O_EXCL`: a file
+    /// or symlink already under its name is never opened, followed or
+    /// replaced) under a short name ([`temp_path`]), and `write` gets the
+    /// open file, never a path that could be swapped under it.
     pub fn write<E: Display>(
         path: &Path,
-        write: impl FnOnce(&Path) -> Result<(), E>,
+        write: impl FnOnce(&mut fs::File) -> Result<(), E>,
     ) -> Result<Staged, Error> {
         // what a killed process left of this output (SIGKILL, `stale`)
         stale::clean(path);
+        let tmp = temp_path(path);
+        let mut file = fs::OpenOptions::new()
+            .write(true)
+            .read(true)
+            .create_new(true)
+            .open(&tmp)
+            .map_err(|e| Error::Write {
+                path: path.to_path_buf(),
+                problem: match e.kind() {
+                    std::io::ErrorKind::AlreadyExists => format!(
+                        "its temporary file {} is in the way (lucent did not create it: \
+                         move it away)",
+                        tmp.display()
+                    ),
+                    _ => format!("cannot create its temporary file {}: {e}", tmp.display()),
+                },
+            })?;
         let staged = Staged {
-            tmp: temp_path(path),
+            tmp,
             path: path.to_path_buf(),
         };
         interrupt::register_temporary(&staged.tmp);
         // on failure, dropping `staged` removes the temporary file
-        write(&staged.tmp).map_err(|problem| Error::Write {
+        write(&mut file).map_err(|problem| Error::Write {
             path: path.to_path_buf(),
             problem: problem.to_string(),
         })?;
@@ -307,27 +334,30 @@ fn roll_back(done: Vec<(&Path, Option<PathBuf>)>) {
 /// a pending signal an [`Error::Interrupted`].
 pub fn atomic_write<E: Display>(
     path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), E>,
+    write: impl FnOnce(&mut fs::File) -> Result<(), E>,
 ) -> Result<(), Error> {
     write_atomically(path, write)
 }
 
+/// The temporary file of `path`: `.lu<key>.<pid>.tmp` ([`stale::key`]),
+/// at most 26 bytes whatever the output's name, so any name that fits the
+/// file system has a temporary name that fits too.
 fn temp_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+    path.with_file_name(format!(
+        ".lu{}.{}.tmp",
+        stale::key(path),
+        std::process::id()
+    ))
 }
 
 /// Where [`commit_all`] sets a file it replaces aside until all renames
-/// succeeded.
+/// succeeded: `.lu<key>.<pid>.old.tmp`.
 fn old_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.old.tmp", std::process::id()))
+    path.with_file_name(format!(
+        ".lu{}.{}.old.tmp",
+        stale::key(path),
+        std::process::id()
+    ))
 }
 
 /// The PNG preview's path beside an EXR path: same stem, `.png`.
@@ -366,8 +396,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let (a, b) = (dir.path().join("a.exr"), dir.path().join("a.png"));
         fs::write(&a, b"old a").unwrap();
-        let write =
-            |text: &'static [u8]| move |tmp: &Path| fs::write(tmp, text).map_err(|e| e.to_string());
+        let write = |text: &'static [u8]| {
+            move |tmp: &mut fs::File| {
+                std::io::Write::write_all(tmp, text).map_err(|e| e.to_string())
+            }
+        };
         let sa = Staged::write(&a, write(b"new a")).unwrap();
         let sb = Staged::write(&b, write(b"new b")).unwrap();
         // the second rename fails after the first succeeded
@@ -403,7 +436,7 @@ mod tests {
         assert!(!p.exists());
         let p2 = dir.path().join("b.exr");
         let r = atomic_write(&p2, |tmp| {
-            fs::write(tmp, b"partial").unwrap();
+            std::io::Write::write_all(tmp, b"partial").unwrap();
             Err("simulated failure".to_string())
         });
         assert!(r.is_err() && !p2.exists());
