@@ -108,7 +108,7 @@ enum Command {
         #[arg(long, value_enum, default_value = "filmic")]
         tonemap: ToneMapArg,
         /// Exposure of the PNG preview in stops.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = exposure_stops)]
         exposure: f32,
         /// No progress bar and no summary line.
         #[arg(short, long)]
@@ -164,7 +164,7 @@ enum Command {
         #[arg(long, value_enum, default_value = "filmic")]
         tonemap: ToneMapArg,
         /// Exposure of the PNG preview in stops.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = exposure_stops)]
         exposure: f32,
         /// No summary line.
         #[arg(short, long)]
@@ -362,6 +362,11 @@ impl SubsurfaceArgs {
     }
 }
 
+mod out_of_memory;
+
+#[global_allocator]
+static ALLOCATOR: out_of_memory::ReportingAllocator = out_of_memory::ReportingAllocator;
+
 /// `println!` that never panics: a closed stdout (`lucent info | head -0`,
 /// a closed descriptor) drops the text, and the command ends with its own
 /// exit status (docs/output.md, "Closed output streams").
@@ -538,6 +543,21 @@ fn run_explain(
         ExplainArg::Json => say!("{}", plan.to_json_pretty()),
     }
     Ok(())
+}
+
+/// The largest `--exposure` in stops either way: 2^64 already turns any
+/// pixel a render can hold white or black.
+const MAX_EXPOSURE: f32 = 64.0;
+
+/// Parses `--exposure`: a finite number of stops within ±[`MAX_EXPOSURE`].
+fn exposure_stops(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|e| format!("{e}"))?;
+    if !v.is_finite() || v.abs() > MAX_EXPOSURE {
+        return Err(format!(
+            "expected a finite number of stops from -{MAX_EXPOSURE} to {MAX_EXPOSURE}, found {s}"
+        ));
+    }
+    Ok(v)
 }
 
 /// `s` with every control character (from a file name, an OBJ line or a

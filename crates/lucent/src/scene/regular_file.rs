@@ -13,10 +13,15 @@ use std::path::Path;
 /// is opened, by what it is ("not a regular file: it is a FIFO").
 ///
 /// Text that is not UTF-8 fails with `NotUtf8`'s message (line, column,
-/// byte).
+/// byte); a leading UTF-8 byte-order mark is dropped.
 pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
-    utf8_text(read_regular_bytes(path, max_bytes)?)
-        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()))
+    let mut text = utf8_text(read_regular_bytes(path, max_bytes)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()))?;
+    // a byte-order mark is not text (it would hide the first statement)
+    if text.starts_with('\u{feff}') {
+        text.replace_range(..'\u{feff}'.len_utf8(), "");
+    }
+    Ok(text)
 }
 
 /// The bytes of a file that must be a regular file (see

@@ -42,6 +42,7 @@ pub fn merge_parts(
         preview: Some(preview),
         ..m.output
     };
+    crate::memory::enter(crate::memory::Phase::Writing);
     exr_layers::write_frame(output, &m.film, &m.layers, &m.coverage, &header, &out)?;
     Ok(MergedFrame {
         parts: parts.len(),
