@@ -140,8 +140,9 @@ pub(crate) fn color(i: usize) -> RGBColor {
 
 /// A log axis range covering `v` (positive values) with some margin.
 pub(crate) fn log_range(v: impl Iterator<Item = f64>) -> Option<std::ops::Range<f64>> {
+    // values a log axis can span with its margin (1e308 · 1.3 is inf)
     let (lo, hi) = v
-        .filter(|x| x.is_finite() && *x > 0.0)
+        .filter(|x| x.is_finite() && *x > 0.0 && *x < 1e300)
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
             (lo.min(x), hi.max(x))
         });

@@ -130,6 +130,52 @@ impl Film {
         Ok(image.layer_data.channel_data.pixels)
     }
 
+    /// The film of the EXR open as `file` (named `path` in errors) if it is
+    /// one RGB(A) layer of `width`×`height` pixels; `None` if its size is
+    /// another. The header is read and checked first, so what reading the
+    /// pixels allocates comes from `width`×`height`, not from the file.
+    pub fn read_exr_of_size(
+        file: fs::File,
+        path: &Path,
+        width: u32,
+        height: u32,
+    ) -> Result<Option<Film>, Error> {
+        use exr::prelude::*;
+        use std::io::{BufReader, Seek};
+        let bad = |problem: String| crate::error::Error::Read {
+            path: path.to_path_buf(),
+            problem,
+        };
+        let meta = exr::meta::MetaData::read_from_buffered(BufReader::new(&file), true)
+            .map_err(|e| bad(e.to_string()))?;
+        let [h] = &meta.headers[..] else {
+            return Err(bad("more than one EXR layer".into()));
+        };
+        if h.deep || h.channels.list.len() > 4 {
+            return Err(bad("not an RGB(A) image".into()));
+        }
+        if h.layer_size != Vec2(width as usize, height as usize) {
+            return Ok(None);
+        }
+        let mut file = file;
+        file.seek(std::io::SeekFrom::Start(0))
+            .map_err(|e| bad(e.to_string()))?;
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .rgba_channels(
+                |res, _| Film::new(res.width() as u32, res.height() as u32),
+                |film: &mut Film, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                    film.set(pos.x() as u32, pos.y() as u32, Vec3::new(r, g, b))
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(BufReader::new(file))
+            .map_err(|e| bad(e.to_string()))?;
+        Ok(Some(image.layer_data.channel_data.pixels))
+    }
+
     /// Writes an 8-bit sRGB PNG preview through `tonemap` after scaling by
     /// 2^exposure.
     pub fn write_png(&self, path: &Path, tonemap: ToneMap, exposure: f32) -> Result<(), Error> {

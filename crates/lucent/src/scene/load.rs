@@ -40,7 +40,7 @@ pub(crate) const MAX_PIXELS: u64 = 1 << 26;
 
 /// Largest accepted scene file, in bytes: scenes are a few kB; anything
 /// near this is not a scene.
-pub(crate) const MAX_SCENE_BYTES: u64 = 16 << 20;
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 
 /// Largest accepted triangle count of a whole scene (2²⁵ ≈ 33.5 M):
 /// about 30 bytes a triangle in the meshes and 50–100 more in a backend's
