@@ -161,6 +161,10 @@ mod tests {
         let r = log_range([4.0].into_iter()).unwrap();
         assert!(r.start < 4.0 && r.end > 4.0);
         assert!(log_range([0.0, -1.0].into_iter()).is_none());
+        // a value whose margin overflows (1e308 · 1.3) is left out, so
+        // the axis stays finite and the plot ends
+        let r = log_range([1e308, 2.0].into_iter()).unwrap();
+        assert!(r.end.is_finite() && r.end < 10.0, "{r:?}");
     }
 
     #[test]

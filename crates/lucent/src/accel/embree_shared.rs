@@ -52,10 +52,16 @@ impl ErrorSink {
         if code != 0 && msgs.is_empty() {
             msgs.push(format!("Embree: {} ({code})", error_name(code)));
         }
-        if msgs.is_empty() {
-            Ok(())
-        } else {
-            Err(Error::Backend(format!("{what}: {}", msgs.join("; "))))
+        // RTC_ERROR_OUT_OF_MEMORY: a failure while working (exit 1), not
+        // bad input
+        let out_of_memory = code == 4 || msgs.iter().any(|m| m.contains("out of memory"));
+        match () {
+            _ if msgs.is_empty() => Ok(()),
+            _ if out_of_memory => Err(Error::Runtime(format!(
+                "out of memory: {what}: {}",
+                msgs.join("; ")
+            ))),
+            _ => Err(Error::Backend(format!("{what}: {}", msgs.join("; ")))),
         }
     }
 }

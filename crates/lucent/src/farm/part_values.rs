@@ -7,7 +7,8 @@
 //!   ([`crate::film::accumulate`]), so |sum| ≤ n · 2^95 (0 for n = 0).
 //! - The nearest hit: none ([`Nearest::NONE`]), or a finite depth ≥ 0 and
 //!   position, one of the part's sample indices, and object and material
-//!   numbers (index + 1) within the scene's names.
+//!   numbers (index + 1) within the scene's names (when the passes name
+//!   them: a number no pass names is never shown).
 //! - ID coverage: each ID within the names, and at most `n` samples in all
 //!   (one ID a sample).
 
@@ -75,9 +76,9 @@ impl<'a> PixelAt<'a> {
             Some(("sample", format!("sample {}", h.sample)))
         } else if !h.p.iter().all(|c| c.is_finite()) {
             Some(("px", format!("position {:?}", h.p)))
-        } else if h.object as usize > self.objects {
+        } else if self.objects > 0 && h.object as usize > self.objects {
             Some(("object", format!("object number {}", h.object)))
-        } else if h.material as usize > self.materials {
+        } else if self.materials > 0 && h.material as usize > self.materials {
             Some(("material", format!("material number {}", h.material)))
         } else {
             None

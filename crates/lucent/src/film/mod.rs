@@ -389,21 +389,25 @@ pub fn atomic_write<E: Display>(
 /// at most 26 bytes whatever the output's name, so any name that fits the
 /// file system has a temporary name that fits too.
 fn temp_path(path: &Path) -> PathBuf {
-    path.with_file_name(format!(
-        ".lu{}.{}.tmp",
-        stale::key(path),
-        std::process::id()
-    ))
+    temporary_path(path, std::process::id())
+}
+
+/// The temporary file process `pid` writes `path` to:
+/// `.lu<key>.<pid>.tmp` (see [`stale`]).
+pub fn temporary_path(path: &Path, pid: u32) -> PathBuf {
+    path.with_file_name(format!(".lu{}.{pid}.tmp", stale::key(path)))
 }
 
 /// Where [`commit_all`] sets a file it replaces aside until all renames
 /// succeeded: `.lu<key>.<pid>.old.tmp`.
 fn old_path(path: &Path) -> PathBuf {
-    path.with_file_name(format!(
-        ".lu{}.{}.old.tmp",
-        stale::key(path),
-        std::process::id()
-    ))
+    set_aside_path(path, std::process::id())
+}
+
+/// Where process `pid` sets the file under `path` aside while it commits:
+/// `.lu<key>.<pid>.old.tmp`.
+pub fn set_aside_path(path: &Path, pid: u32) -> PathBuf {
+    path.with_file_name(format!(".lu{}.{pid}.old.tmp", stale::key(path)))
 }
 
 /// The PNG preview's path beside an EXR path: same stem, `.png`.
