@@ -54,9 +54,15 @@ fn run_in(dir: &Path, program: &str, args: &[&str]) -> Output {
     child.wait_with_output().unwrap()
 }
 
+/// The binary under test: `LUCENT_FUZZ_BIN` if set (another build, to see
+/// these cases fail on it), else this build's.
+fn binary() -> String {
+    std::env::var("LUCENT_FUZZ_BIN").unwrap_or_else(|_| env!("CARGO_BIN_EXE_lucent").into())
+}
+
 /// `lucent ARGS` in `dir`.
 fn lucent(dir: &Path, args: &[&str]) -> Output {
-    run_in(dir, env!("CARGO_BIN_EXE_lucent"), args)
+    run_in(dir, &binary(), args)
 }
 
 fn stderr(o: &Output) -> String {
@@ -98,7 +104,8 @@ fn parts() -> (tempfile::TempDir, [PathBuf; 2]) {
         );
         assert_exit(&o, 0, &[]);
     }
-    (dir, [d.join("p0.exr"), d.join("p1.exr")])
+    let paths = [d.join("p0.exr"), d.join("p1.exr")];
+    (dir, paths)
 }
 
 /// `lucent merge p0.exr p1.exr -o out.exr` in `d`.
@@ -125,12 +132,14 @@ fn parts_claiming_a_huge_frame_are_refused_before_anything_is_allocated() {
             h.set_text("lucent.region", &region);
             h.set_box("displayWindow", [0, 0, 8191, 8191]);
             h.set_box("dataWindow", [0, y, 8191, y + 4095]);
+            h.set_chunks(4096 / 16);
         });
     }
     let o = merge(d);
     assert_exit(&o, 2, &["p0.exr", "truncated or forged"]);
     assert!(!d.join("out.exr").exists());
-    // one bit of the data window's ymax flipped: the header disagrees
+    // one bit of the data window's ymax flipped (the EXR reader itself
+    // refuses the chunk count, or lucent the region)
     let (dir, [p0, _]) = parts();
     let d = dir.path();
     edit_header(&p0, |h| {
@@ -138,7 +147,7 @@ fn parts_claiming_a_huge_frame_are_refused_before_anything_is_allocated() {
         w[15] ^= 0x40;
         h.set("dataWindow", "box2i", w);
     });
-    assert_exit(&merge(d), 2, &["p0.exr", "lucent.region"]);
+    assert_exit(&merge(d), 2, &["p0.exr"]);
     fs::rename(&p0, d.join("out.partial.exr")).unwrap();
     let o = lucent(
         d,
@@ -156,7 +165,7 @@ fn parts_claiming_a_huge_frame_are_refused_before_anything_is_allocated() {
             "out.partial.exr",
         ],
     );
-    assert_exit(&o, 2, &["out.partial.exr", "lucent.region"]);
+    assert_exit(&o, 2, &["out.partial.exr"]);
 }
 
 /// The mistake: opening a part, a checkpoint or a study file without
@@ -255,13 +264,14 @@ fn forged_part_values_are_refused_naming_file_channel_and_pixel() {
         ("coverage.object", "pixel (1, 1)", |p| {
             edit_channel(p, "coverage.object.n0", |v| v[17] = 1_000_000_000)
         }),
-        ("coverage.object.id0", "pixel (3, 0)", |p| {
-            edit_channel(p, "coverage.object.id0", |v| v[3] = 0)
+        ("coverage.object.id0", "pixel (8, 3)", |p| {
+            edit_channel(p, "coverage.object.id0", |v| v[56] = 0)
         }),
     ];
     for (field, pixel, forge) in cases {
         let (dir, [p0, _]) = parts();
         forge(&p0);
+        eprintln!("forged {field} at {pixel}");
         let o = merge(dir.path());
         assert_exit(&o, 2, &["p0.exr", field, pixel]);
         assert!(!dir.path().join("out.exr").exists(), "{field}");
@@ -288,7 +298,7 @@ fn planted_symlinks_and_set_aside_files_are_never_followed_or_moved() {
         .trim_end_matches("0.tmp");
     let script = format!(
         "ln -s victim {prefix}$$.tmp && exec {} render scene.toml -o out.exr --quiet",
-        env!("CARGO_BIN_EXE_lucent")
+        binary()
     );
     let o = run_in(d, "sh", &["-c", &script]);
     assert_exit(&o, 1, &["out.exr", "in the way"]);
@@ -383,7 +393,7 @@ fn with_closed(dir: &Path, args: &[&str], out: bool, err: bool) -> Output {
             Stdio::piped()
         }
     };
-    let child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+    let child = Command::new(binary())
         .args(args)
         .current_dir(dir)
         .stdout(pipe(out))
@@ -416,7 +426,8 @@ fn closed_output_streams_end_quietly_with_the_commands_status() {
 
 /// `lucent ARGS` in `dir` with its address space limited to `limit`.
 fn limited(dir: &Path, limit: &str, args: &[&str]) -> Output {
-    let mut a = vec![limit, "--", env!("CARGO_BIN_EXE_lucent")];
+    let bin = binary();
+    let mut a = vec![limit, "--", bin.as_str()];
     a.extend_from_slice(args);
     run_in(dir, "prlimit", &a)
 }
@@ -432,15 +443,16 @@ fn allocation_failures_end_with_a_message_and_exit_1() {
     let d = dir.path();
     let big = SCENE.replace("subdivisions = 1", "subdivisions = 9");
     fs::write(d.join("big.toml"), big).unwrap();
-    let o = limited(
-        d,
-        "--as=1000000000",
-        &["render", "big.toml", "-o", "big.exr", "--quiet"],
-    );
-    assert_exit(&o, 1, &["out of memory: cannot allocate", "MB while"]);
-    // a 2048×2048 part: 48 MB of sums in the EXR, read under 64 MB
+    for accel in ["bvh", "embree"] {
+        let args = [
+            "render", "big.toml", "-o", "big.exr", "--quiet", "--accel", accel,
+        ];
+        let o = limited(d, "--as=400000000", &args);
+        assert_exit(&o, 1, &["out of memory"]);
+    }
+    // a 1024×1024 part (48 MB of words in the EXR) merged under 200 MB
     let wide = SCENE
-        .replace("[16, 8]", "[2048, 2048]")
+        .replace("[16, 8]", "[1024, 1024]")
         .replace("spp = 2", "spp = 1");
     fs::write(d.join("wide.toml"), wide).unwrap();
     let o = lucent(
@@ -458,14 +470,16 @@ fn allocation_failures_end_with_a_message_and_exit_1() {
     assert_exit(&o, 0, &[]);
     let o = limited(
         d,
-        "--as=120000000",
+        "--as=200000000",
         &["merge", "w.exr", "-o", "m.exr", "--quiet"],
     );
     assert_exit(&o, 1, &["out of memory: cannot allocate"]);
     let left: Vec<_> = fs::read_dir(d)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .filter(|n| n.ends_with(".tmp") || n.starts_with("m.") || n.starts_with("big."))
+        .filter(|n| {
+            n.ends_with(".tmp") || n.ends_with(".png") || n.starts_with("m.") || n == "big.exr"
+        })
         .collect();
     assert!(left.is_empty(), "{left:?}");
 }
@@ -516,6 +530,25 @@ fn inputs_at_the_edges_of_their_ranges_are_refused_up_front_or_work() {
     }
     let o = lucent(d, &["render", "scene.toml", "-o", "slash.exr/", "--quiet"]);
     assert_exit(&o, 2, &["slash.exr/"]);
+    // an append-only directory (root only: chattr), refused before any
+    // temporary file is made there
+    fs::create_dir(d.join("append")).unwrap();
+    let chattr = |flag: &str| {
+        Command::new("chattr")
+            .arg(flag)
+            .arg(d.join("append"))
+            .status()
+    };
+    if chattr("+a").is_ok_and(|s| s.success()) {
+        let o = lucent(
+            d,
+            &["render", "scene.toml", "-o", "append/a.exr", "--quiet"],
+        );
+        let left = fs::read_dir(d.join("append")).unwrap().count();
+        chattr("-a").unwrap();
+        assert_exit(&o, 2, &["append", "append-only"]);
+        assert_eq!(left, 0);
+    }
     // an OBJ of one triangle, with and without a byte-order mark
     let tri = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
     let obj_scene = |mesh: &str| {

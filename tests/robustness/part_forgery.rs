@@ -115,6 +115,17 @@ impl Parts {
         }
     }
 
+    /// Makes the file claim `n` chunks (ZIP16: a data window of 16·n
+    /// lines): the `chunkCount` attribute, and an offset table of `n`
+    /// entries, the new ones pointing at the last chunk.
+    pub fn set_chunks(&mut self, n: usize) {
+        if self.attrs.iter().any(|a| a.name == "chunkCount") {
+            self.set("chunkCount", "int", (n as i32).to_le_bytes().to_vec());
+        }
+        let last = *self.offsets.last().unwrap();
+        self.offsets.resize(n, last);
+    }
+
     /// Sets a text attribute.
     pub fn set_text(&mut self, name: &str, text: &str) {
         self.set(name, "string", text.as_bytes().to_vec());

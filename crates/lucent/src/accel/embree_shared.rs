@@ -42,6 +42,20 @@ pub(crate) struct ErrorSink {
 /// name the cause; later ones are usually consequences).
 const MAX_ERRORS: usize = 8;
 
+/// RTC_ERROR_OUT_OF_MEMORY.
+const OUT_OF_MEMORY: c_int = 4;
+
+/// The error of an Embree call that failed with `code`: running out of
+/// memory is a failure while working (exit 1, "out of memory: …"), any
+/// other error the backend's refusal.
+pub(crate) fn backend_error(message: String, code: c_int) -> Error {
+    if code == OUT_OF_MEMORY {
+        Error::Runtime(format!("out of memory: {message}"))
+    } else {
+        Error::Backend(message)
+    }
+}
+
 impl ErrorSink {
     /// The messages reported since the last call, plus `code` (the device's
     /// own error code, read by the caller) if nothing was reported; an error
@@ -52,16 +66,13 @@ impl ErrorSink {
         if code != 0 && msgs.is_empty() {
             msgs.push(format!("Embree: {} ({code})", error_name(code)));
         }
-        // RTC_ERROR_OUT_OF_MEMORY: a failure while working (exit 1), not
-        // bad input
-        let out_of_memory = code == 4 || msgs.iter().any(|m| m.contains("out of memory"));
+        let out_of_memory = msgs.iter().any(|m| m.contains("out of memory"));
         match () {
             _ if msgs.is_empty() => Ok(()),
-            _ if out_of_memory => Err(Error::Runtime(format!(
-                "out of memory: {what}: {}",
-                msgs.join("; ")
-            ))),
-            _ => Err(Error::Backend(format!("{what}: {}", msgs.join("; ")))),
+            _ => Err(backend_error(
+                format!("{what}: {}", msgs.join("; ")),
+                if out_of_memory { OUT_OF_MEMORY } else { code },
+            )),
         }
     }
 }
