@@ -243,6 +243,10 @@ fn special_files_in_a_study_directory_fail_at_once() {
     }
 }
 
+/// A forgery: the field and pixel its message must name, and how the part
+/// is forged.
+type Forgery = (&'static str, &'static str, fn(&Path));
+
 /// The mistake: trusting a part's pixel values: another compression than
 /// the writer's (PXR24 mangles u32 words into −2.3e18 radiance), sums no
 /// number of samples adds up to, NaN depth, IDs past the scene's objects,
@@ -250,7 +254,7 @@ fn special_files_in_a_study_directory_fail_at_once() {
 /// naming the file, the channel and the pixel.
 #[test]
 fn forged_part_values_are_refused_naming_file_channel_and_pixel() {
-    let cases: [(&str, &str, fn(&Path)); 6] = [
+    let cases: [Forgery; 6] = [
         ("compression", "PXR24", |p| {
             edit_header(p, |h| h.set("compression", "compression", vec![5]))
         }),

@@ -186,7 +186,7 @@ pub fn edit_channel(path: &Path, name: &str, edit: impl FnOnce(&mut Vec<u32>)) {
         .channel_data
         .list
         .iter_mut()
-        .find(|c| c.name == Text::from(name))
+        .find(|c| c.name == *name)
         .unwrap_or_else(|| panic!("no channel {name}"));
     let FlatSamples::U32(v) = &mut c.sample_data else {
         panic!("{name} is not u32")
