@@ -58,8 +58,15 @@ fn binary() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_lucent")))
 }
 
-/// Runs `program ARGS` in `dir`; `None` if it had to be killed after 10 s.
-fn run_in(dir: &Path, program: &Path, args: &[String]) -> Option<Output> {
+/// Runs `program ARGS` in `dir`; `None` if it had to be killed after
+/// `limit`. Its output is read while it runs (a long message must not fill
+/// the pipe and stall it).
+pub(crate) fn run_limited(
+    dir: &Path,
+    program: &Path,
+    args: &[String],
+    limit: Duration,
+) -> Option<Output> {
     let mut child = Command::new(program)
         .args(args)
         .current_dir(dir)
@@ -68,16 +75,39 @@ fn run_in(dir: &Path, program: &Path, args: &[String]) -> Option<Output> {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
+    let drain = |r: Option<Box<dyn std::io::Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut v = Vec::new();
+            if let Some(mut r) = r {
+                let _ = r.read_to_end(&mut v);
+            }
+            v
+        })
+    };
+    let out = drain(child.stdout.take().map(|r| Box::new(r) as _));
+    let err = drain(child.stderr.take().map(|r| Box::new(r) as _));
     let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(10) {
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if start.elapsed() > limit {
             let _ = child.kill();
             let _ = child.wait();
             return None;
         }
         std::thread::sleep(Duration::from_millis(10));
-    }
-    Some(child.wait_with_output().unwrap())
+    };
+    Some(Output {
+        status,
+        stdout: out.join().unwrap(),
+        stderr: err.join().unwrap(),
+    })
+}
+
+/// [`run_limited`] with the cases' 10 s.
+fn run_in(dir: &Path, program: &Path, args: &[String]) -> Option<Output> {
+    run_limited(dir, program, args, Duration::from_secs(10))
 }
 
 /// The two intact band parts every part case starts from (rendered once).

@@ -10,7 +10,7 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use crate::part_forgery::{edit_channel, edit_header};
 
@@ -34,24 +34,9 @@ const LIMIT: Duration = Duration::from_secs(60);
 /// Runs `program ARGS` in `dir`, killing it and failing the test if it has
 /// not ended within [`LIMIT`].
 fn run_in(dir: &Path, program: &str, args: &[&str]) -> Output {
-    let mut child = Command::new(program)
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > LIMIT {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{program} {args:?} did not end within {LIMIT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.wait_with_output().unwrap()
+    let owned: Vec<String> = args.iter().map(|a| a.to_string()).collect();
+    crate::fuzz_files::run_limited(dir, Path::new(program), &owned, LIMIT)
+        .unwrap_or_else(|| panic!("{program} {args:?} did not end within {LIMIT:?}"))
 }
 
 /// The binary under test: `LUCENT_FUZZ_BIN` if set (another build, to see

@@ -218,7 +218,13 @@ impl Attributes<'_> {
         let raw = self.text(k)?;
         T::deserialize(Value::String(raw.clone()))
             .or_else(|_| serde_json::from_str(&raw))
-            .map_err(|e| bad(self.path, Some(k), format!("`{raw}`: {e}")))
+            .map_err(|e| {
+                bad(
+                    self.path,
+                    Some(k),
+                    format!("`{}`: {e}", super::part_file::shown(&raw)),
+                )
+            })
     }
 
     /// That the file is a part of the format this build reads.
