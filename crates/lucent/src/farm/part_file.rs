@@ -30,19 +30,6 @@ use crate::scene::regular_file::open_regular;
 /// bits): no ZIP chunk holds more than this many bytes per stored byte.
 pub const MAX_DEFLATE_RATIO: u64 = 1032;
 
-/// `text` as a message quotes it: at most 200 characters, then how many
-/// more there are (a forged 100 kB field makes a short message).
-pub(super) fn shown(text: &str) -> String {
-    match text.char_indices().nth(200) {
-        None => text.to_string(),
-        Some((at, _)) => format!(
-            "{}… ({} more characters)",
-            &text[..at],
-            text[at..].chars().count()
-        ),
-    }
-}
-
 /// A part file whose header and EXR structure are checked, its pixels not
 /// yet read.
 pub(crate) struct PartFile {
