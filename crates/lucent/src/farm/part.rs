@@ -24,6 +24,7 @@ pub use super::header::{
 
 use super::header::bad;
 pub(crate) use super::part_file::PartFile;
+use super::part_file::NEAREST;
 use super::part_values::PixelAt;
 use crate::error::Error;
 use crate::film::accumulate::{from_words, to_words};
@@ -32,10 +33,6 @@ use crate::film::{Staged, Sums};
 
 /// A part's EXR channels: u32 samples, one a pixel of the region.
 type Channel = AnyChannel<FlatSamples>;
-
-/// The nearest hit's channels, `nearest.<name>`, in [`nearest_words`]
-/// order.
-pub(super) const NEAREST: [&str; 7] = ["depth", "sample", "px", "py", "pz", "object", "material"];
 
 fn nearest_words(n: &Nearest) -> [u32; 7] {
     let [px, py, pz] = n.p.map(f32::to_bits);

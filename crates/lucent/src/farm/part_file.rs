@@ -30,6 +30,10 @@ use crate::scene::regular_file::open_regular;
 /// bits): no ZIP chunk holds more than this many bytes per stored byte.
 pub const MAX_DEFLATE_RATIO: u64 = 1032;
 
+/// The nearest hit's channels, `nearest.<name>`, in `part::nearest_words`
+/// order.
+pub(super) const NEAREST: [&str; 7] = ["depth", "sample", "px", "py", "pz", "object", "material"];
+
 /// A part file whose header and EXR structure are checked, its pixels not
 /// yet read.
 pub(crate) struct PartFile {
@@ -135,9 +139,7 @@ fn check_channel(
             .any(|ch| (0..4).any(|w| name == format!("{}.{ch}.w{w}", l.name)))
     });
     let nearest = layout.is_some_and(|l| l.nearest())
-        && super::part::NEAREST
-            .iter()
-            .any(|n| name == format!("nearest.{n}"));
+        && NEAREST.iter().any(|n| name == format!("nearest.{n}"));
     if summed || nearest || is_coverage(&name, layout) {
         return Ok(());
     }
