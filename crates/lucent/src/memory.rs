@@ -1,6 +1,6 @@
 //! What the process is doing, for the message of an allocation that fails
 //! where no caller can handle it: the binary's allocator reports it as
-//! "out of memory: cannot allocate N MB while <phase>" and exits 1
+//! "out of memory: cannot allocate N MB while PHASE" and exits 1
 //! (docs/output.md, "Out of memory"). A phase is a plain atomic, so the
 //! allocator reads it without allocating or locking.
 

@@ -10,7 +10,7 @@
 //!
 //! - [`part`]: the part file (an EXR of the integer sums), with its
 //!   [`header`] saying which frame, region and samples it holds;
-//! - [`part_file`] and [`part_values`]: a part read as untrusted input,
+//! - `part_file` and `part_values`: a part read as untrusted input,
 //!   its structure and its values checked;
 //! - [`cover`]: whether parts cover the frame exactly once;
 //! - [`merge`]: the checks and the sum;

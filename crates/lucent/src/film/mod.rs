@@ -249,7 +249,7 @@ impl Staged {
     ///
     /// The temporary file is created exclusively (`O_CREAT|O_EXCL`: a file
     /// or symlink already under its name is never opened, followed or
-    /// replaced) under a short name ([`temp_path`]), and `write` gets the
+    /// replaced) under a short name ([`temporary_path`]), and `write` gets the
     /// open file, never a path that could be swapped under it.
     pub fn write<E: Display>(
         path: &Path,

@@ -1,7 +1,7 @@
 //! Temporaries a killed process left beside an output. An output is
 //! written to `.lu<key>.<pid>.tmp` and renamed into place
 //! ([`super::Staged`]); a file it replaces waits as `.lu<key>.<pid>.old.tmp`
-//! until every rename of the command succeeded. `<key>` is [`key`], eight
+//! until every rename of the command succeeded. `<key>` is `key`, eight
 //! hex digits of the output's file name, so the names stay short whatever
 //! the output's name. A process that handles a signal removes its
 //! temporaries ([`crate::interrupt`]), but SIGKILL (the OOM killer, a
