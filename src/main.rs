@@ -2,6 +2,7 @@
 //! errors to exit codes in one place, [`exit_code`] (2: bad input —
 //! arguments, scene, meshes; 1: a failure while running or writing output).
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -107,7 +108,7 @@ enum Command {
         #[arg(long, value_enum, default_value = "filmic")]
         tonemap: ToneMapArg,
         /// Exposure of the PNG preview in stops.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = exposure_stops)]
         exposure: f32,
         /// No progress bar and no summary line.
         #[arg(short, long)]
@@ -163,7 +164,7 @@ enum Command {
         #[arg(long, value_enum, default_value = "filmic")]
         tonemap: ToneMapArg,
         /// Exposure of the PNG preview in stops.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = exposure_stops)]
         exposure: f32,
         /// No summary line.
         #[arg(short, long)]
@@ -361,10 +362,34 @@ impl SubsurfaceArgs {
     }
 }
 
+mod out_of_memory;
+
+#[global_allocator]
+static ALLOCATOR: out_of_memory::ReportingAllocator = out_of_memory::ReportingAllocator;
+
+/// `println!` that never panics: a closed stdout (`lucent info | head -0`,
+/// a closed descriptor) drops the text, and the command ends with its own
+/// exit status (docs/output.md, "Closed output streams").
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
+/// `eprintln!` that never panics: a closed stderr drops the message, and
+/// the exit status still says how the command ended.
+macro_rules! tell {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($t)*);
+    }};
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Err(e) = lucent::interrupt::install() {
-        eprintln!("warning: cannot catch SIGINT/SIGTERM ({e}); an interrupted command may leave temporary files");
+        tell!("warning: cannot catch SIGINT/SIGTERM ({e}); an interrupted command may leave temporary files");
     }
     let result = match cli.command {
         Command::Render {
@@ -435,7 +460,7 @@ fn main() -> ExitCode {
             };
             session::merge_parts(&parts, &output, preview).map(|m| {
                 if !quiet {
-                    eprintln!("{}", m.summary(&output));
+                    tell!("{}", m.summary(&output));
                 }
             })
         }
@@ -443,7 +468,7 @@ fn main() -> ExitCode {
         Command::Study(args) => lucent_tools::study::cli::run_study(args),
         Command::Bench(args) => lucent_tools::bench::cli::run_bench(args),
         Command::Info => {
-            println!("{}", session::build_info());
+            say!("{}", session::build_info());
             Ok(())
         }
     };
@@ -463,7 +488,7 @@ fn finish(result: Result<(), Error>) -> ExitCode {
                 }
                 _ => e.to_string(),
             };
-            eprintln!("error: {}", without_control_characters(&shown));
+            tell!("error: {}", without_control_characters(&shown));
             ExitCode::from(exit_code(&e))
         }
     }
@@ -489,10 +514,10 @@ fn exit_code(e: &Error) -> u8 {
 fn run_render(r: &session::Request, quiet: bool) -> Result<(), Error> {
     let o = session::run(r)?;
     if !quiet {
-        eprintln!("{}", o.summary(&r.output));
+        tell!("{}", o.summary(&r.output));
     }
     if r.opts.stats {
-        eprint!("{}", effects::summary(&o.stats.counters));
+        let _ = write!(std::io::stderr(), "{}", effects::summary(&o.stats.counters));
     }
     report_rejected_rays(o.rejected_rays);
     Ok(())
@@ -512,10 +537,27 @@ fn run_explain(
     let passes = aov.unwrap_or(scene.output.aovs);
     let plan = session::identity::render_plan(&scene, integrator, passes);
     match format {
-        ExplainArg::Text => print!("{}", plan::text::render(&plan)),
-        ExplainArg::Json => println!("{}", plan.to_json_pretty()),
+        ExplainArg::Text => {
+            let _ = write!(std::io::stdout(), "{}", plan::text::render(&plan));
+        }
+        ExplainArg::Json => say!("{}", plan.to_json_pretty()),
     }
     Ok(())
+}
+
+/// The largest `--exposure` in stops either way: 2^64 already turns any
+/// pixel a render can hold white or black.
+const MAX_EXPOSURE: f32 = 64.0;
+
+/// Parses `--exposure`: a finite number of stops within ±[`MAX_EXPOSURE`].
+fn exposure_stops(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|e| format!("{e}"))?;
+    if !v.is_finite() || v.abs() > MAX_EXPOSURE {
+        return Err(format!(
+            "expected a finite number of stops from -{MAX_EXPOSURE} to {MAX_EXPOSURE}, found {s}"
+        ));
+    }
+    Ok(v)
 }
 
 /// `s` with every control character (from a file name, an OBJ line or a
@@ -537,7 +579,7 @@ fn without_control_characters(s: &str) -> String {
 /// how many ray queries the backend refused as out of range, if any.
 fn report_rejected_rays(n: u64) {
     if n > 0 {
-        eprintln!(
+        tell!(
             "warning: {n} ray queries had a non-finite or out-of-range origin, direction or \
              interval (beyond ±{:e}) and were answered as misses; the image may be missing \
              light there (see \"Supported ranges\" in docs/scene-format.md)",

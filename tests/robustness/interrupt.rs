@@ -204,7 +204,8 @@ fn killed_and_resumed(options: &[&str]) {
             // renamed into place whole); the resumed render removes it
             // (film::stale), checked below. A stand-in for the moment the
             // kill does not always hit:
-            fs::write(d.join(format!(".cut.partial.exr.{pid}.tmp")), b"cut").unwrap();
+            let tmp = lucent::film::temporary_path(&d.join("cut.partial.exr"), pid);
+            fs::write(tmp, b"cut").unwrap();
         }
         assert!(
             d.join("cut.partial.exr").is_file(),
@@ -223,7 +224,7 @@ fn killed_and_resumed(options: &[&str]) {
         // done: what was kept to resume from is gone, and what the killed
         // process was writing
         assert!(!d.join("cut.partial.exr").exists());
-        assert!(!d.join(format!(".cut.partial.exr.{pid}.tmp")).exists());
+        assert!(!lucent::film::temporary_path(&d.join("cut.partial.exr"), pid).exists());
         fs::remove_file(d.join("cut.exr")).unwrap();
         fs::remove_file(d.join("cut.png")).unwrap();
     }

@@ -7,6 +7,9 @@
 mod common;
 
 mod fuzz;
+mod fuzz_files;
+mod hostile_files;
 mod hostile_input;
 mod huge_numbers;
 mod interrupt;
+mod part_forgery;

@@ -112,10 +112,7 @@ pub fn png(
         })?;
     }
     let img = image::RgbImage::from_raw(W, H, buf).ok_or(PlotError::Buffer)?;
-    atomic_write(path, |tmp| {
-        img.save_with_format(tmp, image::ImageFormat::Png)
-            .map_err(|e| e.to_string())
-    })?;
+    atomic_write(path, |tmp| lucent::film::write_png(&img, tmp))?;
     Ok(())
 }
 
@@ -143,8 +140,9 @@ pub(crate) fn color(i: usize) -> RGBColor {
 
 /// A log axis range covering `v` (positive values) with some margin.
 pub(crate) fn log_range(v: impl Iterator<Item = f64>) -> Option<std::ops::Range<f64>> {
+    // values a log axis can span with its margin (1e308 · 1.3 is inf)
     let (lo, hi) = v
-        .filter(|x| x.is_finite() && *x > 0.0)
+        .filter(|x| x.is_finite() && *x > 0.0 && *x < 1e300)
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
             (lo.min(x), hi.max(x))
         });
@@ -163,6 +161,10 @@ mod tests {
         let r = log_range([4.0].into_iter()).unwrap();
         assert!(r.start < 4.0 && r.end > 4.0);
         assert!(log_range([0.0, -1.0].into_iter()).is_none());
+        // a value whose margin overflows (1e308 · 1.3) is left out, so
+        // the axis stays finite and the plot ends
+        let r = log_range([1e308, 2.0].into_iter()).unwrap();
+        assert!(r.end.is_finite() && r.end < 10.0, "{r:?}");
     }
 
     #[test]

@@ -109,6 +109,17 @@ fn remove_temporaries() {
     }
 }
 
+/// Removes every registered temporary file, unless the registry is in use
+/// (for an exit from a state that may hold its lock: an allocation that
+/// failed while registering).
+pub fn remove_temporaries_if_free() {
+    if let Ok(t) = TEMPORARIES.try_lock() {
+        for p in t.iter() {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

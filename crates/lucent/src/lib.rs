@@ -21,6 +21,7 @@ pub mod interrupt;
 pub mod kernels;
 pub mod lights;
 pub mod materials;
+pub mod memory;
 pub mod progress;
 pub mod render;
 pub mod sampling;

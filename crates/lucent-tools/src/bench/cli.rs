@@ -1,5 +1,6 @@
 //! `lucent bench` on the command line: its arguments and their run.
 
+use std::io::Write as _;
 use std::path::PathBuf;
 
 use lucent::accel::Backend;
@@ -74,9 +75,14 @@ pub fn run_bench(a: BenchArgs) -> Result<(), Error> {
         s.backends = backends;
         s.progress = !a.quiet;
         let o = super::replay::run(&s)?;
-        print!("{}", o.report);
+        let _ = write!(std::io::stdout(), "{}", o.report);
         if !a.quiet {
-            eprintln!("{} rows in {}", o.rows.len(), o.csv.display());
+            let _ = writeln!(
+                std::io::stderr(),
+                "{} rows in {}",
+                o.rows.len(),
+                o.csv.display()
+            );
         }
         return Ok(());
     }
@@ -91,9 +97,10 @@ pub fn run_bench(a: BenchArgs) -> Result<(), Error> {
     s.rays = a.rays.unwrap_or(s.rays);
     s.progress = !a.quiet;
     let o = super::run(&s)?;
-    print!("{}", o.report);
+    let _ = write!(std::io::stdout(), "{}", o.report);
     if !a.quiet {
-        eprintln!(
+        let _ = writeln!(
+            std::io::stderr(),
             "{} rows in {}; plots: {}",
             o.rows.len(),
             o.csv.display(),

@@ -68,7 +68,7 @@ pub(super) fn write_csv(out: &Path, rows: &[Row]) -> Result<PathBuf, Error> {
         text.push('\n');
     }
     lucent::film::atomic_write(&csv, |tmp| {
-        std::fs::write(tmp, &text).map_err(|e| e.to_string())
+        std::io::Write::write_all(tmp, text.as_bytes()).map_err(|e| e.to_string())
     })
     .map_err(|e| Error::Runtime(format!("{}: {e}", csv.display())))?;
     Ok(csv)

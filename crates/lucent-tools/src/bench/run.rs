@@ -4,6 +4,7 @@
 //! count; then the CSV, the report and the plots.
 
 use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -76,7 +77,7 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
     }
     bar.finish_and_clear();
     for w in &warnings {
-        eprintln!("warning: {w}");
+        let _ = writeln!(std::io::stderr(), "warning: {w}");
     }
 
     let mut report = report(&rows, &threads, s, started.elapsed().as_secs_f64());
@@ -90,13 +91,13 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
     let (csv, plots) = out.finish((|| {
         let csv = write_csv(&s.out, &rows)?;
         lucent::film::write_atomically(&s.out.join("report.txt"), |tmp| {
-            std::fs::write(tmp, &report).map_err(|e| e.to_string())
+            std::io::Write::write_all(tmp, report.as_bytes()).map_err(|e| e.to_string())
         })?;
         let plots = plot::write_plots(&s.out, &rows).map_err(|e| Error::Runtime(e.to_string()))?;
         Ok((csv, plots))
     })())?;
     if !failures.is_empty() {
-        print!("{report}");
+        let _ = write!(std::io::stdout(), "{report}");
         return Err(Error::Runtime(format!(
             "the backends disagree on hit counts beyond edge cases: {}",
             failures.join("; ")

@@ -1,5 +1,6 @@
 //! `lucent study` on the command line: its arguments and their run.
 
+use std::io::Write as _;
 use std::path::PathBuf;
 
 use lucent::integrator::IntegratorKind;
@@ -92,7 +93,8 @@ pub fn run_study(a: StudyArgs) -> Result<(), Error> {
     s.progress = !a.quiet;
     let o = super::run(&s)?;
     if !a.quiet {
-        eprintln!(
+        let _ = writeln!(
+            std::io::stderr(),
             "{}: {} configurations, {} rows ({} rendered now), reference {} at {} spp",
             o.report.display(),
             o.configs.len(),

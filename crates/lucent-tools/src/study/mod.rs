@@ -15,6 +15,7 @@
 
 pub mod cli;
 pub mod config;
+mod input_file;
 mod ladder;
 pub mod metrics;
 pub mod plots;
@@ -110,9 +111,10 @@ fn build_accels(scene: &Scene, backends: &[Backend], configs: &[Config]) -> Resu
 /// Runs (or resumes) a study; see the module docs.
 pub fn run(s: &Settings) -> Result<Outcome, Error> {
     settings::validate(s)?;
-    let scene_text =
-        fs::read(&s.scene).map_err(|e| Error::Input(format!("{}: {e}", s.scene.display())))?;
     let scene = scene::load(&s.scene).map_err(|e| Error::Input(e.to_string()))?;
+    let scene_text = scene::load::read_regular_file(&s.scene, scene::load::MAX_SCENE_BYTES)
+        .map_err(|e| Error::Input(format!("{}: {e}", s.scene.display())))?
+        .into_bytes();
     let scene = resized(scene, s.width);
     let seed = s.seed.unwrap_or(scene.settings.seed);
     let mut backends = vec![Backend::default_available()];

@@ -10,10 +10,11 @@
 //! reference settings (integrator, spp, seed, resolution, path depth,
 //! probe options).
 
-use std::fs;
+use std::io::Write as _;
 use std::path::PathBuf;
 
 use super::config::{self, Overrides};
+use super::input_file::{read_film, read_text};
 use super::settings::Settings;
 use super::{render_opts, runtime};
 use lucent::accel::Accel;
@@ -126,12 +127,13 @@ pub(super) fn reference(
         cached: false,
         overrides,
     };
-    if path.is_file() {
-        let film = Film::read_exr(&path).map_err(runtime)?;
-        if (film.width, film.height) == (scene.camera.width, scene.camera.height) {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    if let Some(film) = read_film(&path, w, h).map_err(|e| Error::Input(e.to_string()))? {
+        {
             info.cached = true;
-            info.seconds = fs::read_to_string(&meta)
+            info.seconds = read_text(&meta)
                 .ok()
+                .flatten()
                 .and_then(|t| {
                     t.lines().find_map(|l| {
                         l.strip_prefix("seconds=")
@@ -144,7 +146,8 @@ pub(super) fn reference(
     }
     let ref_scene = config::apply(scene, &overrides).map_err(|e| Error::Input(e.to_string()))?;
     if s.progress {
-        eprintln!(
+        let _ = writeln!(
+            std::io::stderr(),
             "reference: {} at {} spp, {}x{} → {}",
             config::integrator_name(s.reference),
             s.reference_spp,
@@ -173,7 +176,9 @@ pub(super) fn reference(
         config::describe(&overrides),
         stats.threads
     );
-    film::atomic_write(&meta, |tmp| fs::write(tmp, text).map_err(|e| e.to_string()))
-        .map_err(runtime)?;
+    film::atomic_write(&meta, |tmp| {
+        std::io::Write::write_all(tmp, text.as_bytes()).map_err(|e| e.to_string())
+    })
+    .map_err(runtime)?;
     Ok((film, info))
 }

@@ -8,7 +8,6 @@
 //! sample count, relative to the baseline's (> 1: better).
 
 use std::fmt::Write as _;
-use std::fs;
 use std::path::PathBuf;
 
 use super::config::{self, Axis, Config};
@@ -102,7 +101,9 @@ pub fn write(
         writeln!(r, "![{f}]({f})\n").unwrap();
     }
     writeln!(r, "Raw rows: `results.csv`; final images: `images/`.").unwrap();
-    atomic_write(&path, |tmp| fs::write(tmp, &r).map_err(|e| e.to_string()))?;
+    atomic_write(&path, |tmp| {
+        std::io::Write::write_all(tmp, r.as_bytes()).map_err(|e| e.to_string())
+    })?;
     Ok(path)
 }
 

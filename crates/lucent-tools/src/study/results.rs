@@ -4,11 +4,15 @@
 //! file is read back, a torn last line is dropped (the valid rows are
 //! rewritten atomically first) and only missing rows are rendered.
 
-use std::fs::{self, File, OpenOptions};
+use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use lucent::film::atomic_write;
+
+/// The longest time a row may record (a year): beyond it the row is not
+/// one a study wrote.
+pub const MAX_SECONDS: f64 = 3.2e7;
 
 pub const HEADER: &str =
     "config,axis,value,backend,integrator,spp,seconds,rmse,relmse,bias,bias_stderr,fireflies";
@@ -91,7 +95,7 @@ impl Row {
         if f.len() != 12 {
             return None;
         }
-        Some(Row {
+        let row = Row {
             config: f[0].into(),
             axis: f[1].into(),
             value: f[2].into(),
@@ -104,7 +108,18 @@ impl Row {
             bias: f[9].parse().ok()?,
             bias_stderr: f[10].parse().ok()?,
             fireflies: f[11].parse().ok()?,
-        })
+        };
+        // a row no run writes (seconds of 1e308, a NaN error) is dropped
+        // like a torn one, so no plot is asked to span it
+        let measures = [
+            row.seconds,
+            row.rmse,
+            row.rel_mse,
+            row.bias,
+            row.bias_stderr,
+        ];
+        (measures.iter().all(|v| v.is_finite()) && (0.0..=MAX_SECONDS).contains(&row.seconds))
+            .then_some(row)
     }
 }
 
@@ -128,7 +143,9 @@ impl Results {
             text.push_str(&r.to_line());
             text.push('\n');
         }
-        atomic_write(path, |tmp| fs::write(tmp, &text).map_err(|e| e.to_string()))?;
+        atomic_write(path, |tmp| {
+            std::io::Write::write_all(tmp, text.as_bytes()).map_err(|e| e.to_string())
+        })?;
         let file = OpenOptions::new()
             .append(true)
             .open(path)
@@ -148,11 +165,11 @@ impl Results {
     /// directory before it writes anything in it.
     pub fn read(path: &Path) -> Result<Vec<Row>, ResultsError> {
         let mut rows = Vec::new();
-        if path.exists() {
-            let text = fs::read_to_string(path).map_err(|source| ResultsError::Read {
-                path: path.to_path_buf(),
-                source,
-            })?;
+        let text = super::input_file::read_text(path).map_err(|source| ResultsError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        if let Some(text) = text {
             let mut lines = text.lines();
             match lines.next() {
                 Some(h) if h.trim_end() == HEADER => {}
@@ -208,6 +225,7 @@ impl Results {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
 
     fn row(config: &str, spp: u32) -> Row {
         Row {

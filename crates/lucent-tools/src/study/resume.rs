@@ -7,10 +7,10 @@
 //! running mean both exist and below which every row exists. Rows are
 //! only resumed under the settings that made them ([`check_results_key`]).
 
-use std::fs;
 use std::path::{Path, PathBuf};
 
 use super::config::{self, Config};
+use super::input_file::{read_film, read_text};
 use super::reference::ReferenceInfo;
 use super::results::Results;
 use super::runtime;
@@ -57,10 +57,13 @@ pub(super) fn check_results_key(
     let key = results_key(s, reference_hash, seed, scene);
     let key_path = s.out_dir.join("results.key");
     let csv = s.out_dir.join("results.csv");
-    let has_rows = fs::read_to_string(&csv)
-        .map(|t| t.lines().count() > 1)
-        .unwrap_or(false);
-    match fs::read_to_string(&key_path) {
+    let has_rows = read_text(&csv)
+        .map_err(|e| Error::Input(format!("{}: {e}", csv.display())))?
+        .is_some_and(|t| t.lines().count() > 1);
+    let old_key = read_text(&key_path)
+        .map_err(|e| Error::Input(format!("{}: {e}", key_path.display())))?
+        .ok_or(());
+    match old_key {
         Ok(old) if old == key => return Ok(()),
         Ok(old) if has_rows => {
             return Err(Error::Input(format!(
@@ -99,11 +102,11 @@ pub(super) fn write_results_key(
 ) -> Result<(), Error> {
     let key = results_key(s, r.hash, seed, scene);
     let key_path = s.out_dir.join("results.key");
-    if fs::read_to_string(&key_path).is_ok_and(|old| old == key) {
+    if read_text(&key_path).is_ok_and(|old| old.is_some_and(|old| old == key)) {
         return Ok(());
     }
     film::atomic_write(&key_path, |tmp| {
-        fs::write(tmp, &key).map_err(|e| e.to_string())
+        std::io::Write::write_all(tmp, key.as_bytes()).map_err(|e| e.to_string())
     })
     .map_err(runtime)
 }
@@ -141,11 +144,10 @@ pub(super) fn jobs<'c>(
             let Some(row) = results.get(&c.name, n) else {
                 break;
             };
-            if let Ok(f) = Film::read_exr(&state_path(&s.out_dir, &c.name, n)) {
-                if (f.width, f.height) == (scene.camera.width, scene.camera.height) {
-                    start = j + 1;
-                    acc = Some((f, row.seconds));
-                }
+            let (w, h) = (scene.camera.width, scene.camera.height);
+            if let Ok(Some(f)) = read_film(&state_path(&s.out_dir, &c.name, n), w, h) {
+                start = j + 1;
+                acc = Some((f, row.seconds));
             }
         }
         let scene = config::apply(scene, &c.overrides).map_err(|e| Error::Input(e.to_string()))?;

@@ -42,6 +42,20 @@ pub(crate) struct ErrorSink {
 /// name the cause; later ones are usually consequences).
 const MAX_ERRORS: usize = 8;
 
+/// RTC_ERROR_OUT_OF_MEMORY.
+const OUT_OF_MEMORY: c_int = 4;
+
+/// The error of an Embree call that failed with `code`: running out of
+/// memory is a failure while working (exit 1, "out of memory: …"), any
+/// other error the backend's refusal.
+pub(crate) fn backend_error(message: String, code: c_int) -> Error {
+    if code == OUT_OF_MEMORY {
+        Error::Runtime(format!("out of memory: {message}"))
+    } else {
+        Error::Backend(message)
+    }
+}
+
 impl ErrorSink {
     /// The messages reported since the last call, plus `code` (the device's
     /// own error code, read by the caller) if nothing was reported; an error
@@ -52,10 +66,13 @@ impl ErrorSink {
         if code != 0 && msgs.is_empty() {
             msgs.push(format!("Embree: {} ({code})", error_name(code)));
         }
-        if msgs.is_empty() {
-            Ok(())
-        } else {
-            Err(Error::Backend(format!("{what}: {}", msgs.join("; "))))
+        let out_of_memory = msgs.iter().any(|m| m.contains("out of memory"));
+        match () {
+            _ if msgs.is_empty() => Ok(()),
+            _ => Err(backend_error(
+                format!("{what}: {}", msgs.join("; ")),
+                if out_of_memory { OUT_OF_MEMORY } else { code },
+            )),
         }
     }
 }

@@ -218,7 +218,7 @@ impl Attributes<'_> {
         let raw = self.text(k)?;
         T::deserialize(Value::String(raw.clone()))
             .or_else(|_| serde_json::from_str(&raw))
-            .map_err(|e| bad(self.path, Some(k), format!("`{raw}`: {e}")))
+            .map_err(|e| bad(self.path, Some(k), format!("`{}`: {e}", shown(&raw))))
     }
 
     /// That the file is a part of the format this build reads.
@@ -240,6 +240,19 @@ impl Attributes<'_> {
             ));
         }
         Ok(())
+    }
+}
+
+/// `text` as a message quotes it: at most 200 characters, then how many
+/// more there are (a forged 100 kB field makes a short message).
+fn shown(text: &str) -> String {
+    match text.char_indices().nth(200) {
+        None => text.to_string(),
+        Some((at, _)) => format!(
+            "{}… ({} more characters)",
+            &text[..at],
+            text[at..].chars().count()
+        ),
     }
 }
 

@@ -158,6 +158,7 @@ fn cover_error(
 
 /// Reads, checks and merges the parts at `paths`.
 pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
+    crate::memory::enter(crate::memory::Phase::ReadingParts);
     let headers = paths
         .iter()
         .map(|p| Ok((p.clone(), part::read_header(p)?)))

@@ -10,6 +10,8 @@
 //!
 //! - [`part`]: the part file (an EXR of the integer sums), with its
 //!   [`header`] saying which frame, region and samples it holds;
+//! - `part_file` and `part_values`: a part read as untrusted input,
+//!   its structure and its values checked;
 //! - [`cover`]: whether parts cover the frame exactly once;
 //! - [`merge`]: the checks and the sum;
 //! - [`mod@scene_hash`]: which scene a part is of.
@@ -18,6 +20,8 @@ pub mod cover;
 pub mod header;
 pub mod merge;
 pub mod part;
+mod part_file;
+mod part_values;
 pub mod scene_hash;
 
 pub use scene_hash::scene_hash;

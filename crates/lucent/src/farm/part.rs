@@ -23,6 +23,9 @@ pub use super::header::{
 };
 
 use super::header::bad;
+pub(crate) use super::part_file::PartFile;
+use super::part_file::NEAREST;
+use super::part_values::PixelAt;
 use crate::error::Error;
 use crate::film::accumulate::{from_words, to_words};
 use crate::film::pass_sums::{AovSums, Nearest, Passes};
@@ -30,10 +33,6 @@ use crate::film::{Staged, Sums};
 
 /// A part's EXR channels: u32 samples, one a pixel of the region.
 type Channel = AnyChannel<FlatSamples>;
-
-/// The nearest hit's channels, `nearest.<name>`, in [`nearest_words`]
-/// order.
-const NEAREST: [&str; 7] = ["depth", "sample", "px", "py", "pz", "object", "material"];
 
 fn nearest_words(n: &Nearest) -> [u32; 7] {
     let [px, py, pz] = n.p.map(f32::to_bits);
@@ -194,22 +193,15 @@ pub fn stage(path: &Path, header: &Header, sums: &Sums) -> Result<Staged, Error>
         image
             .write()
             .non_parallel()
-            .to_file(tmp)
+            .to_unbuffered(tmp)
             .map_err(|e| e.to_string())
     })
 }
 
-/// The header of the part at `path`, without its pixels.
+/// The header of the part at `path`, without its pixels, checked to be
+/// one a render writes ([`PartFile::open`]).
 pub(crate) fn read_header(path: &Path) -> Result<Header, Error> {
-    let meta = exr::meta::MetaData::read_from_file(path, true).map_err(|e| {
-        let problem = format!("not a readable OpenEXR file (not a lucent part): {e}");
-        bad(path, None, problem)
-    })?;
-    let [h] = &meta.headers[..] else {
-        let problem = "not a lucent part: more than one EXR layer";
-        return Err(bad(path, None, problem));
-    };
-    Header::read(path, &h.own_attributes.other)
+    Ok(PartFile::open(path)?.header)
 }
 
 /// A part's channels, found by name.
@@ -218,6 +210,8 @@ struct Channels<'a> {
     list: &'a [Channel],
     /// Pixels of the region.
     n: usize,
+    /// Where pixel `j` of a channel is, and the bounds on its values.
+    at: PixelAt<'a>,
 }
 
 impl Channels<'_> {
@@ -242,6 +236,11 @@ impl Channels<'_> {
         bad(self.path, None, problem)
     }
 
+    /// A bad value of channel `name` (layer.channel).
+    fn located(&self, name: &str, problem: String) -> Error {
+        bad(self.path, Some(name), problem)
+    }
+
     /// Reads every summed channel of `layers` into `sums`; the channels
     /// read.
     fn read_sums(
@@ -257,8 +256,10 @@ impl Channels<'_> {
                 *w = self.get(&format!("{name}.w{j}"))?;
             }
             for (j, &i) in order.iter().enumerate() {
+                let v = from_words([w[0][j], w[1][j], w[2][j], w[3][j]]);
+                self.at.check_sum(v, j).map_err(|e| self.located(name, e))?;
                 if let Some(s) = sum_at(sums, k, i) {
-                    *s = from_words([w[0][j], w[1][j], w[2][j], w[3][j]]);
+                    *s = v;
                 }
             }
         }
@@ -275,7 +276,12 @@ impl Channels<'_> {
             *c = self.get(&format!("nearest.{name}"))?;
         }
         for (j, &i) in order.iter().enumerate() {
-            aov.nearest[i] = nearest_from_words(c.map(|c| c[j]));
+            let n = nearest_from_words(c.map(|c| c[j]));
+            let (channel, problem) = self.at.check_nearest(&n, j);
+            if let Some(channel) = channel {
+                return Err(self.located(&format!("nearest.{channel}"), problem));
+            }
+            aov.nearest[i] = n;
         }
         Ok(NEAREST.len())
     }
@@ -296,11 +302,19 @@ impl Channels<'_> {
                 let ids = self.get(&format!("coverage.{kind}.id{k}"))?;
                 let ns = self.get(&format!("coverage.{kind}.n{k}"))?;
                 for (j, &i) in order.iter().enumerate() {
-                    add_coverage(&mut counts[i], ids[j], ns[j], names)
-                        .map_err(|e| self.bad(format!("coverage.{kind}.id{k}: {e}")))?;
+                    add_coverage(&mut counts[i], ids[j], ns[j], names).map_err(|e| {
+                        let problem = format!("{}: {e}", self.at.pixel(j));
+                        self.located(&format!("coverage.{kind}.id{k}"), problem)
+                    })?;
                 }
                 read += 2;
                 k += 1;
+            }
+            for (j, &i) in order.iter().enumerate() {
+                let total: u64 = counts[i].iter().map(|e| e.1 as u64).sum();
+                self.at
+                    .check_coverage(total, j)
+                    .map_err(|e| self.located(&format!("coverage.{kind}"), e))?;
             }
         }
         Ok(read)
@@ -326,7 +340,7 @@ fn add_coverage(
 ) -> Result<(), BadCoverage> {
     match (id, count) {
         (0, 0) => Ok(()),
-        (id, c) if id as usize <= names && c > 0 => {
+        (id, c) if id >= 1 && id as usize <= names && c > 0 => {
             if counts.last().is_some_and(|e| e.0 + 1 > id - 1) {
                 return Err(BadCoverage::OutOfOrder);
             }
@@ -337,10 +351,16 @@ fn add_coverage(
     }
 }
 
-/// The part at `path`: its header and sums. A damaged or truncated file,
-/// or one whose pixels disagree with its header, is bad input naming it.
+/// The part at `path`: its header and sums. A damaged, truncated or
+/// forged file, or one whose pixels disagree with its header, is bad input
+/// naming it (and the channel and pixel at fault).
 pub fn read(path: &Path) -> Result<(Header, Sums), Error> {
-    let header = read_header(path)?;
+    read_pixels(path, PartFile::open(path)?)
+}
+
+/// The header and sums of the checked part `file` at `path`.
+pub(crate) fn read_pixels(path: &Path, file: PartFile) -> Result<(Header, Sums), Error> {
+    let header = file.header.clone();
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -349,18 +369,10 @@ pub fn read(path: &Path) -> Result<(Header, Sums), Error> {
         .all_attributes()
         .pedantic()
         .non_parallel()
-        .from_file(path)
+        .from_buffered(file.rewound()?)
         .map_err(|e| bad(path, None, format!("damaged or truncated part: {e}")))?;
     let layer = &image.layer_data;
     let r = header.region;
-    let at = layer.attributes.layer_position;
-    if layer.size != Vec2(r.width() as usize, r.height() as usize)
-        || at != Vec2(r.x0 as i32, r.y0 as i32)
-    {
-        let (w, h) = (layer.size.0, layer.size.1);
-        let problem = format!("{r} but the pixels are {w}×{h} at ({}, {})", at.0, at.1);
-        return Err(bad(path, Some("lucent.region"), problem));
-    }
     let layout = layout_of(&header.identity).map_err(|e| e.at(path))?;
     let mut sums = Sums::with_passes(r, header.samples.start, layout.as_ref())?;
     sums.done = header.samples.end;
@@ -370,6 +382,7 @@ pub fn read(path: &Path) -> Result<(Header, Sums), Error> {
         path,
         list,
         n: r.area() as usize,
+        at: PixelAt::new(&header, layout.as_ref()),
     };
     let order = pixel_order(&sums);
     let mut expected = channels.read_sums(&header.layers, &order, &mut sums)?;

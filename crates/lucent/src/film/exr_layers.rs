@@ -293,7 +293,7 @@ impl File {
         );
         let image = Image::from_layer(layer);
         Staged::write(&self.path, |tmp| {
-            image.write().non_parallel().to_file(tmp)?;
+            image.write().non_parallel().to_unbuffered(&mut *tmp)?;
             sort_header_in_file(tmp)
         })
     }
@@ -317,12 +317,8 @@ enum FrameWriteError {
 /// [`sort_header_attributes`] on the file at `path`, reading only its
 /// header (the first 64 kB, more if the header is longer), so the pixels
 /// are never held in memory twice.
-fn sort_header_in_file(path: &Path) -> Result<(), FrameWriteError> {
+fn sort_header_in_file(f: &mut std::fs::File) -> Result<(), FrameWriteError> {
     use std::io::{Read, Seek, SeekFrom, Write};
-    let mut f = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .open(path)?;
     let len = f.metadata()?.len() as usize;
     let mut n = len.min(1 << 16);
     loop {

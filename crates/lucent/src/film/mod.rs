@@ -95,7 +95,7 @@ impl Film {
             line_order: LineOrder::Increasing,
         };
         let image = Image::from_encoded_channels((w, self.height as usize), encoding, channels);
-        Staged::write(path, |tmp| image.write().non_parallel().to_file(tmp))
+        Staged::write(path, |tmp| image.write().non_parallel().to_unbuffered(tmp))
     }
 
     /// The EXR at `exr` and its PNG preview beside it
@@ -130,6 +130,52 @@ impl Film {
         Ok(image.layer_data.channel_data.pixels)
     }
 
+    /// The film of the EXR open as `file` (named `path` in errors) if it is
+    /// one RGB(A) layer of `width`×`height` pixels; `None` if its size is
+    /// another. The header is read and checked first, so what reading the
+    /// pixels allocates comes from `width`×`height`, not from the file.
+    pub fn read_exr_of_size(
+        file: fs::File,
+        path: &Path,
+        width: u32,
+        height: u32,
+    ) -> Result<Option<Film>, Error> {
+        use exr::prelude::*;
+        use std::io::{BufReader, Seek};
+        let bad = |problem: String| crate::error::Error::Read {
+            path: path.to_path_buf(),
+            problem,
+        };
+        let meta = exr::meta::MetaData::read_from_buffered(BufReader::new(&file), true)
+            .map_err(|e| bad(e.to_string()))?;
+        let [h] = &meta.headers[..] else {
+            return Err(bad("more than one EXR layer".into()));
+        };
+        if h.deep || h.channels.list.len() > 4 {
+            return Err(bad("not an RGB(A) image".into()));
+        }
+        if h.layer_size != Vec2(width as usize, height as usize) {
+            return Ok(None);
+        }
+        let mut file = file;
+        file.seek(std::io::SeekFrom::Start(0))
+            .map_err(|e| bad(e.to_string()))?;
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .rgba_channels(
+                |res, _| Film::new(res.width() as u32, res.height() as u32),
+                |film: &mut Film, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                    film.set(pos.x() as u32, pos.y() as u32, Vec3::new(r, g, b))
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(BufReader::new(file))
+            .map_err(|e| bad(e.to_string()))?;
+        Ok(Some(image.layer_data.channel_data.pixels))
+    }
+
     /// Writes an 8-bit sRGB PNG preview through `tonemap` after scaling by
     /// 2^exposure.
     pub fn write_png(&self, path: &Path, tonemap: ToneMap, exposure: f32) -> Result<(), Error> {
@@ -155,11 +201,16 @@ impl Film {
                 problem: "bad film size".into(),
             }
         })?;
-        Staged::write(path, |tmp| {
-            img.save_with_format(tmp, image::ImageFormat::Png)
-                .map_err(|e| e.to_string())
-        })
+        Staged::write(path, |tmp| write_png(&img, tmp))
     }
+}
+
+/// Encodes `img` as PNG into `file`.
+pub fn write_png(img: &image::RgbImage, file: &mut fs::File) -> Result<(), String> {
+    let mut w = std::io::BufWriter::new(file);
+    img.write_to(&mut w, image::ImageFormat::Png)
+        .map_err(|e| e.to_string())?;
+    std::io::Write::flush(&mut w).map_err(|e| e.to_string())
 }
 
 /// The error of an allocation that failed: what it was for and its size.
@@ -170,13 +221,13 @@ pub(crate) fn out_of_memory(what: &str, bytes: usize) -> Error {
     ))
 }
 
-/// Runs `write` on a temporary path next to `path`, then renames it into
-/// place; on any failure the temporary file is removed and nothing appears
-/// under `path`. `write` reports its failure as any displayable error; the
-/// error names `path` and carries that text.
+/// Runs `write` on a temporary file next to `path` ([`Staged::write`]),
+/// then renames it into place; on any failure the temporary file is
+/// removed and nothing appears under `path`. `write` reports its failure as
+/// any displayable error; the error names `path` and carries that text.
 pub fn write_atomically<E: Display>(
     path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), E>,
+    write: impl FnOnce(&mut fs::File) -> Result<(), E>,
 ) -> Result<(), Error> {
     commit_all(vec![Staged::write(path, write)?])
 }
@@ -193,21 +244,43 @@ pub struct Staged {
 }
 
 impl Staged {
-    /// Runs `write` on the temporary path of `path`; on failure the
-    /// temporary file is removed and the error names `path`.
+    /// Runs `write` on a temporary file created for it beside `path`; on
+    /// failure the temporary file is removed and the error names `path`.
+    ///
+    /// The temporary file is created exclusively (`O_CREAT|O_EXCL`: a file
+    /// or symlink already under its name is never opened, followed or
+    /// replaced) under a short name ([`temporary_path`]), and `write` gets the
+    /// open file, never a path that could be swapped under it.
     pub fn write<E: Display>(
         path: &Path,
-        write: impl FnOnce(&Path) -> Result<(), E>,
+        write: impl FnOnce(&mut fs::File) -> Result<(), E>,
     ) -> Result<Staged, Error> {
         // what a killed process left of this output (SIGKILL, `stale`)
         stale::clean(path);
+        let tmp = temp_path(path);
+        let mut file = fs::OpenOptions::new()
+            .write(true)
+            .read(true)
+            .create_new(true)
+            .open(&tmp)
+            .map_err(|e| Error::Write {
+                path: path.to_path_buf(),
+                problem: match e.kind() {
+                    std::io::ErrorKind::AlreadyExists => format!(
+                        "its temporary file {} is in the way (lucent did not create it: \
+                         move it away)",
+                        tmp.display()
+                    ),
+                    _ => format!("cannot create its temporary file {}: {e}", tmp.display()),
+                },
+            })?;
         let staged = Staged {
-            tmp: temp_path(path),
+            tmp,
             path: path.to_path_buf(),
         };
         interrupt::register_temporary(&staged.tmp);
         // on failure, dropping `staged` removes the temporary file
-        write(&staged.tmp).map_err(|problem| Error::Write {
+        write(&mut file).map_err(|problem| Error::Write {
             path: path.to_path_buf(),
             problem: problem.to_string(),
         })?;
@@ -307,27 +380,34 @@ fn roll_back(done: Vec<(&Path, Option<PathBuf>)>) {
 /// a pending signal an [`Error::Interrupted`].
 pub fn atomic_write<E: Display>(
     path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), E>,
+    write: impl FnOnce(&mut fs::File) -> Result<(), E>,
 ) -> Result<(), Error> {
     write_atomically(path, write)
 }
 
+/// The temporary file of `path`: `.lu<key>.<pid>.tmp` ([`stale::key`]),
+/// at most 26 bytes whatever the output's name, so any name that fits the
+/// file system has a temporary name that fits too.
 fn temp_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+    temporary_path(path, std::process::id())
+}
+
+/// The temporary file process `pid` writes `path` to:
+/// `.lu<key>.<pid>.tmp` (see [`stale`]).
+pub fn temporary_path(path: &Path, pid: u32) -> PathBuf {
+    path.with_file_name(format!(".lu{}.{pid}.tmp", stale::key(path)))
 }
 
 /// Where [`commit_all`] sets a file it replaces aside until all renames
-/// succeeded.
+/// succeeded: `.lu<key>.<pid>.old.tmp`.
 fn old_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.old.tmp", std::process::id()))
+    set_aside_path(path, std::process::id())
+}
+
+/// Where process `pid` sets the file under `path` aside while it commits:
+/// `.lu<key>.<pid>.old.tmp`.
+pub fn set_aside_path(path: &Path, pid: u32) -> PathBuf {
+    path.with_file_name(format!(".lu{}.{pid}.old.tmp", stale::key(path)))
 }
 
 /// The PNG preview's path beside an EXR path: same stem, `.png`.
@@ -366,8 +446,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let (a, b) = (dir.path().join("a.exr"), dir.path().join("a.png"));
         fs::write(&a, b"old a").unwrap();
-        let write =
-            |text: &'static [u8]| move |tmp: &Path| fs::write(tmp, text).map_err(|e| e.to_string());
+        let write = |text: &'static [u8]| {
+            move |tmp: &mut fs::File| {
+                std::io::Write::write_all(tmp, text).map_err(|e| e.to_string())
+            }
+        };
         let sa = Staged::write(&a, write(b"new a")).unwrap();
         let sb = Staged::write(&b, write(b"new b")).unwrap();
         // the second rename fails after the first succeeded
@@ -403,7 +486,7 @@ mod tests {
         assert!(!p.exists());
         let p2 = dir.path().join("b.exr");
         let r = atomic_write(&p2, |tmp| {
-            fs::write(tmp, b"partial").unwrap();
+            std::io::Write::write_all(tmp, b"partial").unwrap();
             Err("simulated failure".to_string())
         });
         assert!(r.is_err() && !p2.exists());

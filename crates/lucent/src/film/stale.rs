@@ -1,18 +1,23 @@
 //! Temporaries a killed process left beside an output. An output is
-//! written to `.NAME.PID.tmp` and renamed into place
-//! ([`super::Staged`]); a file it replaces waits as `.NAME.PID.old.tmp`
-//! until every rename of the command succeeded. A process that handles a
-//! signal removes both ([`crate::interrupt`]), but SIGKILL (the OOM
-//! killer, a scheduler's hard limit) cannot be handled: whatever it was
-//! writing stays. The next command that writes the same output removes
-//! them, so a killed and resumed render leaves nothing behind.
+//! written to `.lu<key>.<pid>.tmp` and renamed into place
+//! ([`super::Staged`]); a file it replaces waits as `.lu<key>.<pid>.old.tmp`
+//! until every rename of the command succeeded. `<key>` is `key`, eight
+//! hex digits of the output's file name, so the names stay short whatever
+//! the output's name. A process that handles a signal removes its
+//! temporaries ([`crate::interrupt`]), but SIGKILL (the OOM killer, a
+//! scheduler's hard limit) cannot be handled: whatever it was writing
+//! stays. The next command that writes the same output removes it, so a
+//! killed and resumed render leaves nothing behind.
 //!
 //! A temporary is stale when the process its name records no longer runs
 //! on this machine (`/proc/PID` is gone; elsewhere than Linux, none is
 //! treated as stale and nothing is removed). A live process, even one that
-//! reused the PID, keeps its files. A stale `.old.tmp` is the previous
-//! output, set aside by a commit that never finished: it goes back under
-//! its name when nothing is there, and is removed otherwise.
+//! reused the PID, keeps its files. Only a regular file owned by this user
+//! is removed: a symlink or another user's file under such a name was not
+//! written by lucent for this user and is left alone. A set-aside
+//! `.old.tmp` is never moved into place nor removed: a file planted under
+//! that name would otherwise become the output; the previous output a
+//! killed commit set aside stays there for the user to take back.
 //!
 //! The PIDs are this machine's: two machines that write the same output
 //! path on a shared file system at once are already racing for it, and
@@ -21,13 +26,23 @@
 use std::fs;
 use std::path::Path;
 
-/// Removes (or, for a set-aside previous output with nothing under its
-/// name, restores) the temporaries of `path` that processes no longer
-/// running left. Best effort: what cannot be read or removed stays.
+/// The key of an output's temporary names: FNV-1a (32 bits) of its file
+/// name, as eight hex digits.
+pub(crate) fn key(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map(|n| n.as_encoded_bytes())
+        .unwrap_or_default();
+    let h = name.iter().fold(0x811c_9dc5u32, |h, &b| {
+        (h ^ b as u32).wrapping_mul(0x0100_0193)
+    });
+    format!("{h:08x}")
+}
+
+/// Removes the temporaries of `path` that processes no longer running
+/// left (see the module docs for which). Best effort: what cannot be read
+/// or removed stays.
 pub fn clean(path: &Path) {
-    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
-        return;
-    };
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -35,26 +50,39 @@ pub fn clean(path: &Path) {
     let Ok(entries) = fs::read_dir(dir) else {
         return;
     };
-    let prefix = format!(".{name}.");
+    let prefix = format!(".lu{}.", key(path));
     for entry in entries.flatten() {
         let file = entry.file_name();
         let Some((pid, set_aside)) = file.to_str().and_then(|f| parse(f, &prefix)) else {
             continue;
         };
-        if pid == std::process::id() || runs(pid) {
+        if set_aside || pid == std::process::id() || runs(pid) {
             continue;
         }
         let stale = entry.path();
-        if set_aside && fs::symlink_metadata(path).is_err() {
-            let _ = fs::rename(&stale, path);
-        } else {
+        if fs::symlink_metadata(&stale).is_ok_and(|m| ours(&m)) {
             let _ = fs::remove_file(&stale);
         }
     }
 }
 
-/// The PID in `.NAME.PID.tmp` or `.NAME.PID.old.tmp` (prefix `.NAME.`),
-/// and whether it is the set-aside form.
+/// Whether `m` is a regular file (not a symlink) owned by this user.
+fn ours(m: &fs::Metadata) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        // SAFETY: getuid has no preconditions and cannot fail.
+        let uid = unsafe { libc::getuid() };
+        m.file_type().is_file() && m.uid() == uid
+    }
+    #[cfg(not(unix))]
+    {
+        m.file_type().is_file()
+    }
+}
+
+/// The PID in `.lu<key>.PID.tmp` or `.lu<key>.PID.old.tmp` (prefix
+/// `.lu<key>.`), and whether it is the set-aside form.
 fn parse(file: &str, prefix: &str) -> Option<(u32, bool)> {
     let rest = file.strip_prefix(prefix)?;
     let (pid, set_aside) = match rest.strip_suffix(".old.tmp") {
@@ -91,18 +119,18 @@ mod tests {
 
     #[test]
     fn names_are_read_strictly() {
-        let p = ".a.exr.";
-        assert_eq!(parse(".a.exr.123.tmp", p), Some((123, false)));
-        assert_eq!(parse(".a.exr.123.old.tmp", p), Some((123, true)));
+        let p = ".lu0000abcd.";
+        assert_eq!(parse(".lu0000abcd.123.tmp", p), Some((123, false)));
+        assert_eq!(parse(".lu0000abcd.123.old.tmp", p), Some((123, true)));
         // another output's temporaries, and names that only look alike
         for f in [
-            ".a.exr.5.exr.123.tmp",
-            ".a.exr..tmp",
-            ".a.exr.12a.tmp",
-            ".a.exr.+12.tmp",
-            ".a.exr.123",
-            ".b.exr.123.tmp",
-            "a.exr.123.tmp",
+            ".lu0000abcd.5.exr.123.tmp",
+            ".lu0000abcd..tmp",
+            ".lu0000abcd.12a.tmp",
+            ".lu0000abcd.+12.tmp",
+            ".lu0000abcd.123",
+            ".lu0000abce.123.tmp",
+            "lu0000abcd.123.tmp",
         ] {
             assert_eq!(parse(f, p), None, "{f}");
         }
@@ -115,14 +143,14 @@ mod tests {
         let out = d.join("a.exr");
         let dead = dead_pid();
         let me = std::process::id();
+        let (a, b) = (key(&out), key(Path::new("b.exr")));
         let write = |n: String| fs::write(d.join(n), b"x").unwrap();
-        write(format!(".a.exr.{dead}.tmp"));
-        write(format!(".a.exr.{me}.tmp"));
+        write(format!(".lu{a}.{dead}.tmp"));
+        write(format!(".lu{a}.{me}.tmp"));
         // PID 1 runs as long as the machine (or container) does
-        write(".a.exr.1.tmp".into());
-        write(format!(".b.exr.{dead}.tmp"));
+        write(format!(".lu{a}.1.tmp"));
+        write(format!(".lu{b}.{dead}.tmp"));
         fs::write(&out, b"current").unwrap();
-        write(format!(".a.exr.{dead}.old.tmp"));
         clean(&out);
         let mut left: Vec<String> = fs::read_dir(d)
             .unwrap()
@@ -130,9 +158,9 @@ mod tests {
             .collect();
         left.sort();
         let mut want = vec![
-            format!(".a.exr.{me}.tmp"),
-            ".a.exr.1.tmp".to_string(),
-            format!(".b.exr.{dead}.tmp"),
+            format!(".lu{a}.{me}.tmp"),
+            format!(".lu{a}.1.tmp"),
+            format!(".lu{b}.{dead}.tmp"),
             "a.exr".to_string(),
         ];
         want.sort();
@@ -140,18 +168,27 @@ mod tests {
         assert_eq!(fs::read(&out).unwrap(), b"current");
     }
 
+    /// The mistake: moving a planted `.old.tmp` into place (it would
+    /// become the output), or following a planted symlink to remove its
+    /// target's name.
     #[test]
-    fn a_previous_output_set_aside_by_a_killed_commit_is_put_back() {
+    fn a_set_aside_file_is_never_moved_into_place_and_symlinks_stay() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("a.exr");
-        let dead = dead_pid();
-        fs::write(
-            dir.path().join(format!(".a.exr.{dead}.old.tmp")),
-            b"previous",
-        )
-        .unwrap();
+        let (dead, a) = (dead_pid(), key(&out));
+        let aside = dir.path().join(format!(".lu{a}.{dead}.old.tmp"));
+        fs::write(&aside, b"planted").unwrap();
+        let target = dir.path().join("target");
+        fs::write(&target, b"keep").unwrap();
+        let link = dir.path().join(format!(".lu{a}.{dead}.tmp"));
+        std::os::unix::fs::symlink(&target, &link).unwrap();
         clean(&out);
-        assert_eq!(fs::read(&out).unwrap(), b"previous");
-        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+        assert!(!out.exists());
+        assert_eq!(fs::read(&aside).unwrap(), b"planted");
+        assert!(fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(fs::read(&target).unwrap(), b"keep");
     }
 }

@@ -39,7 +39,7 @@ impl Cx<'_> {
     /// value); those are described here from the text at the span.
     pub(crate) fn toml_error(&self, e: &toml::de::Error) -> InputError {
         // Syntax errors carry a multi-line message; keep it on one line.
-        let mut msg = e.message().trim_end().replace('\n', "; ");
+        let mut msg = shortened(&e.message().trim_end().replace('\n', "; "));
         let mut key = None;
         if msg.is_empty() {
             (msg, key) = match e.span() {
@@ -237,6 +237,22 @@ fn syntax_cause(text: &str, at: usize) -> (String, Option<String>) {
             format!("invalid TOML at `{}`", found.escape_default()),
             None,
         )
+    }
+}
+
+/// The longest message a TOML error keeps (in characters): a value it
+/// quotes (a 10 MB string of the wrong type) is cut, the message says so.
+const MAX_MESSAGE_CHARS: usize = 300;
+
+/// `msg`, cut to [`MAX_MESSAGE_CHARS`] with the length of what was cut.
+fn shortened(msg: &str) -> String {
+    match msg.char_indices().nth(MAX_MESSAGE_CHARS) {
+        None => msg.to_string(),
+        Some((at, _)) => format!(
+            "{}… ({} more characters not shown)",
+            &msg[..at],
+            msg[at..].chars().count()
+        ),
     }
 }
 

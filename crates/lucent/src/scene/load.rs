@@ -40,12 +40,17 @@ pub(crate) const MAX_PIXELS: u64 = 1 << 26;
 
 /// Largest accepted scene file, in bytes: scenes are a few kB; anything
 /// near this is not a scene.
-pub(crate) const MAX_SCENE_BYTES: u64 = 16 << 20;
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 
 /// Largest accepted triangle count of a whole scene (2²⁵ ≈ 33.5 M):
 /// about 30 bytes a triangle in the meshes and 50–100 more in a backend's
 /// acceleration structure, a few GB at this bound.
 pub(crate) const MAX_TRIANGLES: u64 = 1 << 25;
+
+/// Largest accepted `render.max_depth`: a path that bounces this often in
+/// a closed white box already costs a thousand times a typical depth, and
+/// a larger bound would let such a scene render for days.
+pub const MAX_DEPTH: u32 = 1024;
 
 /// Reads and loads the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, InputError> {
@@ -280,11 +285,14 @@ fn settings(cx: &Cx, r: &RenderDef) -> Res<RenderSettings> {
         s.spp = *spp.get_ref();
     }
     if let Some(d) = &r.max_depth {
-        if *d.get_ref() == 0 {
+        if !(1..=MAX_DEPTH).contains(d.get_ref()) {
             return Err(cx.err(
                 d.span(),
                 "render.max_depth",
-                "expected a path depth of at least 1, found 0",
+                format!(
+                    "expected a path depth of 1 to {MAX_DEPTH}, found {}",
+                    d.get_ref()
+                ),
             ));
         }
         s.max_depth = *d.get_ref();

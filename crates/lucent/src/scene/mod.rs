@@ -14,7 +14,7 @@ pub mod obj;
 mod objects;
 mod output;
 mod output_file;
-mod regular_file;
+pub mod regular_file;
 pub mod shapes;
 pub mod transform;
 

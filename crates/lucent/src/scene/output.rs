@@ -59,10 +59,26 @@ impl Output {
     }
 }
 
+/// The longest light group name, in bytes: its channels
+/// (`RGBA_<group>.<C>` in the frame, `RGBA_<group>.<C>.w0` in a part) stay
+/// within OpenEXR's 255 bytes with room for any channel suffix.
+pub const MAX_GROUP_NAME: usize = 200;
+
 /// A light group name: ASCII letters, digits and `_`, as compositors accept
 /// in a layer name (`RGBA_<group>`).
 fn group_name(cx: &Cx, name: &Spanned<String>, field: &str) -> Res<String> {
     let n = name.get_ref();
+    if n.len() > MAX_GROUP_NAME {
+        return Err(cx.err(
+            name.span(),
+            field,
+            format!(
+                "a light group name of {} bytes: at most {MAX_GROUP_NAME} (it becomes EXR \
+                 channel names such as RGBA_<group>.R.w0, which OpenEXR limits to 255 bytes)",
+                n.len()
+            ),
+        ));
+    }
     if n.is_empty() || !n.bytes().all(|c| c.is_ascii_alphanumeric() || c == b'_') {
         return Err(cx.err(
             name.span(),

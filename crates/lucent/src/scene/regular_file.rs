@@ -13,10 +13,15 @@ use std::path::Path;
 /// is opened, by what it is ("not a regular file: it is a FIFO").
 ///
 /// Text that is not UTF-8 fails with `NotUtf8`'s message (line, column,
-/// byte).
+/// byte); a leading UTF-8 byte-order mark is dropped.
 pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
-    utf8_text(read_regular_bytes(path, max_bytes)?)
-        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()))
+    let mut text = utf8_text(read_regular_bytes(path, max_bytes)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()))?;
+    // a byte-order mark is not text (it would hide the first statement)
+    if text.starts_with('\u{feff}') {
+        text.replace_range(..'\u{feff}'.len_utf8(), "");
+    }
+    Ok(text)
 }
 
 /// The bytes of a file that must be a regular file (see
@@ -24,29 +29,19 @@ pub fn read_regular_file(path: &Path, max_bytes: u64) -> std::io::Result<String>
 /// before it is read, so its size (and what parsing it would allocate) is
 /// bounded.
 pub(crate) fn read_regular_bytes(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
-    let meta = std::fs::metadata(path)?;
-    if !meta.is_file() {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            format!("not a regular file: it is {}", file_kind(&meta.file_type())),
-        ));
-    }
-    if meta.len() > max_bytes {
+    let (file, len) = open_regular(path)?;
+    if len > max_bytes {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
             format!(
-                "the file is {} bytes, more than the {max_bytes} supported (see \"Supported \
-                 ranges\" in docs/scene-format.md)",
-                meta.len()
+                "the file is {len} bytes, more than the {max_bytes} supported (see \"Supported \
+                 ranges\" in docs/scene-format.md)"
             ),
         ));
     }
     // take no more than the bound even if the file grows meanwhile
     let mut bytes = Vec::new();
-    std::io::Read::read_to_end(
-        &mut std::io::Read::take(std::fs::File::open(path)?, max_bytes + 1),
-        &mut bytes,
-    )?;
+    std::io::Read::read_to_end(&mut std::io::Read::take(file, max_bytes + 1), &mut bytes)?;
     if bytes.len() as u64 > max_bytes {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
@@ -89,6 +84,31 @@ pub(crate) fn utf8_text(bytes: Vec<u8>) -> Result<String, NotUtf8> {
             byte: bytes[at],
         }
     })
+}
+
+/// Opens a file for reading only if it is a regular file (symlinks
+/// followed), with its length. The file is opened without blocking (a FIFO
+/// with no writer opens at once) and checked by what was opened, so a file
+/// swapped after a check cannot slip through; a FIFO, a device, a socket or
+/// a directory is refused by what it is.
+pub fn open_regular(path: &Path) -> std::io::Result<(std::fs::File, u64)> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // no effect on a regular file's reads
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    let meta = file.metadata()?;
+    if !meta.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("not a regular file: it is {}", file_kind(&meta.file_type())),
+        ));
+    }
+    Ok((file, meta.len()))
 }
 
 /// What a file that is not a regular file is, for messages.

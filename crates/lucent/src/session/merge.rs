@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::output::check_exr_output;
+use super::output::{check_exr_output, check_not_an_input};
 use crate::error::Error;
 use crate::farm::merge::merge;
 use crate::film::exr_attributes::FrameHeader;
@@ -29,6 +29,8 @@ pub fn merge_parts(
     preview: Preview,
 ) -> Result<MergedFrame, Error> {
     check_exr_output(output)?;
+    let preview_path = crate::film::preview_path(output);
+    check_not_an_input(&[output, &preview_path], parts)?;
     let start = Instant::now();
     let m = merge(parts)?;
     let header = FrameHeader {
@@ -40,6 +42,7 @@ pub fn merge_parts(
         preview: Some(preview),
         ..m.output
     };
+    crate::memory::enter(crate::memory::Phase::Writing);
     exr_layers::write_frame(output, &m.film, &m.layers, &m.coverage, &header, &out)?;
     Ok(MergedFrame {
         parts: parts.len(),

@@ -5,6 +5,7 @@
 //! (docs/farm.md, docs/output.md).
 
 pub mod checkpoint;
+mod checkpoint_owner;
 pub mod identity;
 mod info;
 mod merge;

@@ -9,9 +9,11 @@ use crate::film::Sums;
 use crate::render::Job;
 
 /// The sums of the part at `path`, checked to be a start of `job` of the
-/// frame `identity`.
+/// frame `identity`: its header is checked against this render before its
+/// pixels are read, so what reading sizes comes from this render.
 pub fn resumable(path: &Path, identity: &Identity, job: &Job) -> Result<Sums, Error> {
-    let (h, sums) = part::read(path)?;
+    let file = part::PartFile::open(path)?;
+    let h = file.header.clone();
     let located = |field: &str, problem: String| -> Error {
         InputError::new(path, problem).in_field(field).into()
     };
@@ -36,5 +38,5 @@ pub fn resumable(path: &Path, identity: &Identity, job: &Job) -> Result<Sums, Er
             ),
         ));
     }
-    Ok(sums)
+    Ok(part::read_pixels(path, file)?.1)
 }

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::checkpoint::{self, Checkpoints};
+use super::checkpoint_owner::ThisRender;
 use super::identity;
 use super::output::check_exr_output;
 use super::resume::resumable;
@@ -17,6 +18,7 @@ use crate::film::exr_layers::{self, OutputOptions};
 use crate::film::passes::PassSet;
 use crate::film::region::Region;
 use crate::film::Sums;
+use crate::memory::{self, Phase};
 use crate::render::{self, RenderStats, Settings};
 use crate::scene::{self, Scene};
 
@@ -125,6 +127,7 @@ fn load(r: &Request) -> Result<(Scene, String, String), Error> {
 pub fn run(r: &Request) -> Result<Outcome, Error> {
     check_exr_output(&r.output)?;
     check_counts(r)?;
+    memory::enter(Phase::LoadingScene);
     let (scene, text, options) = load(r)?;
     let settings = Settings::resolved(&scene, &r.opts);
     let (w, h) = (scene.camera.width, scene.camera.height);
@@ -153,16 +156,23 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         counters: sums.counters,
     };
     let job = job_of(r, region, samples.clone(), passes);
+    let keep = checkpoint::checkpoint_path(&r.output);
+    let this = ThisRender {
+        identity: &identity,
+        region,
+        requested: &samples,
+    };
+    this.check(&keep, r.split.resume.as_deref())?;
     let resume = match &r.split.resume {
         Some(p) => Some(resumable(p, &identity, &job)?),
         None => None,
     };
     stop_if_interrupted()?;
     let traversal = settings.integrator.traversal(scene.settings.traversal);
+    memory::enter(Phase::BuildingAccel);
     let accel = accel::build_with(&scene.meshes, r.backend, traversal)?;
     stop_if_interrupted()?;
     out.preview = Some(r.preview);
-    let keep = checkpoint::checkpoint_path(&r.output);
     let mut checkpoints = Checkpoints {
         path: &keep,
         every: r.split.checkpoint,
@@ -170,6 +180,7 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         last: Instant::now(),
     };
     let mut after_pass = |sums: &Sums| checkpoints.after_pass(sums, &header(sums));
+    memory::enter(Phase::Rendering);
     let done = render::render_job(
         &scene,
         accel.as_ref(),
@@ -178,6 +189,7 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         resume,
         &mut after_pass,
     )?;
+    memory::enter(Phase::Writing);
     if let Some(signal) = done.interrupted {
         return keep_interrupted(signal, keep, &header(&done.sums), &done.sums, samples);
     }
@@ -199,7 +211,9 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         )?;
         write_frame(r, &done.sums, &header, &out)?;
     }
-    checkpoint::clean(&keep);
+    if this.owns(&keep) {
+        checkpoint::clean(&keep);
+    }
     Ok(Outcome {
         region,
         frame: (w, h),

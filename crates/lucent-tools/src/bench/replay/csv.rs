@@ -106,7 +106,7 @@ pub(super) fn write_csv(
         text.push('\n');
     }
     lucent::film::atomic_write(&csv, |tmp| {
-        std::fs::write(tmp, &text).map_err(|e| e.to_string())
+        std::io::Write::write_all(tmp, text.as_bytes()).map_err(|e| e.to_string())
     })
     .map_err(|e| Error::Runtime(e.to_string()))?;
     Ok(csv)

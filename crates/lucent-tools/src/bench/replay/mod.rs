@@ -95,7 +95,7 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
     let csv = out.finish((|| {
         let csv = csv::write_csv(&s.out, &rows, &s.scene, &scene, s.spp)?;
         lucent::film::write_atomically(&s.out.join("render-mix.txt"), |tmp| {
-            std::fs::write(tmp, &rep).map_err(|e| e.to_string())
+            std::io::Write::write_all(tmp, rep.as_bytes()).map_err(|e| e.to_string())
         })?;
         Ok(csv)
     })())?;

@@ -83,10 +83,10 @@ impl Device {
             // SAFETY: with a null device, rtcGetDeviceError returns the error
             // of the failed rtcNewDevice on this thread.
             let code = unsafe { ffi::rtcGetDeviceError(ptr::null_mut()) };
-            return Err(Error::Backend(format!(
-                "Embree: rtcNewDevice failed: {} ({code})",
-                error_name(code)
-            )));
+            return Err(super::embree_shared::backend_error(
+                format!("Embree: rtcNewDevice failed: {} ({code})", error_name(code)),
+                code,
+            ));
         }
         LIVE_DEVICES.fetch_add(1, Ordering::SeqCst);
         let dev = Device {

@@ -75,10 +75,13 @@ impl Device {
         if raw.is_null() {
             // SAFETY: with a null device, the error of the failed call.
             let code = unsafe { (api.get_device_error)(ptr::null_mut()) };
-            return Err(Error::Backend(format!(
-                "Embree 4: rtcNewDevice failed: {} ({code})",
-                super::embree_shared::error_name(code)
-            )));
+            return Err(super::embree_shared::backend_error(
+                format!(
+                    "Embree 4: rtcNewDevice failed: {} ({code})",
+                    super::embree_shared::error_name(code)
+                ),
+                code,
+            ));
         }
         LIVE_DEVICES.fetch_add(1, Ordering::SeqCst);
         let dev = Device {
