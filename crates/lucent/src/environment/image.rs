@@ -37,7 +37,7 @@ pub enum ImageError {
     TooLarge { width: u32, height: u32 },
     #[error("the image is empty ({width}×{height})")]
     Empty { width: u32, height: u32 },
-    #[error("texel (column {x}, row {y}) has {channel} = {value}: texels must be finite and not negative")]
+    #[error("texel (column {x}, row {y}) has {channel} = {value}: texels must be finite")]
     BadTexel {
         x: u32,
         y: u32,
@@ -53,12 +53,12 @@ pub fn read(path: &Path) -> Result<Texels, ImageError> {
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
-    let texels = match ext.as_str() {
+    let mut texels = match ext.as_str() {
         "exr" => read_exr(path)?,
         "hdr" => read_hdr(path)?,
         _ => return Err(ImageError::Unsupported(ext)),
     };
-    check(&texels)?;
+    check(&mut texels)?;
     Ok(texels)
 }
 
@@ -116,19 +116,22 @@ fn read_hdr(path: &Path) -> Result<Texels, ImageError> {
     })
 }
 
-/// The first negative or non-finite texel, if any.
-fn check(t: &Texels) -> Result<(), ImageError> {
-    for (i, c) in t.data.iter().enumerate() {
+/// Refuses the first non-finite texel; clamps negative channels to 0 (the
+/// ringing of lossy compression such as DWAB: light is never negative).
+fn check(t: &mut Texels) -> Result<(), ImageError> {
+    let width = t.width as usize;
+    for (i, c) in t.data.iter_mut().enumerate() {
         for (channel, value) in [("R", c.x), ("G", c.y), ("B", c.z)] {
-            if !value.is_finite() || value < 0.0 {
+            if !value.is_finite() {
                 return Err(ImageError::BadTexel {
-                    x: (i % t.width as usize) as u32,
-                    y: (i / t.width as usize) as u32,
+                    x: (i % width) as u32,
+                    y: (i / width) as u32,
                     channel,
                     value,
                 });
             }
         }
+        *c = c.max(Vec3::ZERO);
     }
     Ok(())
 }
