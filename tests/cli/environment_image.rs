@@ -78,7 +78,10 @@ fn exr_and_hdr_images_light_the_render() {
     });
     assert_eq!(code, Some(0), "{stderr}");
     let m = mean.unwrap();
-    assert!((m[0] - 1.0).abs() < 1e-5 && m[1] == 0.0 && (m[2] - 0.25).abs() < 1e-5, "{m:?}");
+    assert!(
+        (m[0] - 1.0).abs() < 1e-5 && m[1] == 0.0 && (m[2] - 0.25).abs() < 1e-5,
+        "{m:?}"
+    );
     let hdr = format!("{CAM}[environment]\nfile = \"env.hdr\"\nrotation = 45\n");
     let (code, stderr, mean) = render(&hdr, |d| {
         write_hdr(&d.join("env.hdr"), 6, 3, [128, 64, 32, 129])

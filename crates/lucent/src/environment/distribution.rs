@@ -1,7 +1,7 @@
 //! A piecewise-constant density over the unit square, sampled by its
 //! marginal over rows and the conditional within the row (pbrt-v4 §A.5.2,
 //! `PiecewiseConstant2D`); what the environment map samples directions
-//! from (`docs/scene-format.md`, "[environment]").
+//! from (`docs/scene-format.md`, "`[environment]`").
 
 /// A piecewise-constant density on [0, 1) with `n` equal pieces.
 #[derive(Clone, Debug)]

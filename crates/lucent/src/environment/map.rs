@@ -2,7 +2,7 @@
 //! each texel, importance-sampled by a piecewise-constant distribution
 //! over the image weighted by luminance × sin θ (the solid angle of the
 //! texel's row), so directions are drawn nearly in proportion to the
-//! radiance they bring (`docs/scene-format.md`, "[environment]").
+//! radiance they bring (`docs/scene-format.md`, "`[environment]`").
 //!
 //! Map space: +y is up (v = 0 the zenith, v = 1 the nadir); u = ½ looks
 //! along −z and u increases towards +x, so u = φ/2π + ½ with

@@ -2,7 +2,7 @@
 //! rays that leave the scene, either one constant radiance or a
 //! latitude-longitude HDR image ([`map`]) read from OpenEXR or Radiance
 //! `.hdr` ([`image`]) and importance-sampled ([`distribution`]);
-//! `docs/scene-format.md`, "[environment]".
+//! `docs/scene-format.md`, "`[environment]`".
 
 pub mod distribution;
 pub mod image;

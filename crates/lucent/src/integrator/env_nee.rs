@@ -3,7 +3,7 @@
 //! the power heuristic against sampling the vertex's lobe (Veach 1997,
 //! §9.2); and the matching weight of the image's light found by an
 //! escaping ray. A constant environment is not light-sampled (its escaping
-//! rays weigh 1). `docs/scene-format.md`, "[environment]".
+//! rays weigh 1). `docs/scene-format.md`, "`[environment]`".
 
 use super::aov::{self, Event, Recorder, Source};
 use super::interaction::offset_along;

@@ -1,6 +1,6 @@
 //! A perspective camera (pbrt-v4 §5.2, without motion): a pinhole, or a
 //! thin lens of some aperture radius focused at a distance
-//! (`docs/scene-format.md`, "[camera]").
+//! (`docs/scene-format.md`, "`[camera]`").
 
 use crate::geometry::{Ray, Vec3};
 use crate::sampling::concentric_disk;

@@ -1,6 +1,6 @@
 //! `[environment]`: a constant radiance, or a latitude-longitude HDR image
 //! with its rotation, intensity and exposure (`docs/scene-format.md`,
-//! "[environment]"). An image that cannot be used is refused with the
+//! "`[environment]`"). An image that cannot be used is refused with the
 //! file and, for a bad texel, its column and row.
 
 use std::path::Path;

@@ -1,6 +1,6 @@
 //! `[camera]`'s thin lens: the aperture as a radius in scene units or as
 //! an f-number, and the focus distance (`docs/scene-format.md`,
-//! "[camera]").
+//! "`[camera]`").
 //!
 //! An f-number N is read as a 35 mm film camera's: the focal length that
 //! gives `fov_y` on the 24 mm film height is F = 12 mm / tan(fov_y / 2),
