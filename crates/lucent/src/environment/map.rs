@@ -14,7 +14,7 @@ use std::fmt;
 use super::distribution::Distribution2D;
 use super::image::Texels;
 use crate::geometry::Vec3;
-use crate::lights::luminance;
+use crate::sampling::luminance;
 
 /// An environment map ready to render: texels scaled by the intensity,
 /// the rotation and the sampling distribution.
