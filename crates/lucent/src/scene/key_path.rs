@@ -228,7 +228,7 @@ mod tests {
                  [ materials . \"my red\" ]\nalbedo = {r = 1}\n";
         let at = |needle: &str| key_path_at(t, t.find(needle).unwrap());
         assert_eq!(at("a = 1").as_deref(), Some("a"));
-        assert_eq!(at("`[camera]`").as_deref(), Some("camera"));
+        assert_eq!(at("[camera]").as_deref(), Some("camera"));
         assert_eq!(at("1,").as_deref(), Some("camera.look_from"));
         assert_eq!(at("2]").as_deref(), Some("camera.look_from"));
         assert_eq!(at("\"x =").as_deref(), Some("camera.name"));
