@@ -35,7 +35,9 @@ impl TestScene {
             meshes: Arc::new(meshes),
             objects,
             materials,
-            environment: self.environment,
+            environment: self
+                .environment
+                .map(lucent::environment::Environment::Constant),
             units_per_mm: 1.0,
             source: None,
             output: Default::default(),

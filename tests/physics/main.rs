@@ -15,6 +15,7 @@ mod culling;
 #[cfg(feature = "subsurface")]
 mod curvature;
 mod dielectric;
+mod environment_map;
 mod furnace;
 mod glossy;
 #[cfg(feature = "subsurface")]

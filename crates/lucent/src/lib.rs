@@ -11,6 +11,7 @@
 pub mod accel;
 #[cfg(feature = "subsurface")]
 pub mod bssrdf;
+pub mod environment;
 pub mod error;
 pub mod farm;
 pub mod film;

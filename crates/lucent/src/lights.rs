@@ -4,6 +4,7 @@
 //! (pbrt-v4 §12.5 and §12.6, without light BVHs).
 
 use crate::geometry::Vec3;
+pub use crate::sampling::luminance;
 use crate::sampling::{uniform_triangle, Distribution1D};
 use crate::scene::Scene;
 
@@ -45,10 +46,6 @@ pub struct LightSample {
     pub pdf_area: f32,
     /// The emissive triangle it is on (see [`LightSet::geom_of`]).
     pub index: u32,
-}
-
-pub fn luminance(c: Vec3) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
 
 impl LightSet {

@@ -478,7 +478,11 @@ fn render_tile<P: PixelPasses, T: Clock>(
                 // pixel once
                 let mut rng = SampleRng::for_sample(pixel_key, s as u64);
                 let [jx, jy] = rng.uniform2_packed();
-                let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
+                let (fx, fy) = (x as f32 + jx, y as f32 + jy);
+                let ray = match scene.camera.lens() {
+                    None => scene.camera.ray(fx, fy),
+                    Some(_) => scene.camera.ray_through_lens(fx, fy, rng.uniform2_packed()),
+                };
                 let rec = passes.begin_sample();
                 let t0 = T::now();
                 let l = integrator.radiance::<_, T>(

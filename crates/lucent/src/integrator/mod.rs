@@ -25,6 +25,7 @@ pub mod culling;
 #[cfg(feature = "subsurface")]
 pub mod diffuse_boundary;
 pub mod effects;
+mod env_nee;
 pub mod footprint;
 mod glossy;
 pub mod interaction;

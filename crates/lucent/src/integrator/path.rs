@@ -12,6 +12,7 @@
 
 use super::aov::{self, Event, Recorder, Source};
 use super::branch::{roulette, At, Branch, Branches, Next};
+use super::env_nee::{escaped, record_environment};
 use super::footprint::Cone;
 use super::lobe::{Bounce, Vertex};
 use super::nee::{emission_weight, record_direct, NeeAt};
@@ -140,6 +141,10 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
             l += record_direct::<R, T>(st, beta, path.event, depth, |rng, counters| {
                 nee.light(ctx, vertex, rng, counters)
             });
+        }
+        if ctx.plan.environment_map {
+            let beta = nee.scale * path.beta;
+            l += record_environment::<R, T>(ctx, vertex, st, beta, path.event, depth);
         }
         let Some(b) = vertex.bounce(ctx.ray_epsilon, path.beta, st.rng.uniform2_packed()) else {
             break;
@@ -295,7 +300,7 @@ fn nearest<R: Recorder, T: Clock>(
 /// The environment's light reaching a path that leaves the scene.
 #[inline(always)]
 fn environment<R: Recorder>(ctx: &Context, path: &Branch, depth: u32, rec: &mut R) -> Vec3 {
-    let c = path.beta * ctx.scene.environment.unwrap_or(Vec3::ZERO);
+    let c = path.beta * escaped(ctx, path.ray.d, path.prev);
     let found = aov::found(path.event, depth, Pass::Background);
     rec.light(c, found, Source::Environment);
     c

@@ -8,6 +8,12 @@ pub use rng::{Draw, Rng, SampleRng};
 use crate::geometry::Vec3;
 use std::f32::consts::PI;
 
+/// The luminance of linear Rec. 709 RGB: what the light distributions
+/// weigh emitters and environment texels by.
+pub fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
 /// Cosine-weighted direction about +z; pdf = cos θ / π.
 pub fn cosine_hemisphere(u: [f32; 2]) -> Vec3 {
     let [x, y] = concentric_disk(u);

@@ -1,6 +1,20 @@
-//! A pinhole perspective camera (pbrt-v4 §5.2 without lens or motion).
+//! A perspective camera (pbrt-v4 §5.2, without motion): a pinhole, or a
+//! thin lens of some aperture radius focused at a distance
+//! (`docs/scene-format.md`, "`[camera]`").
 
 use crate::geometry::{Ray, Vec3};
+use crate::sampling::concentric_disk;
+
+/// A thin lens: rays leave a disk of `radius` about the eye and pass
+/// through the point the pinhole ray meets on the plane `focus_distance`
+/// ahead (perpendicular to the view direction).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    /// Aperture radius, scene units (> 0).
+    pub radius: f32,
+    /// Distance from the eye to the plane in focus, scene units (> 0).
+    pub focus_distance: f32,
+}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
@@ -18,6 +32,11 @@ pub struct Camera {
     d00: Vec3,
     dx: Vec3,
     dy: Vec3,
+    /// Unit view direction, right and up vectors of the film.
+    forward: Vec3,
+    right: Vec3,
+    upv: Vec3,
+    lens: Option<ThinLens>,
 }
 
 impl Camera {
@@ -50,7 +69,35 @@ impl Camera {
             d00: forward - right * half_w + upv * tan_half,
             dx: right * (2.0 * half_w / width as f32),
             dy: upv * (-2.0 * tan_half / height as f32),
+            forward,
+            right,
+            upv,
+            lens: None,
         }
+    }
+
+    /// This camera with a thin lens (None: a pinhole).
+    pub fn with_lens(mut self, lens: Option<ThinLens>) -> Self {
+        self.lens = lens;
+        self
+    }
+
+    pub fn lens(&self) -> Option<ThinLens> {
+        self.lens
+    }
+
+    /// The ray through film position (x, y) and the lens point that
+    /// `u` ∈ [0, 1)² picks (uniform over the aperture's disk); the pinhole
+    /// ray without a lens.
+    pub fn ray_through_lens(&self, x: f32, y: f32, u: [f32; 2]) -> Ray {
+        let pinhole = self.ray(x, y);
+        let Some(lens) = self.lens else {
+            return pinhole;
+        };
+        let focus = pinhole.d * (lens.focus_distance / pinhole.d.dot(self.forward));
+        let [lx, ly] = concentric_disk(u);
+        let offset = self.right * (lens.radius * lx) + self.upv * (lens.radius * ly);
+        Ray::new(self.origin + offset, (focus - offset).normalize())
     }
 
     /// The ray through film position (x, y) in pixels, y down; (0, 0) is
@@ -64,6 +111,68 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn lens_camera(radius: f32, focus_distance: f32) -> Camera {
+        Camera::new(
+            Vec3::new(1.0, 2.0, 5.0),
+            Vec3::new(0.0, 0.5, 0.0),
+            Vec3::Y,
+            50.0,
+            64,
+            48,
+        )
+        .with_lens(Some(ThinLens {
+            radius,
+            focus_distance,
+        }))
+    }
+
+    /// Where `r` meets the plane `depth` ahead of the eye along `forward`.
+    fn at_depth(c: &Camera, r: &Ray, depth: f32) -> Vec3 {
+        let t = (depth - (r.o - c.origin).dot(c.forward)) / r.d.dot(c.forward);
+        r.at(t)
+    }
+
+    /// Every lens sample's ray through a film position meets the focal
+    /// plane at the pinhole ray's point (a point there stays sharp), and
+    /// leaves from within the aperture. Catches a focus point taken along
+    /// the ray (a sphere of focus) rather than on the plane.
+    #[test]
+    fn a_point_in_the_focal_plane_stays_sharp() {
+        let c = lens_camera(0.3, 4.0);
+        for (x, y) in [(32.0, 24.0), (3.5, 40.2), (60.0, 1.0)] {
+            let p = at_depth(&c, &c.ray(x, y), 4.0);
+            for u in [[0.1, 0.9], [0.99, 0.5], [0.5, 0.0], [0.73, 0.21]] {
+                let r = c.ray_through_lens(x, y, u);
+                assert!((r.o - c.origin).length() <= 0.3 * 1.0001);
+                assert!((at_depth(&c, &r, 4.0) - p).length() < 1e-4);
+            }
+        }
+    }
+
+    /// The rays of one film position spread over a disk of radius
+    /// A·|z − f|/f on the plane at depth z (aperture radius A, focus f):
+    /// the circle of confusion; the lens' edge reaches it.
+    #[test]
+    fn the_circle_of_confusion_matches_the_thin_lens_formula() {
+        let (a, f) = (0.25, 3.0);
+        let c = lens_camera(a, f);
+        for z in [1.5, 6.0, 20.0] {
+            let centre = at_depth(&c, &c.ray(32.0, 24.0), z);
+            let mut widest = 0.0f32;
+            for k in 0..64 {
+                // u = (1, v) is the disk's edge for the concentric map.
+                let u = [0.999_999, k as f32 / 64.0];
+                let r = c.ray_through_lens(32.0, 24.0, u);
+                widest = widest.max((at_depth(&c, &r, z) - centre).length());
+            }
+            let expect = a * (z - f).abs() / f;
+            assert!(
+                (widest / expect - 1.0).abs() < 1e-3,
+                "z = {z}: {widest} vs {expect}"
+            );
+        }
+    }
 
     #[test]
     fn centre_ray_looks_at_target_and_fov_is_vertical() {

@@ -93,6 +93,13 @@ pub struct CameraDef {
     pub fov_y: Option<Spanned<f64>>,
     /// `[width, height]` in pixels. Required.
     pub resolution: Option<Spanned<Numbers<u32, 2>>>,
+    // The thin lens (none of these: a pinhole).
+    /// Aperture radius in scene units.
+    pub aperture_radius: Option<Spanned<f64>>,
+    /// Aperture as an f-number of a 35 mm film camera of this `fov_y`.
+    pub f_number: Option<Spanned<f64>>,
+    /// Distance to the plane in focus, scene units.
+    pub focus_distance: Option<Spanned<f64>>,
 }
 
 /// `[render]`; every key is optional.
@@ -123,14 +130,24 @@ pub struct OutputDef {
     pub cryptomatte_ranks: Option<Spanned<u32>>,
 }
 
-/// `[environment]`.
+/// `[environment]`: a constant `radiance`, or an image `file` with its
+/// `rotation`, `intensity` and `exposure` (exactly one of the two forms).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDef {
-    /// Required.
     pub radiance: Option<Spanned<Triple3>>,
     /// The light group of the environment's light (`RGBA_<group>` pass).
     pub light_group: Option<Spanned<String>>,
+    // The image form.
+    /// A latitude-longitude OpenEXR or Radiance `.hdr` image, relative to
+    /// the scene file's directory.
+    pub file: Option<Spanned<String>>,
+    /// Degrees about +y (counter-clockwise seen from above).
+    pub rotation: Option<Spanned<f64>>,
+    /// A factor on the texels.
+    pub intensity: Option<Spanned<f64>>,
+    /// Stops: a further factor 2^exposure.
+    pub exposure: Option<Spanned<f64>>,
 }
 
 /// The `type` of a `[materials.NAME]` table.

@@ -14,7 +14,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use super::checked::{Cx, Res};
+use super::environment::environment;
 use super::format::{CameraDef, RenderDef, SceneFile, Spanned};
+use super::lens::lens;
 use super::material::material;
 use super::objects::{generated_triangles, object};
 use super::output::output;
@@ -92,7 +94,7 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         )
         .in_field("camera"));
     };
-    let camera = camera(cx, c)?;
+    let camera = camera(cx, c, units_per_mm)?;
     let settings = settings(cx, &def.render)?;
 
     // Materials: indexed in name order (the map is sorted), so the same file
@@ -146,11 +148,7 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
     }
 
     let environment = match &def.environment {
-        Some(env) => {
-            let field = "environment.radiance";
-            let r = cx.required(&env.get_ref().radiance, Some(env.span()), field)?;
-            Some(cx.rgb(r, field, false)?).filter(|r| *r != Vec3::ZERO)
-        }
+        Some(env) => environment(cx, scene_dir, env)?,
         None => None,
     };
 
@@ -184,7 +182,7 @@ fn too_many_triangles(cx: &Cx, span: std::ops::Range<usize>, field: &str, n: u64
 
 /// `[camera]`: the required keys present, values finite, the field of view
 /// in (0°, 180°), the resolution in range, and a well-defined view frame.
-fn camera(cx: &Cx, c: &Spanned<CameraDef>) -> Res<Camera> {
+fn camera(cx: &Cx, c: &Spanned<CameraDef>, units_per_mm: f32) -> Res<Camera> {
     let d = c.get_ref();
     let required = |v, field| cx.required(v, Some(c.span()), field);
     let look_from = required(&d.look_from, "camera.look_from")?;
@@ -268,7 +266,8 @@ fn camera(cx: &Cx, c: &Spanned<CameraDef>) -> Res<Camera> {
             ),
         ));
     }
-    Ok(Camera::new(from, at, up, fov, w, h))
+    let lens = lens(cx, d, fov, view.length(), units_per_mm)?;
+    Ok(Camera::new(from, at, up, fov, w, h).with_lens(lens))
 }
 
 /// `[render]`: defaults for what it does not give.
@@ -390,7 +389,10 @@ mod tests {
             (c.look_from, c.look_at, c.up, c.fov_y, c.width, c.height),
             (Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, Vec3::Z, 60.0, 10, 20)
         );
-        assert_eq!(s.environment, Some(Vec3::new(0.5, 1.0, 2.0)));
+        assert!(matches!(
+            s.environment,
+            Some(crate::environment::Environment::Constant(c)) if c == Vec3::new(0.5, 1.0, 2.0)
+        ));
         assert_eq!(s.units_per_mm, 2.5);
     }
 

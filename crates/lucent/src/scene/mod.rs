@@ -5,9 +5,11 @@
 
 pub mod camera;
 mod checked;
+mod environment;
 pub mod format;
 mod glossy_material;
 pub mod key_path;
+mod lens;
 pub mod load;
 mod material;
 pub mod obj;
@@ -96,8 +98,8 @@ pub struct Scene {
     pub meshes: Arc<Vec<Mesh>>,
     pub objects: Vec<Object>,
     pub materials: Vec<Material>,
-    /// Constant environment radiance seen by rays that escape.
-    pub environment: Option<Vec3>,
+    /// What rays that escape see; None: black.
+    pub environment: Option<crate::environment::Environment>,
     /// Scene units per millimetre (subsurface parameters are in mm).
     pub units_per_mm: f32,
     /// Where the scene came from, for messages and caches.

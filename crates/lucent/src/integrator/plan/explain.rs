@@ -153,13 +153,23 @@ fn direct_lighting(scene: &Scene, flags: &Plan) -> Choice {
 
 /// The environment: escaping rays where it is not black.
 fn environment(scene: &Scene, flags: &Plan) -> Choice {
-    match scene.environment {
-        Some(e) if flags.environment => choice(
+    use crate::environment::Environment;
+    match &scene.environment {
+        Some(Environment::Constant(e)) if flags.environment => choice(
             "escaping rays",
             format!(
                 "constant radiance ({}, {}, {}) added where a path escapes; not \
                  light-sampled",
                 e.x, e.y, e.z
+            ),
+        ),
+        Some(Environment::Map(m)) if flags.environment => choice(
+            "next-event estimation",
+            format!(
+                "{}×{} image: one direction sampled by luminance × sin θ and a shadow ray \
+                 per non-specular vertex, MIS with lobe sampling and with escaping rays",
+                m.width(),
+                m.height()
             ),
         ),
         _ => choice("none", "no environment (or black): escaping paths end"),

@@ -31,6 +31,9 @@ pub struct Plan {
     pub area_lights: bool,
     /// Escaping rays see a non-zero environment.
     pub environment: bool,
+    /// The environment is an image: light-sample it where lights are
+    /// sampled, and weigh what escaping rays find by MIS.
+    pub environment_map: bool,
     /// Some object has a subsurface material: probe rays will be cast.
     pub subsurface: bool,
 }
@@ -39,7 +42,11 @@ impl Plan {
     pub fn new(scene: &Scene) -> Self {
         Plan {
             area_lights: scene.objects.iter().any(|o| emits(o.emission)),
-            environment: scene.environment.is_some_and(|e| e.max_element() > 0.0),
+            environment: scene.environment.as_ref().is_some_and(|e| !e.is_black()),
+            environment_map: scene
+                .environment
+                .as_ref()
+                .is_some_and(|e| e.map().is_some()),
             subsurface: scene
                 .objects
                 .iter()

@@ -8,6 +8,7 @@ use crate::geometry::Vec3;
 use crate::integrator::aov::{self, Event, Recorder, Source};
 use crate::integrator::branch::{roulette, At, Branch, Branches, Next};
 use crate::integrator::coated::Coated;
+use crate::integrator::env_nee::record_environment;
 use crate::integrator::lobe::{Bounce, Vertex};
 use crate::integrator::nee::{direct_lighting, direct_lighting_ahead, record_direct, NeeAt};
 use crate::integrator::state::PathState;
@@ -35,6 +36,9 @@ pub(crate) fn resolve<'v, 's, R: Recorder, T: Clock>(
         *l += record_direct::<R, T>(st, w.beta, coat_event, at.depth, |rng, counters| {
             direct_lighting(ctx, &w.vertex, rng, counters)
         });
+    }
+    if let (Some(w), true) = (&c.coat, ctx.plan.environment_map) {
+        *l += record_environment::<R, T>(ctx, &w.vertex, st, w.beta, coat_event, at.depth);
     }
     let (next, follow_reflected) = match (&c.entry, c.reflected) {
         // Both: this path enters the medium, the reflection waits on the
@@ -124,6 +128,10 @@ fn entry<R: Recorder, T: Clock>(
             *l += record_direct::<R, T>(st, twin.beta, path.event, at.depth, |rng, counters| {
                 direct_lighting_ahead(ctx, &twin.vertex, ahead, rng, counters)
             });
+        }
+        if ctx.plan.environment_map {
+            *l +=
+                record_environment::<R, T>(ctx, &twin.vertex, st, twin.beta, path.event, at.depth);
         }
         nee.scale = 0.5;
     }
