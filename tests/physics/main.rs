@@ -21,6 +21,8 @@ mod hard_cases;
 #[cfg(feature = "subsurface")]
 mod lod;
 #[cfg(feature = "subsurface")]
+mod non_negative;
+#[cfg(feature = "subsurface")]
 mod params_edges;
 #[cfg(feature = "subsurface")]
 mod probe_pair;
