@@ -166,6 +166,16 @@ fn exr_text(s: &str) -> AttributeValue {
 /// Stages the part file of `sums` at `path` (commit it with
 /// [`crate::film::commit_all`]).
 pub fn stage(path: &Path, header: &Header, sums: &Sums) -> Result<Staged, Error> {
+    prepare(header, sums).stage(path, true)
+}
+
+/// A part's EXR image, its channels copied out of the sums: what
+/// [`Prepared::stage`] compresses and writes (a checkpoint, in a thread of
+/// its own while the sums go on changing).
+pub struct Prepared(Image<Layer<AnyChannels<FlatSamples>>>);
+
+/// The part image of `sums` with `header`.
+pub fn prepare(header: &Header, sums: &Sums) -> Prepared {
     let r = sums.region;
     let order = pixel_order(sums);
     let mut channels = sum_channels(sums, &order);
@@ -190,13 +200,24 @@ pub fn stage(path: &Path, header: &Header, sums: &Sums) -> Result<Staged, Error>
     let mut image = Image::from_layer(Layer::new(size, attrs, encoding, channels));
     let (w, h) = header.identity.frame;
     image.attributes.display_window = IntegerBounds::new((0, 0), (w as usize, h as usize));
-    Staged::write(path, |tmp| {
-        image
-            .write()
-            .non_parallel()
-            .to_file(tmp)
+    Prepared(image)
+}
+
+impl Prepared {
+    /// Stages the part file at `path`, its blocks compressed on every core
+    /// (`parallel`: nothing else is running) or in this thread alone (a
+    /// checkpoint beside the render). The bytes are the same either way.
+    pub fn stage(self, path: &Path, parallel: bool) -> Result<Staged, Error> {
+        let image = self.0;
+        Staged::write(path, |tmp| {
+            let w = image.write();
+            match parallel {
+                true => w.to_file(tmp),
+                false => w.non_parallel().to_file(tmp),
+            }
             .map_err(|e| e.to_string())
-    })
+        })
+    }
 }
 
 /// The header of the part at `path`, without its pixels.
