@@ -61,7 +61,7 @@ impl Identity {
             ("lucent.seed", text(&self.seed)),
             ("lucent.spp", text(&self.spp)),
             ("lucent.options", text(&self.options)),
-            ("lucent.provenance", ascii(text(&self.frame))),
+            ("lucent.frame", text(&self.frame)),
             ("lucent.passes", text(&self.passes)),
             ("lucent.names", text(&self.names)),
             ("lucent.output", text(&self.output)),
