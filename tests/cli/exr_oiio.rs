@@ -405,11 +405,11 @@ fn a_single_and_a_merged_frame_carry_the_same_provenance() {
          [[shapes]]\ntype = \"sphere\"\nmaterial = \"wax\"\n",
     )
     .unwrap();
-    let common = ["--quiet", "--accel", "bvh", "--aov", "albedo,Z", "s.toml"];
+    let common = ["render", "--quiet", "--accel", "bvh", "--aov", "albedo,Z", "s.toml"];
     let with = |extra: &[&'static str]| [&common[..], extra].concat();
-    lucent_ok(d, &with(&["render", "-o", "single.exr"]));
-    lucent_ok(d, &with(&["render", "--samples", "0..1", "-o", "p0.exr"]));
-    lucent_ok(d, &with(&["render", "--samples", "1..4", "-o", "p1.exr"]));
+    lucent_ok(d, &with(&["-o", "single.exr"]));
+    lucent_ok(d, &with(&["--samples", "0..1", "-o", "p0.exr"]));
+    lucent_ok(d, &with(&["--samples", "1..4", "-o", "p1.exr"]));
     lucent_ok(
         d,
         &["merge", "--quiet", "-o", "merged.exr", "p1.exr", "p0.exr"],

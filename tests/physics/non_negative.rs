@@ -57,8 +57,9 @@ fn negatives(path: &Path, spp: u32) -> Vec<(String, usize, f32)> {
     let beauty: Vec<f32> = film.pixels.iter().flat_map(|p| p.to_array()).collect();
     let mut all = vec![("beauty".to_string(), beauty)];
     assert!(
-        layers.iter().any(|l| l.name.contains("key")),
-        "no light group layer"
+        layers.iter().any(|l| l.name.starts_with("RGBA_")),
+        "{}: no light group layer",
+        path.display()
     );
     for l in layers.into_iter().filter(|l| l.kind == LayerKind::Light) {
         all.push((l.name, l.values));

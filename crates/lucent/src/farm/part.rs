@@ -205,18 +205,45 @@ pub fn prepare(header: &Header, sums: &Sums) -> Prepared {
 
 impl Prepared {
     /// Stages the part file at `path`, its blocks compressed on every core
-    /// (`parallel`: nothing else is running) or in this thread alone (a
-    /// checkpoint beside the render). The bytes are the same either way.
+    /// (`parallel`: nothing else is running) or, for a checkpoint beside
+    /// the render, in this thread alone and given up at a signal (the
+    /// interrupted render writes its own part at once). The bytes are the
+    /// same either way.
     pub fn stage(self, path: &Path, parallel: bool) -> Result<Staged, Error> {
         let image = self.0;
         Staged::write(path, |tmp| {
             let w = image.write();
             match parallel {
                 true => w.to_file(tmp),
-                false => w.non_parallel().to_file(tmp),
+                false => std::fs::File::create(tmp)
+                    .map_err(exr::error::Error::from)
+                    .and_then(|f| w.non_parallel().to_unbuffered(UntilSignal(f))),
             }
             .map_err(|e| e.to_string())
         })
+    }
+}
+
+/// A file that refuses further writes once a signal asked the process to
+/// stop ([`crate::interrupt::requested`]).
+struct UntilSignal(std::fs::File);
+
+impl std::io::Write for UntilSignal {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        match crate::interrupt::requested() {
+            Some(_) => Err(std::io::Error::other("a signal stopped the write")),
+            None => self.0.write(buf),
+        }
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush()
+    }
+}
+
+impl std::io::Seek for UntilSignal {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.0.seek(pos)
     }
 }
 
