@@ -405,7 +405,9 @@ fn a_single_and_a_merged_frame_carry_the_same_provenance() {
          [[shapes]]\ntype = \"sphere\"\nmaterial = \"wax\"\n",
     )
     .unwrap();
-    let common = ["render", "--quiet", "--accel", "bvh", "--aov", "albedo,Z", "s.toml"];
+    let common = [
+        "render", "--quiet", "--accel", "bvh", "--aov", "albedo,Z", "s.toml",
+    ];
     let with = |extra: &[&'static str]| [&common[..], extra].concat();
     lucent_ok(d, &with(&["-o", "single.exr"]));
     lucent_ok(d, &with(&["--samples", "0..1", "-o", "p0.exr"]));

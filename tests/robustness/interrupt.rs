@@ -198,6 +198,14 @@ fn killed_and_resumed(options: &[&str]) {
         let wait = 300 + (nanos / 7 + k * 337) % 900;
         let child = render("cut.exr", &["--checkpoint", "0.1"]);
         std::thread::sleep(Duration::from_millis(wait as u64));
+        if signal == "-KILL" {
+            // after a checkpoint (written beside the render, it commits
+            // when its thread is done): SIGKILL keeps what was committed
+            let start = Instant::now();
+            while !d.join("cut.partial.exr").exists() && start.elapsed() < Duration::from_secs(60) {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+        }
         kill(&child, signal);
         let pid = child.id();
         let (status, e) = finish(child, Duration::from_secs(10));
