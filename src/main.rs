@@ -169,6 +169,11 @@ enum Command {
         /// No summary line.
         #[arg(short, long)]
         quiet: bool,
+        /// Merge parts rendered on different ray-query backends (they
+        /// answer alike; the frame's `lucent/backend` then names each).
+        /// Without it such parts are refused.
+        #[arg(long)]
+        mixed_backends: bool,
     },
     /// Benchmark the ray-query backends on the same meshes and rays: build
     /// time and memory, Mrays/s of camera, incoherent, shadow and probe
@@ -389,7 +394,7 @@ macro_rules! tell {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Err(e) = lucent::interrupt::install() {
-        tell!("warning: cannot catch SIGINT/SIGTERM ({e}); an interrupted command may leave temporary files");
+        tell!("warning: cannot catch SIGINT/SIGTERM/SIGHUP ({e}); an interrupted command may leave temporary files");
     }
     let result = match cli.command {
         Command::Render {
@@ -453,12 +458,13 @@ fn main() -> ExitCode {
             tonemap,
             exposure,
             quiet,
+            mixed_backends,
         } => {
             let preview = Preview {
                 tonemap: tonemap.into(),
                 exposure,
             };
-            session::merge_parts(&parts, &output, preview).map(|m| {
+            session::merge_parts(&parts, &output, preview, mixed_backends).map(|m| {
                 if !quiet {
                     tell!("{}", m.summary(&output));
                 }
@@ -512,6 +518,11 @@ fn exit_code(e: &Error) -> u8 {
 
 /// Renders `r` and says how it went (unless `quiet`).
 fn run_render(r: &session::Request, quiet: bool) -> Result<(), Error> {
+    // warned even with --quiet: the frame is not rendered where the user
+    // pointed
+    if let Some(w) = session::embree4_warning(r.backend) {
+        eprintln!("{w}");
+    }
     let o = session::run(r)?;
     if !quiet {
         tell!("{}", o.summary(&r.output));

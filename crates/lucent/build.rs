@@ -115,8 +115,47 @@ fn from_standard_paths() -> Option<Embree> {
     })
 }
 
+/// The build's identity for the frames' `lucent/build` attribute
+/// (`LUCENT_BUILD_ID`): the crate version, the git commit, and for a tree
+/// with uncommitted changes a hash of its diff, so that two development
+/// builds of one commit are told apart; the profile (`release`, `debug`).
+/// Without git, the version and profile alone.
+fn build_id() -> String {
+    let git = |args: &[&str]| {
+        Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| o.stdout)
+    };
+    let version = env::var("CARGO_PKG_VERSION").unwrap_or_default();
+    let profile = env::var("PROFILE").unwrap_or_default();
+    let Some(commit) = git(&["rev-parse", "--short=12", "HEAD"]) else {
+        return format!("{version} ({profile})");
+    };
+    let commit = String::from_utf8_lossy(&commit).trim().to_string();
+    if let Some(dir) = git(&["rev-parse", "--git-dir"]) {
+        let dir = PathBuf::from(String::from_utf8_lossy(&dir).trim());
+        for f in ["HEAD", "index"] {
+            println!("cargo::rerun-if-changed={}", dir.join(f).display());
+        }
+    }
+    println!("cargo::rerun-if-changed=src");
+    let diff = git(&["diff", "HEAD"]).unwrap_or_default();
+    if diff.is_empty() {
+        return format!("{version} {commit} ({profile})");
+    }
+    // FNV-1a: stable across Rust versions, unlike std's hashers
+    let h = diff.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    format!("{version} {commit}+dirty.{h:016x} ({profile})")
+}
+
 fn main() {
     println!("cargo::rerun-if-changed=build.rs");
+    println!("cargo::rustc-env=LUCENT_BUILD_ID={}", build_id());
     // The feature decides whether lucent has the Embree backend; nothing on
     // the build machine does.
     if env::var_os("CARGO_FEATURE_EMBREE").is_none() {

@@ -171,6 +171,7 @@ fn header() -> FrameHeader {
         sampling: vec![("bunny".into(), "axes=curvature roughness=0.3".into())],
         plan: Some(r#"{"schema":1,"integrator":"path"}"#.into()),
         render_seconds: Some(12.5),
+        ..FrameHeader::default()
     }
 }
 
@@ -370,4 +371,87 @@ fn oiiotool_reads_the_header_of_a_real_render() {
     );
     let info = Info::parse(&oiio_info(&exr));
     assert_eq!(info.attribute("compression"), Some("\"piz\""));
+}
+
+/// `lucent ARGS` in `dir`, which must succeed.
+fn lucent_ok(dir: &Path, args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// A single render and the merge of its parts: the same header attributes
+/// as oiiotool reads them, but for the render time (the merge cannot know
+/// it) and the date; the plan names the passes written, the backend is
+/// the one that ran, the camera is there as the standard matrices, and
+/// the build and host are recorded. Caught: a merge that writes only spp
+/// and seed; a plan built without the passes (`aovs: none` with --aov).
+#[test]
+fn a_single_and_a_merged_frame_carry_the_same_provenance() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("s.toml"),
+        "[camera]\nlook_from = [0, 1, 4]\nlook_at = [0, 0, 0]\nresolution = [8, 6]\n\
+         [render]\nspp = 4\nseed = 5\n[environment]\nradiance = [0.5, 0.5, 0.5]\n\
+         [materials.wax]\ntype = \"subsurface\"\npreset = \"marble\"\n\
+         [[shapes]]\ntype = \"sphere\"\nmaterial = \"wax\"\n",
+    )
+    .unwrap();
+    let common = [
+        "render", "--quiet", "--accel", "bvh", "--aov", "albedo,Z", "s.toml",
+    ];
+    let with = |extra: &[&'static str]| [&common[..], extra].concat();
+    lucent_ok(d, &with(&["-o", "single.exr"]));
+    lucent_ok(d, &with(&["--samples", "0..1", "-o", "p0.exr"]));
+    lucent_ok(d, &with(&["--samples", "1..4", "-o", "p1.exr"]));
+    lucent_ok(
+        d,
+        &["merge", "--quiet", "-o", "merged.exr", "p1.exr", "p0.exr"],
+    );
+    let single = Info::parse(&oiio_info(&d.join("single.exr")));
+    let merged = Info::parse(&oiio_info(&d.join("merged.exr")));
+    let own = |i: &Info| -> Vec<(String, String)> {
+        i.attributes
+            .iter()
+            .filter(|(n, _)| n != "lucent/renderTime" && n != "DateTime" && n != "capDate")
+            .cloned()
+            .collect()
+    };
+    assert_eq!(own(&single), own(&merged));
+    for name in [
+        "lucent/scene",
+        "lucent/sceneSha256",
+        "lucent/integrator",
+        "lucent/maxDepth",
+        "lucent/sampling",
+        "lucent/build",
+        "lucent/hosts",
+        "worldToCamera",
+        "worldToNDC",
+    ] {
+        assert!(
+            merged.attribute(name).is_some(),
+            "{name} missing: {:?}",
+            merged.attributes
+        );
+    }
+    assert!(merged
+        .attribute("capDate")
+        .or(merged.attribute("DateTime"))
+        .is_some());
+    assert!(single.attribute("lucent/renderTime").is_some());
+    assert_eq!(merged.attribute("lucent/backend"), Some("\"bvh\""));
+    let plan = merged.attribute("lucent/plan").unwrap();
+    assert!(
+        plan.contains("recorded") && plan.contains("albedo"),
+        "{plan}"
+    );
 }

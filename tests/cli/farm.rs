@@ -92,6 +92,7 @@ fn render_part(
         requested: samples,
         layers: part::layers_of(layout.as_ref()),
         counters: r.sums.counters,
+        frame: Default::default(),
     };
     lucent::film::commit_all(vec![part::stage(path, &header, &r.sums).unwrap()]).unwrap();
 }
@@ -195,7 +196,7 @@ fn merged_parts_are_bitwise_the_uncut_render_for_random_splits() {
                 }
                 // in any order
                 parts.reverse();
-                let merged = lucent::farm::merge::merge(&parts).unwrap();
+                let merged = lucent::farm::merge::merge(&parts, false).unwrap();
                 let what = format!("{backend:?} {kind}: x {xs:?} y {ys:?} samples {ss:?}");
                 assert!(bits(&merged.film) == bits(&uncut.film), "{what}");
                 assert_eq!(merged.film.width, w);

@@ -25,6 +25,8 @@ mod heavy_tails;
 #[cfg(feature = "subsurface")]
 mod lod;
 #[cfg(feature = "subsurface")]
+mod non_negative;
+#[cfg(feature = "subsurface")]
 mod params_edges;
 #[cfg(feature = "subsurface")]
 mod probe_pair;

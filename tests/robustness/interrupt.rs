@@ -1,9 +1,10 @@
-//! SIGINT and SIGTERM: a render stops at the
+//! SIGINT, SIGTERM and SIGHUP: a render stops at the
 //! next pixel, drops the pass under way, keeps the finished samples in
 //! OUT.partial.exr and commits nothing else, no temporary file remains, and
-//! the exit code is 128 + the signal (130, 143); outputs staged when the
-//! signal came are not committed. A render killed at a random moment and
-//! resumed from what it kept is bitwise the uninterrupted render. Its own
+//! the exit code is 128 + the signal (130, 143, 129); outputs staged when
+//! the signal came are not committed. A render killed at a random moment,
+//! or while it writes a checkpoint, and resumed from what it kept is
+//! bitwise the uninterrupted render. Its own
 //! test binary: the library test sets the process-wide flag of
 //! `lucent::interrupt`.
 
@@ -79,7 +80,11 @@ fn finish(mut child: Child, limit: Duration) -> (Option<i32>, String) {
 
 #[test]
 fn a_signal_stops_a_render_with_its_exit_code_keeping_only_the_finished_samples() {
-    for (signal, code, name) in [("-INT", 130, "SIGINT"), ("-TERM", 143, "SIGTERM")] {
+    for (signal, code, name) in [
+        ("-INT", 130, "SIGINT"),
+        ("-TERM", 143, "SIGTERM"),
+        ("-HUP", 129, "SIGHUP"),
+    ] {
         let dir = tempfile::tempdir().unwrap();
         let child = start_render(dir.path());
         // well into the render (loading takes milliseconds)
@@ -193,6 +198,14 @@ fn killed_and_resumed(options: &[&str]) {
         let wait = 300 + (nanos / 7 + k * 337) % 900;
         let child = render("cut.exr", &["--checkpoint", "0.1"]);
         std::thread::sleep(Duration::from_millis(wait as u64));
+        if signal == "-KILL" {
+            // after a checkpoint (written beside the render, it commits
+            // when its thread is done): SIGKILL keeps what was committed
+            let start = Instant::now();
+            while !d.join("cut.partial.exr").exists() && start.elapsed() < Duration::from_secs(60) {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+        }
         kill(&child, signal);
         let pid = child.id();
         let (status, e) = finish(child, Duration::from_secs(10));
@@ -233,6 +246,96 @@ fn killed_and_resumed(options: &[&str]) {
         .filter(|n| n.ends_with(".tmp"))
         .collect();
     assert!(left.is_empty(), "{left:?}");
+}
+
+/// SIGTERM while a checkpoint is being written (its temporary file seen
+/// in the directory): the process still keeps every finished sample, at
+/// least the checkpoint's, exits 143 within the bound, and the render
+/// resumed from it is bitwise the uninterrupted one. Caught: a checkpoint
+/// whose commit, refused after the signal, drops the sums with it
+/// ("stopped, no output written").
+#[test]
+fn a_signal_during_a_checkpoint_write_keeps_the_samples_and_resumes_bitwise() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // big enough (every pass, 160×120) that a part takes a while to write
+    fs::write(
+        d.join("scene.toml"),
+        SCENE.replace("[256, 256]", "[160, 120]"),
+    )
+    .unwrap();
+    let render = |out: &str, extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            "scene.toml",
+            "--quiet",
+            "--spp",
+            "40",
+            "--threads",
+            "2",
+            "--aov",
+            "all",
+            "-o",
+            out,
+        ];
+        a.extend_from_slice(extra);
+        Command::new(env!("CARGO_BIN_EXE_lucent"))
+            .args(a)
+            .current_dir(d)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (status, e) = finish(render("whole.exr", &[]), Duration::from_secs(300));
+    assert_eq!(status, Some(0), "{e}");
+    let whole = exr_channels(&d.join("whole.exr"));
+    let mut caught = 0;
+    for _ in 0..5 {
+        let child = render("cut.exr", &["--checkpoint", "0.05"]);
+        let tmp = lucent::film::temporary_path(&d.join("cut.partial.exr"), child.id());
+        // the first checkpoint's write under way
+        let start = Instant::now();
+        while !tmp.exists() && start.elapsed() < Duration::from_secs(60) {
+            std::thread::sleep(Duration::from_micros(200));
+        }
+        kill(&child, "-TERM");
+        let signalled = Instant::now();
+        let (status, e) = finish(child, Duration::from_secs(30));
+        if status == Some(0) {
+            // finished before the signal landed: no test, try again
+            fs::remove_file(d.join("cut.exr")).unwrap();
+            fs::remove_file(d.join("cut.png")).unwrap();
+            continue;
+        }
+        caught += 1;
+        assert_eq!(status, Some(143), "{e}");
+        assert!(
+            signalled.elapsed() < Duration::from_secs(10),
+            "{:?} from SIGTERM to exit",
+            signalled.elapsed()
+        );
+        assert!(e.contains("kept in cut.partial.exr"), "{e}");
+        let (status, e) = finish(
+            render("cut.exr", &["--resume", "cut.partial.exr"]),
+            Duration::from_secs(300),
+        );
+        assert_eq!(status, Some(0), "{e}");
+        assert!(
+            exr_channels(&d.join("cut.exr")) == whole,
+            "resumed image differs"
+        );
+        let left: Vec<String> = names(d)
+            .into_iter()
+            .filter(|n| n.ends_with(".tmp") || n.contains("partial"))
+            .collect();
+        assert!(left.is_empty(), "{left:?}");
+        fs::remove_file(d.join("cut.exr")).unwrap();
+        fs::remove_file(d.join("cut.png")).unwrap();
+        break;
+    }
+    assert_eq!(caught, 1, "no signal landed during a checkpoint write");
 }
 
 #[test]

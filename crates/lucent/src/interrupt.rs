@@ -1,4 +1,5 @@
-//! Interruption by SIGINT or SIGTERM: a flag that long work polls, and a
+//! Interruption by SIGINT, SIGTERM or SIGHUP (a closed terminal, a
+//! scheduler's hang-up): a flag that long work polls, and a
 //! registry of the temporary files that must not outlive the process
 //! (`docs/farm.md`, "Interruption, checkpoints, resume").
 //!
@@ -21,6 +22,8 @@ use std::sync::Mutex;
 pub const SIGINT: i32 = signal_hook::consts::SIGINT;
 /// SIGTERM's number (`kill`'s default).
 pub const SIGTERM: i32 = signal_hook::consts::SIGTERM;
+/// SIGHUP's number (the terminal closed; some schedulers' first notice).
+pub const SIGHUP: i32 = signal_hook::consts::SIGHUP;
 
 /// The first signal received, 0 before any.
 static SIGNAL: AtomicI32 = AtomicI32::new(0);
@@ -28,9 +31,10 @@ static SIGNAL: AtomicI32 = AtomicI32::new(0);
 /// Temporary files written now, removed on an exit at the second signal.
 static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
-/// Starts catching SIGINT and SIGTERM (see the module docs). Call once.
+/// Starts catching SIGINT, SIGTERM and SIGHUP (see the module docs). Call
+/// once.
 pub fn install() -> std::io::Result<()> {
-    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])?;
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])?;
     std::thread::Builder::new()
         .name("signals".into())
         .spawn(move || {
@@ -79,6 +83,7 @@ pub(crate) fn signal_name(signal: i32) -> String {
     match signal {
         SIGINT => "SIGINT".into(),
         SIGTERM => "SIGTERM".into(),
+        SIGHUP => "SIGHUP".into(),
         s => format!("signal {s}"),
     }
 }
@@ -126,10 +131,14 @@ mod tests {
 
     #[test]
     fn exit_codes_and_names_follow_the_shell_convention() {
-        assert_eq!((exit_code(SIGINT), exit_code(SIGTERM)), (130, 143));
+        assert_eq!(
+            (exit_code(SIGINT), exit_code(SIGTERM), exit_code(SIGHUP)),
+            (130, 143, 129)
+        );
         assert_eq!(signal_name(SIGINT), "SIGINT");
         assert_eq!(signal_name(SIGTERM), "SIGTERM");
-        assert_eq!(signal_name(1), "signal 1");
+        assert_eq!(signal_name(SIGHUP), "SIGHUP");
+        assert_eq!(signal_name(3), "signal 3");
     }
 
     #[test]

@@ -36,16 +36,6 @@ pub(crate) struct ExitFactor {
     f: [f32; 3],
 }
 
-impl ExitFactor {
-    /// f(κo) per channel: the factor a hit at a point of xo's own curvature
-    /// gets, √(f(κo)·f(κo)) (1 on flat and concave surfaces). The plane
-    /// control variate's model surface is such a point everywhere
-    /// (`integrator::control_variate`).
-    pub(crate) fn at_exit_alone(&self) -> Vec3 {
-        Vec3::from_array(self.f)
-    }
-}
-
 /// One channel's data: A, d, ℓd, and h at the table's ρ nodes.
 #[derive(Clone, Debug, PartialEq)]
 struct Channel {

@@ -16,6 +16,7 @@ use serde_json::Value;
 
 use crate::error::{Error, InputError};
 use crate::film::accumulate::FixedPoint;
+use crate::film::exr_attributes::FrameHeader;
 use crate::film::exr_layers::{ExrCompression, OutputOptions, Precision};
 use crate::film::pass_layout::Layout;
 use crate::film::passes::PassSet;
@@ -67,6 +68,28 @@ impl Identity {
         ]
     }
 
+    /// The identity with the backend of its options (`accel=…`) left out:
+    /// what parts rendered on different backends share (`lucent merge
+    /// --mixed-backends`).
+    pub fn without_backend(&self) -> Identity {
+        let options = self
+            .options
+            .split(' ')
+            .map(|t| {
+                if t.starts_with("accel=") {
+                    "accel=*"
+                } else {
+                    t
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(" ");
+        Identity {
+            options,
+            ..self.clone()
+        }
+    }
+
     /// The first field in which `self` and `o` differ: its attribute name,
     /// and the two values.
     pub fn difference(&self, o: &Identity) -> Option<(&'static str, String, String)> {
@@ -116,6 +139,11 @@ pub struct Header {
     pub requested: Range<u32>,
     pub layers: Vec<LayerFormat>,
     pub counters: Counters,
+    /// What the frame's EXR header is to say of the render (its scene,
+    /// backend, plan, camera, …; no date or render time), with this part's
+    /// host: a merge writes it, so a merged frame says what a single render
+    /// says. Empty in a part of a build that did not record it.
+    pub frame: FrameHeader,
 }
 
 impl Header {
@@ -133,6 +161,7 @@ impl Header {
             ("lucent.requested", text(&self.requested)),
             ("lucent.layers", text(&self.layers)),
             ("lucent.counters", text(&self.counters)),
+            ("lucent.provenance", ascii(text(&self.frame))),
         ]);
         v
     }
@@ -150,6 +179,13 @@ impl Header {
             requested: attrs.get("lucent.requested")?,
             layers: attrs.get("lucent.layers")?,
             counters: attrs.get("lucent.counters")?,
+            frame: match attrs
+                .attrs
+                .contains_key(&Text::new_or_panic("lucent.provenance"))
+            {
+                true => attrs.get("lucent.provenance")?,
+                false => FrameHeader::default(),
+            },
         };
         header.check().map_err(|e| e.at(path))?;
         Ok(header)
@@ -327,8 +363,14 @@ pub fn names_text(layout: Option<&Layout>) -> String {
         objects: l.object_names.clone(),
         materials: l.material_names.clone(),
     };
+    ascii(text(&names))
+}
+
+/// JSON text with its non-ASCII characters escaped (`\uXXXX`; EXR text is
+/// bytes): the same JSON value.
+fn ascii(json: String) -> String {
     let mut out = String::new();
-    for c in text(&names).chars() {
+    for c in json.chars() {
         if c.is_ascii() {
             out.push(c);
         } else {
@@ -449,6 +491,13 @@ mod tests {
                 rays: 5,
                 clamped: 1,
                 ..Counters::default()
+            },
+            frame: FrameHeader {
+                scene_path: Some("scènes/a.toml".into()),
+                backend: Some("embree4".into()),
+                hosts: vec!["node-7".into()],
+                world_to_camera: Some([0.5; 16]),
+                ..FrameHeader::default()
             },
         }
     }

@@ -19,6 +19,7 @@ use super::cover::{self, CoverError, Piece};
 use super::header::bad;
 use super::part::{self, Header, Identity};
 use crate::error::Error;
+use crate::film::exr_attributes::FrameHeader;
 use crate::film::exr_layers::OutputOptions;
 use crate::film::layers::{Coverage, Layer};
 use crate::film::region::Region;
@@ -38,12 +39,17 @@ pub struct Merged {
     pub identity: Identity,
     /// Summed over the parts.
     pub counters: Counters,
+    /// What the frame's header says of the render: the parts' (every part's
+    /// host; with mixed backends, each backend).
+    pub frame: FrameHeader,
 }
 
 /// Checks that the parts' headers belong together and cover the frame
-/// exactly once; the identity they share.
-pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
-    let id = shared_identity(headers)?;
+/// exactly once; the identity they share. With `mixed_backends` parts
+/// rendered on different ray-query backends belong together too (the
+/// backends answer alike, tests/accel; the frame then names each).
+pub fn check(headers: &[(PathBuf, Header)], mixed_backends: bool) -> Result<Identity, Error> {
+    let id = shared_identity(headers, mixed_backends)?;
     let pieces: Vec<Piece> = headers
         .iter()
         .map(|(_, h)| Piece {
@@ -60,16 +66,24 @@ pub fn check(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
 
 /// The identity every part has, or an error naming the first part that
 /// differs from the first and the field that does.
-fn shared_identity(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
+fn shared_identity(headers: &[(PathBuf, Header)], mixed_backends: bool) -> Result<Identity, Error> {
     let Some((first_path, first)) = headers.first() else {
         return Err(Error::Argument {
             argument: "merge".into(),
             problem: "no parts given".into(),
         });
     };
+    let compared = |id: &Identity| match mixed_backends {
+        true => id.without_backend(),
+        false => id.clone(),
+    };
     for (p, h) in &headers[1..] {
-        if let Some((field, a, b)) = h.identity.difference(&first.identity) {
+        if let Some((field, a, b)) = compared(&h.identity).difference(&compared(&first.identity)) {
             let what = match field {
+                "lucent.options" if backend(&a) != backend(&b) => {
+                    "the parts were rendered on different ray-query backends \
+                     (--mixed-backends merges them, and the frame says so)"
+                }
                 "lucent.passes" => "the parts carry different passes",
                 "lucent.names" => "the parts' passes name different groups or IDs",
                 "lucent.output" => "the parts ask for different frame file options",
@@ -88,6 +102,59 @@ fn shared_identity(headers: &[(PathBuf, Header)]) -> Result<Identity, Error> {
         }
     }
     Ok(first.identity.clone())
+}
+
+/// The `accel=` token of identity options.
+fn backend(options: &str) -> Option<&str> {
+    options.split(' ').find(|t| t.starts_with("accel="))
+}
+
+/// The frame header the parts' headers say: the same in every part but
+/// for the host, the scene's path, the build and (with `mixed_backends`)
+/// the backend; the merged one lists every host, build and backend (the
+/// first part's scene path).
+fn merged_frame(headers: &[(PathBuf, Header)], mixed_backends: bool) -> Result<FrameHeader, Error> {
+    let key = |f: &FrameHeader| {
+        // where the scene was and which build ran may differ by machine
+        let mut k = FrameHeader {
+            hosts: Vec::new(),
+            scene_path: None,
+            build: None,
+            ..f.clone()
+        };
+        if mixed_backends {
+            (k.backend, k.backend_version) = (None, None);
+        }
+        k
+    };
+    let first = &headers[0].1.frame;
+    let mut frame = first.clone();
+    for (p, h) in headers {
+        let f = &h.frame;
+        if key(f) != key(first) {
+            let problem = format!(
+                "says a different render than {} (scene, camera, plan or sampling)",
+                headers[0].0.display()
+            );
+            return Err(bad(p, Some("lucent.provenance"), problem));
+        }
+        frame.hosts.extend(f.hosts.iter().cloned());
+        for (all, one) in [
+            (&mut frame.build, &f.build),
+            (&mut frame.backend, &f.backend),
+            (&mut frame.backend_version, &f.backend_version),
+        ] {
+            if let (Some(all), Some(one)) = (all.as_mut(), one) {
+                if !all.split(", ").any(|x| x == one) {
+                    all.push_str(", ");
+                    all.push_str(one);
+                }
+            }
+        }
+    }
+    frame.hosts.sort();
+    frame.hosts.dedup();
+    Ok(frame)
 }
 
 /// The error of parts (`headers`, covering `pieces`) of the frame `id`
@@ -156,14 +223,16 @@ fn cover_error(
     }
 }
 
-/// Reads, checks and merges the parts at `paths`.
-pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
+/// Reads, checks and merges the parts at `paths` (`mixed_backends`: see
+/// [`check`]).
+pub fn merge(paths: &[PathBuf], mixed_backends: bool) -> Result<Merged, Error> {
     crate::memory::enter(crate::memory::Phase::ReadingParts);
     let headers = paths
         .iter()
         .map(|p| Ok((p.clone(), part::read_header(p)?)))
         .collect::<Result<Vec<_>, Error>>()?;
-    let identity = check(&headers)?;
+    let identity = check(&headers, mixed_backends)?;
+    let frame_header = merged_frame(&headers, mixed_backends)?;
     let frame = Region::full(identity.frame.0, identity.frame.1);
     let (first, _) = &headers[0];
     let layout = part::layout_of(&identity).map_err(|e| e.at(first))?;
@@ -215,5 +284,6 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
         output,
         identity,
         counters: sums.counters,
+        frame: frame_header,
     })
 }

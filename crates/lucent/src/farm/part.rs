@@ -165,6 +165,16 @@ fn exr_text(s: &str) -> AttributeValue {
 /// Stages the part file of `sums` at `path` (commit it with
 /// [`crate::film::commit_all`]).
 pub fn stage(path: &Path, header: &Header, sums: &Sums) -> Result<Staged, Error> {
+    prepare(header, sums).stage(path, true)
+}
+
+/// A part's EXR image, its channels copied out of the sums: what
+/// [`Prepared::stage`] compresses and writes (a checkpoint, in a thread of
+/// its own while the sums go on changing).
+pub struct Prepared(Image<Layer<AnyChannels<FlatSamples>>>);
+
+/// The part image of `sums` with `header`.
+pub fn prepare(header: &Header, sums: &Sums) -> Prepared {
     let r = sums.region;
     let order = pixel_order(sums);
     let mut channels = sum_channels(sums, &order);
@@ -189,13 +199,52 @@ pub fn stage(path: &Path, header: &Header, sums: &Sums) -> Result<Staged, Error>
     let mut image = Image::from_layer(Layer::new(size, attrs, encoding, channels));
     let (w, h) = header.identity.frame;
     image.attributes.display_window = IntegerBounds::new((0, 0), (w as usize, h as usize));
-    Staged::write(path, |tmp| {
-        image
-            .write()
-            .non_parallel()
-            .to_unbuffered(tmp)
+    Prepared(image)
+}
+
+impl Prepared {
+    /// Stages the part file at `path`, its blocks compressed on every core
+    /// (`parallel`: nothing else is running) or, for a checkpoint beside
+    /// the render, in this thread alone and given up at a signal (the
+    /// interrupted render writes its own part at once). The bytes are the
+    /// same either way.
+    pub fn stage(self, path: &Path, parallel: bool) -> Result<Staged, Error> {
+        let image = self.0;
+        Staged::write(path, |tmp| {
+            let w = image.write();
+            match parallel {
+                true => w.to_buffered(&mut *tmp),
+                false => tmp
+                    .try_clone()
+                    .map_err(exr::error::Error::from)
+                    .and_then(|f| w.non_parallel().to_unbuffered(UntilSignal(f))),
+            }
             .map_err(|e| e.to_string())
-    })
+        })
+    }
+}
+
+/// A file that refuses further writes once a signal asked the process to
+/// stop ([`crate::interrupt::requested`]).
+struct UntilSignal(std::fs::File);
+
+impl std::io::Write for UntilSignal {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        match crate::interrupt::requested() {
+            Some(_) => Err(std::io::Error::other("a signal stopped the write")),
+            None => self.0.write(buf),
+        }
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush()
+    }
+}
+
+impl std::io::Seek for UntilSignal {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.0.seek(pos)
+    }
 }
 
 /// The header of the part at `path`, without its pixels, checked to be

@@ -1,11 +1,14 @@
 //! What a frame's EXR header says about the render that made it: the
-//! renderer and its version, the scene file and its content hash, the
-//! resolution, samples, seed, backend, integrator, every sampling option
-//! the render plan (JSON, `crate::integrator::plan`) and the render time,
-//! as standard OpenEXR attribute types (`string`,
-//! `int`, `float`, `v2i`) so `exrheader`, OpenImageIO (`iinfo -v`,
-//! `oiiotool --info -v`) and compositors show them. The names are listed
-//! in `docs/output.md` ("Header attributes").
+//! renderer, its version and build, the scene file and its content hash,
+//! the resolution, samples, seed, backend, integrator, every sampling
+//! option, the render plan (JSON, `crate::integrator::plan`), the hosts,
+//! the date (`capDate`, `utcOffset`), the camera (`worldToCamera`,
+//! `worldToNDC`, the OpenEXR standard attributes) and the render time, as
+//! standard OpenEXR attribute types (`string`, `int`, `float`, `v2i`,
+//! `m44f`) so `exrheader`, OpenImageIO (`iinfo -v`, `oiiotool --info -v`)
+//! and compositors show them. A single render and a merge of its parts
+//! write the same fields (the parts carry them, `crate::farm`). The names
+//! are listed in `docs/output.md` ("Header attributes").
 //!
 //! Strings are stored as their UTF-8 bytes (OpenEXR strings are byte
 //! strings; OpenImageIO and Nuke read them as UTF-8). The seed is a string
@@ -14,14 +17,17 @@
 
 use exr::meta::attribute::{AttributeValue, Text};
 use exr::prelude::Vec2;
+use serde::{Deserialize, Serialize};
 
 /// The renderer's name, written into `software` with its version.
 pub(crate) const RENDERER: &str = "lucent";
 
 /// What the header records about one render. Every field but the
 /// resolution (taken from the film) is filled by the caller; `None` and
-/// empty fields are left out of the file.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// empty fields are left out of the file. Parts carry it (as JSON) so that
+/// a merged frame says what a single render says.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct FrameHeader {
     /// The scene file as given on the command line.
     pub scene_path: Option<String>,
@@ -42,6 +48,19 @@ pub struct FrameHeader {
     pub plan: Option<String>,
     /// Wall time of the render, seconds.
     pub render_seconds: Option<f64>,
+    /// When the frame was made, UTC, as `capDate` says it
+    /// (`YYYY:MM:DD hh:mm:ss`).
+    pub date: Option<String>,
+    /// The machines that rendered it (a merge: every part's).
+    pub hosts: Vec<String>,
+    /// The lucent build ([`crate::session::build_id`]).
+    pub build: Option<String>,
+    /// The camera: world to camera space (left-handed, +z the view
+    /// direction, +y up) and world to NDC (x right, y down, (0, 0) and
+    /// (1, 1) the display window's corners after dividing by w), row
+    /// vectors times the matrix, as the OpenEXR standard attributes say.
+    pub world_to_camera: Option<[f32; 16]>,
+    pub world_to_ndc: Option<[f32; 16]>,
 }
 
 /// A string attribute value: the UTF-8 bytes of `s`.
@@ -93,6 +112,20 @@ impl FrameHeader {
             ("lucent/backendVersion", s(&self.backend_version)),
             ("lucent/integrator", s(&self.integrator)),
             ("lucent/plan", s(&self.plan)),
+            ("lucent/build", s(&self.build)),
+            ("capDate", s(&self.date)),
+            (
+                "utcOffset",
+                self.date.as_ref().map(|_| AttributeValue::F32(0.0)),
+            ),
+            (
+                "worldToCamera",
+                self.world_to_camera.map(AttributeValue::Matrix4x4),
+            ),
+            (
+                "worldToNDC",
+                self.world_to_ndc.map(AttributeValue::Matrix4x4),
+            ),
             (
                 "lucent/renderTime",
                 self.render_seconds.map(|t| AttributeValue::F32(t as f32)),
@@ -102,6 +135,12 @@ impl FrameHeader {
             if let Some(v) = v {
                 put(name, v);
             }
+        }
+        if !self.hosts.is_empty() {
+            put(
+                "lucent/hosts",
+                AttributeValue::Text(text(&self.hosts.join(", "))),
+            );
         }
         if !self.sampling.is_empty() {
             let joined = self

@@ -259,15 +259,22 @@ struct File {
 
 impl File {
     fn stage(self, width: u32, height: u32, compression: ExrCompression) -> Result<Staged, Error> {
-        let mut other = std::collections::HashMap::new();
-        let mut software = None;
+        // the standard attributes the exr crate keeps in fields of their own
+        let mut attributes = LayerAttributes::default();
         for (name, value) in self.attributes {
-            if name == "software" {
-                if let AttributeValue::Text(t) = value {
-                    software = Some(t);
+            match (name.as_str(), value) {
+                ("software", AttributeValue::Text(t)) => attributes.software_name = Some(t),
+                ("capDate", AttributeValue::Text(t)) => attributes.capture_date = Some(t),
+                ("utcOffset", AttributeValue::F32(f)) => attributes.utc_offset = Some(f),
+                ("worldToCamera", AttributeValue::Matrix4x4(m)) => {
+                    attributes.world_to_camera = Some(m)
                 }
-            } else {
-                other.insert(text(&name), value);
+                ("worldToNDC", AttributeValue::Matrix4x4(m)) => {
+                    attributes.world_to_normalized_device = Some(m)
+                }
+                (_, value) => {
+                    attributes.other.insert(text(&name), value);
+                }
             }
         }
         let channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = self
@@ -275,11 +282,6 @@ impl File {
             .into_iter()
             .map(|p| AnyChannel::new(Text::from_slice_unchecked(p.name.as_bytes()), p.samples))
             .collect();
-        let attributes = LayerAttributes {
-            software_name: software,
-            other,
-            ..LayerAttributes::default()
-        };
         let encoding = Encoding {
             compression: compression.exr(),
             blocks: Blocks::ScanLines,
@@ -485,8 +487,23 @@ pub fn read_attributes(path: &Path) -> Result<Vec<(String, AttributeValue)>, Err
     })?;
     let mut out = Vec::new();
     for h in &meta.headers {
-        if let Some(s) = &h.own_attributes.software_name {
+        let own = &h.own_attributes;
+        if let Some(s) = &own.software_name {
             out.push(("software".to_string(), AttributeValue::Text(s.clone())));
+        }
+        if let Some(d) = &own.capture_date {
+            out.push(("capDate".to_string(), AttributeValue::Text(d.clone())));
+        }
+        if let Some(o) = own.utc_offset {
+            out.push(("utcOffset".to_string(), AttributeValue::F32(o)));
+        }
+        for (name, m) in [
+            ("worldToCamera", own.world_to_camera),
+            ("worldToNDC", own.world_to_normalized_device),
+        ] {
+            if let Some(m) = m {
+                out.push((name.to_string(), AttributeValue::Matrix4x4(m)));
+            }
         }
         for (k, v) in h
             .own_attributes

@@ -1,6 +1,6 @@
 //! A subsurface hit with more than one vertex: the coat's lobe at xo, the
-//! path the coat reflects, the entry point(s) xi and the plane control
-//! variate's terms (`docs/bssrdf.md` §5, §6 "The coat").
+//! path the coat reflects, the entry point(s) xi and the light samples the
+//! plane model drew ahead (`docs/bssrdf.md` §5, §6 "The coat").
 
 use super::lobe::{Bounce, Vertex};
 use crate::geometry::Vec3;
@@ -22,7 +22,7 @@ pub(crate) struct Coated<'a> {
     /// ([`super::path::PAIR_DEPTH`]); when Some, light sampled at `entry`
     /// counts ½ too.
     pub(crate) pair: Option<Weighted<'a>>,
-    /// What the plane control variate drew and adds ([`Ahead`]).
+    /// What the plane model drew ahead ([`Ahead`]).
     pub(crate) ahead: Ahead,
 }
 
@@ -33,14 +33,11 @@ pub(crate) struct Weighted<'a> {
     pub(crate) beta: Vec3,
 }
 
-/// The plane control variate's part of a subsurface hit
+/// The plane model's part of a subsurface hit
 /// ([`super::control_variate`]): when it applies, the light samples drawn
 /// ahead for next-event estimation at the entry point (and at its pair's
-/// twin), which its model used, and its terms, each × the throughput, with
-/// the light they sampled ([`super::aov::NO_LIGHT`]: none). The terms count
-/// whether or not the probes found an entry point.
+/// twin), which its model used.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct Ahead {
     pub(crate) lights: Option<[Option<LightSample>; 2]>,
-    pub(crate) terms: [(Vec3, u32); 2],
 }

@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use super::provenance;
 use crate::accel::Backend;
 use crate::error::Error;
 use crate::farm::part::{self, Identity};
@@ -72,8 +73,10 @@ pub fn render_plan(
 
 /// What the EXR header records about this render (docs/output.md): the
 /// scene file (`scene_text`) and its SHA-256, samples, seed, depth,
-/// backend and version, integrator, every subsurface material's sampling
-/// options (named by the objects that use it) and the render time.
+/// backend that ran (`accel_name`, a resolved `backend`) and its version,
+/// integrator, every subsurface material's sampling options (named by the
+/// objects that use it), the plan with its `passes`, this host, the build
+/// and the camera. The caller adds the date and render time.
 pub(crate) fn frame_header(
     scene_path: &Path,
     scene_text: &str,
@@ -81,9 +84,10 @@ pub(crate) fn frame_header(
     accel_name: &str,
     backend: Backend,
     settings: &Settings,
-    seconds: f64,
+    passes: PassSet,
 ) -> Result<FrameHeader, Error> {
     use sha2::{Digest, Sha256};
+    let (world_to_camera, world_to_ndc) = provenance::camera_matrices(&scene.camera);
     let sha: String = Sha256::digest(scene_text.as_bytes())
         .iter()
         .map(|b| format!("{b:02x}"))
@@ -98,8 +102,13 @@ pub(crate) fn frame_header(
         backend_version: Some(backend_version(backend)?),
         integrator: Some(integrator_name(settings.integrator).into()),
         sampling: sampling(scene),
-        plan: Some(render_plan(scene, settings.integrator, PassSet::EMPTY).to_json()),
-        render_seconds: Some(seconds),
+        plan: Some(render_plan(scene, settings.integrator, passes).to_json()),
+        render_seconds: None,
+        date: None,
+        hosts: vec![provenance::host_name()],
+        build: Some(provenance::build_id().into()),
+        world_to_camera: Some(world_to_camera),
+        world_to_ndc: Some(world_to_ndc),
     })
 }
 

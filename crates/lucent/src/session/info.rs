@@ -8,8 +8,9 @@ use crate::accel::{self, Backend};
 pub fn build_info() -> String {
     let names: Vec<&str> = Backend::all_available().iter().map(|b| b.name()).collect();
     let mut s = format!(
-        "lucent {}\nbackends: {}",
+        "lucent {}\nbuild: {}\nbackends: {}",
         env!("CARGO_PKG_VERSION"),
+        super::provenance::build_id(),
         names.join(", ")
     );
     for line in accel::embree_report() {

@@ -22,21 +22,26 @@ pub struct MergedFrame {
     pub nonfinite: u64,
 }
 
-/// Merges `parts` into the frame `output` (EXR, with the preview `preview`).
+/// Merges `parts` into the frame `output` (EXR, with the preview
+/// `preview`); `mixed_backends` lets parts rendered on different
+/// ray-query backends merge (the frame names each).
 pub fn merge_parts(
     parts: &[PathBuf],
     output: &Path,
     preview: Preview,
+    mixed_backends: bool,
 ) -> Result<MergedFrame, Error> {
     check_exr_output(output)?;
     let preview_path = crate::film::preview_path(output);
     check_not_an_input(&[output, &preview_path], parts)?;
     let start = Instant::now();
-    let m = merge(parts)?;
+    let m = merge(parts, mixed_backends)?;
+    // what the parts say of the render, as a single render's frame says it
     let header = FrameHeader {
         spp: Some(m.identity.spp),
         seed: Some(m.identity.seed),
-        ..Default::default()
+        date: Some(super::provenance::date_now()),
+        ..m.frame.clone()
     };
     let out = OutputOptions {
         preview: Some(preview),

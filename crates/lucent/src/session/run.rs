@@ -3,7 +3,6 @@
 
 use std::ops::Range;
 use std::path::PathBuf;
-use std::time::Instant;
 
 use super::checkpoint::{self, Checkpoints};
 use super::checkpoint_owner::ThisRender;
@@ -14,6 +13,7 @@ use super::{overrides, Request, Split};
 use crate::accel;
 use crate::error::{Error, InputError};
 use crate::farm::part;
+use crate::film::exr_attributes::FrameHeader;
 use crate::film::exr_layers::{self, OutputOptions};
 use crate::film::passes::PassSet;
 use crate::film::region::Region;
@@ -136,25 +136,17 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
     let passes = r.aov.unwrap_or(scene.output.aovs);
     let layout = (!passes.is_empty()).then(|| crate::integrator::aov::layout(&scene, passes));
     let mut out = output_options(r, &scene);
+    // parts and resumes record the backend this machine resolves to
+    let backend = r.backend.resolve().unwrap_or(r.backend);
     let identity = identity::identity(
         text.as_bytes(),
         &scene,
         &settings,
-        r.backend,
+        backend,
         &options,
         layout.as_ref(),
         &out,
     );
-    let scene_name = scene_name(r);
-    let header = |sums: &Sums| part::Header {
-        identity: identity.clone(),
-        scene: scene_name.clone(),
-        region,
-        samples: sums.start..sums.done,
-        requested: samples.clone(),
-        layers: part::layers_of(layout.as_ref()),
-        counters: sums.counters,
-    };
     let job = job_of(r, region, samples.clone(), passes);
     let keep = checkpoint::checkpoint_path(&r.output);
     let this = ThisRender {
@@ -172,13 +164,28 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
     memory::enter(Phase::BuildingAccel);
     let accel = accel::build_with(&scene.meshes, r.backend, traversal)?;
     stop_if_interrupted()?;
-    out.preview = Some(r.preview);
-    let mut checkpoints = Checkpoints {
-        path: &keep,
-        every: r.split.checkpoint,
-        end: samples.end,
-        last: Instant::now(),
+    let frame = identity::frame_header(
+        &r.scene,
+        &text,
+        &scene,
+        accel.name(),
+        backend,
+        &settings,
+        passes,
+    )?;
+    let scene_name = scene_name(r);
+    let header = |sums: &Sums| part::Header {
+        identity: identity.clone(),
+        scene: scene_name.clone(),
+        region,
+        samples: sums.start..sums.done,
+        requested: samples.clone(),
+        layers: part::layers_of(layout.as_ref()),
+        counters: sums.counters,
+        frame: frame.clone(),
     };
+    out.preview = Some(r.preview);
+    let mut checkpoints = Checkpoints::new(&keep, r.split.checkpoint, samples.end);
     let mut after_pass = |sums: &Sums| checkpoints.after_pass(sums, &header(sums));
     memory::enter(Phase::Rendering);
     let done = render::render_job(
@@ -191,8 +198,18 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
     )?;
     memory::enter(Phase::Writing);
     if let Some(signal) = done.interrupted {
-        return keep_interrupted(signal, keep, &header(&done.sums), &done.sums, samples);
+        // A save that failed leaves the interrupted render's own to try.
+        let more = checkpoints.finish(done.sums.done).unwrap_or(true);
+        return keep_interrupted(
+            signal,
+            keep.clone(),
+            more,
+            &header(&done.sums),
+            &done.sums,
+            samples,
+        );
     }
+    checkpoints.finish(done.sums.done)?;
     if r.split.is_part() {
         crate::film::commit_all(vec![part::stage(
             &r.output,
@@ -200,15 +217,11 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
             &done.sums,
         )?])?;
     } else {
-        let header = identity::frame_header(
-            &r.scene,
-            &text,
-            &scene,
-            accel.name(),
-            r.backend,
-            &settings,
-            done.stats.seconds,
-        )?;
+        let header = FrameHeader {
+            render_seconds: Some(done.stats.seconds),
+            date: Some(super::provenance::date_now()),
+            ..frame.clone()
+        };
         write_frame(r, &done.sums, &header, &out)?;
     }
     if this.owns(&keep) {
@@ -253,10 +266,12 @@ fn job_of(r: &Request, region: Region, samples: Range<u32>, passes: PassSet) -> 
 }
 
 /// A render stopped by `signal`: keeps the finished passes as a part at
-/// `keep` (none finished: nothing kept) and reports the stop.
+/// `keep` (none finished: nothing kept; `more` false: the last checkpoint
+/// holds them all already) and reports the stop.
 fn keep_interrupted(
     signal: i32,
     keep: PathBuf,
+    more: bool,
     header: &part::Header,
     sums: &Sums,
     requested: Range<u32>,
@@ -264,8 +279,10 @@ fn keep_interrupted(
     if sums.count() == 0 {
         return Err(Error::Interrupted(signal));
     }
-    let staged = part::stage(&keep, header, sums)?;
-    crate::film::commit_even_if_interrupted(vec![staged])?;
+    if more {
+        let staged = part::stage(&keep, header, sums)?;
+        crate::film::commit_even_if_interrupted(vec![staged])?;
+    }
     Err(Error::InterruptedKept {
         signal,
         part: keep,
@@ -278,7 +295,7 @@ fn keep_interrupted(
 fn write_frame(
     r: &Request,
     sums: &Sums,
-    header: &exr_layers::FrameHeader,
+    header: &FrameHeader,
     out: &OutputOptions,
 ) -> Result<(), Error> {
     let (layers, coverage) = sums.layers()?;

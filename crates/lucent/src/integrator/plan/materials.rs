@@ -240,9 +240,14 @@ fn diffusion_reason(pair_depth: u32, cv_depth: u32, area_lights: bool, asked: u3
         "one a hit".into()
     };
     let cv = if cv_depth > 0 {
-        format!("; the plane control variate on next-event estimation at depth < {cv_depth}")
+        format!(
+            "; the plane control variate chooses between each probe and its mirror at depth \
+             < {cv_depth}"
+        )
     } else if asked > 0 && !area_lights {
         "; no control variate (it models area-light sampling; the scene has no area light)".into()
+    } else if asked > 0 {
+        "; no control variate (the pair traces both mirrors it would choose between)".into()
     } else {
         "; no control variate (control_variate = false)".into()
     };
@@ -280,7 +285,8 @@ fn diffusion_methods(
     lod: crate::materials::lod::LodDecision,
 ) -> Vec<SubsurfaceMethod> {
     let pair_depth = if ss.probe_pair() { opts.pair_depth } else { 0 };
-    let cv_depth = if ss.control_variate() && area_lights {
+    // below the pair's depth the pair traces both mirrors: nothing to choose
+    let cv_depth = if ss.control_variate() && area_lights && pair_depth < opts.cv_depth {
         opts.cv_depth
     } else {
         0

@@ -1,13 +1,13 @@
-//! The plane control variate's model at a subsurface exit point xo
-//! (`docs/bssrdf.md` §5; the estimator's math: [`crate::integrator::control_variate`]):
-//! g, the light a sample brings through the entry lobe at a model point,
-//! unshadowed, and the terms it adds at one probe or a pair.
+//! The plane model at a subsurface exit point xo (`docs/bssrdf.md` §5;
+//! the estimator's math: [`crate::integrator::control_variate`]): g, the
+//! light a sample brings through the entry lobe at a model point,
+//! unshadowed, and the choice between a probe and its mirror it makes.
 
 use super::probe_at::ProbeAt;
 use crate::bssrdf::PlaneModel;
 use crate::geometry::Vec3;
 use crate::integrator::coated::Ahead;
-use crate::integrator::control_variate;
+use crate::integrator::control_variate::{self, MirrorChoice};
 use crate::integrator::nee::unshadowed_at;
 use crate::lights::LightSample;
 use crate::materials::Subsurface;
@@ -23,15 +23,11 @@ struct CvModel<'s> {
     xo: Vec3,
     n: Vec3,
     kappa: f32,
-    /// A_plane per channel.
-    a_plane: Vec3,
-    /// f(κo): the curvature correction of the model surface (1 without).
-    f_o: Vec3,
 }
 
 impl<'s> CvModel<'s> {
     /// The model at the hit of `at` (its shading frame and mean
-    /// curvature), with the curvature correction's exit half if any.
+    /// curvature).
     fn new(at: &ProbeAt<'_, 's>) -> Self {
         let ss = at.ss;
         CvModel {
@@ -39,11 +35,6 @@ impl<'s> CvModel<'s> {
             xo: at.si.p,
             n: at.frame_o.n,
             kappa: at.k_mean,
-            a_plane: Vec3::from_array(ss.probe().planar_reflectance().map(|a| a as f32)),
-            f_o: at
-                .exit
-                .map(|e| e.1)
-                .map_or(Vec3::ONE, |e| e.at_exit_alone()),
         }
     }
 
@@ -64,63 +55,34 @@ impl<'s> CvModel<'s> {
         .unwrap_or(Vec3::ZERO)
     }
 
-    /// C of one probe along N with plane model `pm` and light sample `ls`.
-    fn one_probe(&self, pm: &PlaneModel, ls: &LightSample) -> Vec3 {
-        let d = pm.offset;
-        control_variate::one_probe(
-            pm,
-            self.a_plane,
-            self.g(Vec3::ZERO, ls),
-            self.g(d, ls),
-            self.g(-d, ls),
-        )
+    /// The probability of following the probe at offset `d` rather than
+    /// its mirror under light sample `ls`.
+    fn probability_of_probe(&self, d: Vec3, ls: &LightSample) -> f32 {
+        control_variate::probability_of_probe(self.g(Vec3::ZERO, ls), self.g(d, ls), self.g(-d, ls))
     }
 }
 
-/// The control variate's part at one probe with plane model `plane`,
-/// its term × the throughput `beta_in` before the probe.
-pub(super) fn one_probe_ahead(
-    at: &ProbeAt,
-    lights: Lights,
-    plane: Option<&PlaneModel>,
-    beta_in: Vec3,
-) -> Ahead {
-    let mut ahead = Ahead::default();
-    if let Some(lights) = lights {
-        ahead.lights = Some(lights);
-        if let (Some(ls), Some(pm)) = (&lights[0], plane) {
-            let model = CvModel::new(at);
-            let c = model.one_probe(pm, ls);
-            ahead.terms[0] = (-(beta_in * model.f_o) * c, ls.index);
-        }
-    }
-    ahead
+/// What the model adds to a hit's entries: the light samples drawn ahead
+/// (the entry point's next-event estimation uses the one the model used).
+pub(super) fn ahead(lights: Lights) -> Ahead {
+    Ahead { lights }
 }
 
-/// The control variate's part at an antithetic pair: the term split by
-/// light sample (it is linear in the g_k), so each part is recorded with
-/// the light it sampled.
-pub(super) fn pair_ahead(
+/// Which of a probe along N with plane model `plane` and its mirror the
+/// path follows, under the entry point's light sample; `u` draws the
+/// uniform number, only where there is a choice. The probe itself where
+/// the model does not apply (no light sample, no plane model: T and B).
+pub(super) fn mirror_choice(
     at: &ProbeAt,
-    lights: Lights,
+    lights: &Lights,
     plane: Option<&PlaneModel>,
-    beta_in: Vec3,
-) -> Ahead {
-    let mut ahead = Ahead::default();
-    if let Some(lights) = lights {
-        ahead.lights = Some(lights);
-        if let Some(pm) = plane {
-            let model = CvModel::new(at);
-            let g0 = lights.map(|l| l.map_or(Vec3::ZERO, |ls| model.g(Vec3::ZERO, &ls)));
-            for (k, light) in lights.iter().enumerate() {
-                if let Some(ls) = light {
-                    let mut gk = [Vec3::ZERO; 2];
-                    gk[k] = g0[k];
-                    let c = control_variate::pair(pm, model.a_plane, gk);
-                    ahead.terms[k] = (-(beta_in * model.f_o) * c, ls.index);
-                }
-            }
+    u: impl FnOnce() -> f32,
+) -> MirrorChoice {
+    match (lights, plane) {
+        (Some([Some(ls), _]), Some(pm)) => {
+            let p = CvModel::new(at).probability_of_probe(pm.offset, ls);
+            control_variate::choose(p, u())
         }
+        _ => MirrorChoice::PROBE,
     }
-    ahead
 }

@@ -2,14 +2,14 @@
 //! pair, each with the control variate's part where it applies; or, where
 //! the footprint is wide, xo itself (`docs/bssrdf.md` §5, §10, §11).
 
-use super::cv_model::{one_probe_ahead, pair_ahead, Lights};
+use super::cv_model::{ahead, mirror_choice, Lights};
 use super::probe_at::ProbeAt;
 use crate::bssrdf::{ProbeRandoms, ProbeSegment};
 use crate::geometry::curvature::TriangleCurvature;
 use crate::geometry::{Frame, Vec3};
 use crate::integrator::aov::Recorder;
 use crate::integrator::coated::{Ahead, Coated, Weighted};
-use crate::integrator::control_variate;
+use crate::integrator::control_variate::{self, MirrorChoice};
 use crate::integrator::lobe::{Bounce, Lobe, SubsurfaceLobe, Vertex};
 use crate::integrator::nee::draw_light;
 use crate::integrator::probe::{entry_on_segment, ProbeTarget};
@@ -74,8 +74,8 @@ impl<'s> Entries<'s> {
 /// The entry vertices the path goes on from at a subsurface hit, `beta`
 /// scaled by the chosen one's probe weight: one probe, or below
 /// `ctx.pair_depth` where the material asks for it an antithetic pair;
-/// below `ctx.cv_depth` where the material asks for it with the plane
-/// control variate's light samples and terms. Where the material's
+/// else below `ctx.cv_depth` where the material asks for it the probe or
+/// its mirror as the plane model chooses, with the light sample it drew. Where the material's
 /// level-of-detail rule applies to the footprint, no probe: xo itself.
 pub(super) fn entries<'s, R: Recorder>(
     ctx: &Context,
@@ -98,7 +98,11 @@ pub(super) fn entries<'s, R: Recorder>(
     // The probe axes also see sharp edges near xo (`sharp_edges`); level
     // of detail above and the curvature correction read the triangle's.
     let kappa = ctx.axes_curvature(si.geom, si.prim, si.p);
-    let cv = ss.control_variate()
+    let pair = ss.probe_pair() && hit.depth < ctx.pair_depth;
+    // The plane model chooses between a probe and its mirror; the pair
+    // traces both, so there it has nothing to choose.
+    let cv = !pair
+        && ss.control_variate()
         && control_variate::applies(ctx.cv_depth, ctx.plan.area_lights, hit.depth);
     // The control variate's light samples, drawn before the probe's randoms.
     let lights = cv.then(|| [draw_light(ctx, st.rng), None]);
@@ -119,12 +123,10 @@ pub(super) fn entries<'s, R: Recorder>(
         u,
         exit,
     };
-    if !(ss.probe_pair() && hit.depth < ctx.pair_depth) {
+    if !pair {
         return one_probe(ctx, &at, cv, lights, beta, st);
     }
-    // The pair: with the control variate, a light sample for the twin too.
-    let lights = lights.map(|[a, _]| [a, draw_light(ctx, st.rng)]);
-    pair(ctx, &at, cv, lights, beta, st)
+    self::pair(ctx, &at, beta, st)
 }
 
 /// One probe from xo: its entry vertex, with the control variate's part.
@@ -138,21 +140,26 @@ fn one_probe<'s, R: Recorder>(
 ) -> Entries<'s> {
     let (p, frame_o, kappa, u) = (at.si.p, &at.frame_o, at.kappa, &at.u);
     let probe = at.ss.probe();
-    let (seg, plane) = if cv {
-        match probe.sample_probe_and_plane(p, frame_o, kappa, u) {
-            Some(sp) => sp,
+    // With the model: the probe or its mirror (the pair's twin), as the
+    // model's light at each asks, the followed one's weight scaled.
+    let (seg, choice) = if cv {
+        match probe.sample_probe_pair_and_plane(p, frame_o, kappa, u) {
+            Some(([a, b], plane)) => {
+                let c = mirror_choice(at, &lights, plane.as_ref(), || st.rng.uniform());
+                (if c.mirror { b } else { a }, c)
+            }
             None => return Entries::new(None, Ahead::default()),
         }
     } else {
         match probe.sample_probe(p, frame_o, kappa, u) {
-            Some(seg) => (seg, None),
+            Some(seg) => (seg, MirrorChoice::PROBE),
             None => return Entries::new(None, Ahead::default()),
         }
     };
-    let ahead = one_probe_ahead(at, lights, plane.as_ref(), *beta);
+    let ahead = ahead(lights);
     match probe_entry(ctx, at, &seg, st) {
         Some((v, w)) => {
-            *beta *= w;
+            *beta *= w * choice.factor;
             Entries::new(Some(v), ahead)
         }
         None => Entries::new(None, ahead),
@@ -167,25 +174,15 @@ fn one_probe<'s, R: Recorder>(
 fn pair<'s, R: Recorder>(
     ctx: &Context,
     at: &ProbeAt<'_, 's>,
-    cv: bool,
-    lights: Lights,
     beta: &mut Vec3,
     st: &mut PathState<R>,
 ) -> Entries<'s> {
     let (p, frame_o, kappa, u) = (at.si.p, &at.frame_o, at.kappa, &at.u);
     let probe = at.ss.probe();
-    let ([seg_a, seg_b], plane) = if cv {
-        match probe.sample_probe_pair_and_plane(p, frame_o, kappa, u) {
-            Some(sp) => sp,
-            None => return Entries::new(None, Ahead::default()),
-        }
-    } else {
-        match probe.sample_probe_pair(p, frame_o, kappa, u) {
-            Some(segs) => (segs, None),
-            None => return Entries::new(None, Ahead::default()),
-        }
+    let Some([seg_a, seg_b]) = probe.sample_probe_pair(p, frame_o, kappa, u) else {
+        return Entries::new(None, Ahead::default());
     };
-    let ahead = pair_ahead(at, lights, plane.as_ref(), *beta);
+    let ahead = Ahead::default();
     let a = probe_entry(ctx, at, &seg_a, st);
     let b = probe_entry(ctx, at, &seg_b, st);
     match (a, b) {

@@ -1,11 +1,10 @@
 //! How the bounce loop reads a subsurface hit with more than one vertex
 //! ([`Coated`]): light sampled at the rough coat, the coat's reflection
-//! kept on the stack or followed, the control variate's terms, light
-//! sampled at the pair's twin, and the entry vertex the path goes on from
+//! kept on the stack or followed, light sampled at the pair's twin, and the entry vertex the path goes on from
 //! (`docs/bssrdf.md` §5, §6 "The coat").
 
 use crate::geometry::Vec3;
-use crate::integrator::aov::{self, Event, Recorder, Source};
+use crate::integrator::aov::{Event, Recorder};
 use crate::integrator::branch::{roulette, At, Branch, Branches, Next};
 use crate::integrator::coated::Coated;
 use crate::integrator::env_nee::record_environment;
@@ -50,7 +49,6 @@ pub(crate) fn resolve<'v, 's, R: Recorder, T: Clock>(
         (Some(v), None) => (Some(v), None),
         (None, reflected) => (None, reflected),
     };
-    add_terms(c, at, path.event, l, st.rec);
     match (next, follow_reflected) {
         (Some(v), _) => Next::Vertex(v, entry::<R, T>(ctx, c, v, at, path, l, st)),
         (None, Some(r)) => {
@@ -83,21 +81,6 @@ fn push_reflection<R: Recorder>(
             event,
             cone: at.cone_specular,
         });
-    }
-}
-
-/// The control variate's terms, which count whether or not the probes
-/// found an entry point.
-#[inline(always)]
-fn add_terms<R: Recorder>(c: &Coated, at: &At, event: Event, l: &mut Vec3, rec: &mut R) {
-    if c.ahead.lights.is_some() {
-        let ev = if at.first { Event::Subsurface } else { event };
-        for (t, light) in c.ahead.terms {
-            if light != aov::NO_LIGHT {
-                *l += t;
-                rec.light(t, aov::sampled(ev, at.depth), Source::Light(light));
-            }
-        }
     }
 }
 
