@@ -67,16 +67,21 @@ fn renders_the_cornell_box_end_to_end() {
     assert_eq!(names, ["cornell.exr", "cornell.png"]);
 }
 
-/// The EXR's bytes with the value of its one run-dependent header
-/// attribute, `lucent/renderTime` (a 4-byte float), set to zero.
-fn without_render_time(mut bytes: Vec<u8>) -> Vec<u8> {
-    let key = b"lucent/renderTime\0float\0\x04\0\0\0";
-    let at = bytes
-        .windows(key.len())
-        .position(|w| w == key)
-        .expect("no lucent/renderTime attribute")
-        + key.len();
-    bytes[at..at + 4].fill(0);
+/// The EXR's bytes with the values of its run-dependent header attributes
+/// blanked: `lucent/renderTime` (a 4-byte float) and `capDate` (the
+/// 19-character UTC date and time the frame was made).
+fn without_run_attributes(mut bytes: Vec<u8>) -> Vec<u8> {
+    for (key, len) in [
+        (&b"lucent/renderTime\0float\0\x04\0\0\0"[..], 4),
+        (&b"capDate\0string\0\x13\0\0\0"[..], 19),
+    ] {
+        let at = bytes
+            .windows(key.len())
+            .position(|w| w == key)
+            .unwrap_or_else(|| panic!("no {} attribute", String::from_utf8_lossy(key)))
+            + key.len();
+        bytes[at..at + len].fill(0);
+    }
     bytes
 }
 
@@ -104,8 +109,8 @@ fn exr_is_bitwise_identical_for_one_and_two_threads() {
         ]);
     }
     let (fa, fb) = (
-        without_render_time(std::fs::read(&a).unwrap()),
-        without_render_time(std::fs::read(&b).unwrap()),
+        without_run_attributes(std::fs::read(&a).unwrap()),
+        without_run_attributes(std::fs::read(&b).unwrap()),
     );
     assert!(fa.len() > 1000);
     assert!(fa == fb, "EXRs differ between --threads 1 and --threads 2");
