@@ -8,7 +8,8 @@
 # (default 2), LUCENT_FUZZ_CASE_TIMEOUT the seconds after which a case
 # counts as a hang (default 30). The files fuzzer (tests/robustness/
 # fuzz_files.rs: parts, output paths) then runs LUCENT_FUZZ_FILE_CASES
-# cases (default 400).
+# cases (default 400), and the study-directory fuzzer (fuzz_study.rs)
+# LUCENT_FUZZ_STUDY_CASES (default 200).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export LUCENT_FUZZ_SECONDS="${1:-${LUCENT_FUZZ_SECONDS:-600}}"
@@ -18,3 +19,5 @@ echo "fuzzing for ${LUCENT_FUZZ_SECONDS} s with seed ${LUCENT_FUZZ_SEED}; failur
 cargo test --test robustness fuzz::mutated_inputs_end_in_an_image_or_a_clear_error -- --nocapture
 export LUCENT_FUZZ_FILE_CASES="${LUCENT_FUZZ_FILE_CASES:-400}"
 cargo test --test robustness fuzz_files::damaged_files_and_hostile_output_paths_end_cleanly -- --nocapture
+export LUCENT_FUZZ_STUDY_CASES="${LUCENT_FUZZ_STUDY_CASES:-200}"
+cargo test --test robustness fuzz_study::damaged_study_directories_end_cleanly -- --nocapture

@@ -21,23 +21,23 @@ use std::time::{Duration, Instant};
 use crate::part_forgery::Parts;
 
 /// SplitMix64: a case depends only on (seed, index).
-struct Rng(u64);
+pub(crate) struct Rng(u64);
 
 impl Rng {
-    fn new(seed: u64, index: u64) -> Rng {
+    pub(crate) fn new(seed: u64, index: u64) -> Rng {
         Rng(seed ^ index.wrapping_mul(0xA076_1D64_78BD_642F))
     }
-    fn next(&mut self) -> u64 {
+    pub(crate) fn next(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^ (z >> 31)
     }
-    fn below(&mut self, n: usize) -> usize {
+    pub(crate) fn below(&mut self, n: usize) -> usize {
         (self.next() % n as u64) as usize
     }
-    fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
+    pub(crate) fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
         &v[self.below(v.len())]
     }
 }
@@ -52,7 +52,7 @@ const SCENE: &str = "[camera]\nlook_from = [0, 0, 3]\nlook_at = [0, 0, 0]\nresol
 
 const AOV: &str = "Z,object_id,crypto_object";
 
-fn binary() -> PathBuf {
+pub(crate) fn binary() -> PathBuf {
     std::env::var_os("LUCENT_FUZZ_BIN")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_lucent")))
@@ -425,7 +425,7 @@ fn save(corpus: &Path, name: &str, bytes: &[u8], what: &str, found: &str) {
     fs::write(d.join("case.txt"), format!("{what}\nfound: {found}\n")).unwrap();
 }
 
-fn env_u64(name: &str, default: u64) -> u64 {
+pub(crate) fn env_u64(name: &str, default: u64) -> u64 {
     std::env::var(name)
         .ok()
         .and_then(|s| s.parse().ok())

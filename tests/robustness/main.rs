@@ -8,6 +8,8 @@ mod common;
 
 mod fuzz;
 mod fuzz_files;
+#[cfg(feature = "subsurface")]
+mod fuzz_study;
 mod hostile_files;
 mod hostile_input;
 mod huge_numbers;
