@@ -20,23 +20,22 @@
 //! figure. `--map` writes σ²/(R² + ε) per pixel and channel as an EXR,
 //! `--image` the pixels' means (the render of these samples).
 //! The time is the wall time of the samples (no accel build), ms per spp;
-//! `--probe-pair true` samples an antithetic probe pair at the camera
-//! vertex (`integrator::path`), `--control-variate false` drops the plane
-//! control variate there (`integrator::control_variate`), and `--axes`,
-//! `--specular`, `--exit-sw`, `--renormalize` override the materials'
-//! choices as on the command line.
+//! every estimator option of `lucent render` (`--probe-pair true`,
+//! `--control-variate false`, `--axes normal`, …; the option table,
+//! `lucent::materials::OPTIONS`) overrides the materials' choices as on
+//! the command line.
 
 use std::path::Path;
 use std::time::Instant;
 
 use lucent::accel::{self, Backend};
-use lucent::bssrdf::ProbeAxes;
 use lucent::film::Film;
 use lucent::geometry::{Ray, Vec3};
 use lucent::integrator::aov::NoAov;
 use lucent::integrator::path::Scratch;
 use lucent::integrator::{Context, Counters, IntegratorKind, NoClock};
-use lucent::materials::SubsurfaceOverrides;
+use lucent::materials::estimator_options::Assignments;
+use lucent::materials::OPTIONS;
 use lucent::sampling::{Draw, Rng, SampleRng};
 use lucent::scene::{self, Camera};
 use rayon::prelude::*;
@@ -83,16 +82,15 @@ fn main() {
     let spp: u32 = arg(&args, "--spp").unwrap_or(256);
     let seed: u64 = arg(&args, "--seed").unwrap_or(1);
     let threads: usize = arg(&args, "--threads").unwrap_or(2);
-    let ov = SubsurfaceOverrides {
-        axes: arg::<String>(&args, "--axes")
-            .map(|s| ProbeAxes::parse(&s).unwrap_or_else(|| die("--axes: unknown"))),
-        specular: arg(&args, "--specular"),
-        exit_sw: arg(&args, "--exit-sw"),
-        renormalize: arg(&args, "--renormalize"),
-        control_variate: arg(&args, "--control-variate"),
-        probe_pair: arg(&args, "--probe-pair"),
-        ..Default::default()
-    };
+    // any estimator option, as `lucent render` takes it (`--axes normal`)
+    let mut ov = Assignments::default();
+    for row in &OPTIONS {
+        let flag = format!("--{}", row.flag_name());
+        if let Some(v) = arg::<String>(&args, &flag) {
+            ov.push(row, &v)
+                .unwrap_or_else(|e| die(&format!("{flag}: {e}")));
+        }
+    }
     ov.apply_all(&mut scene.materials)
         .unwrap_or_else(|e| die(&e.to_string()));
     let reference = arg::<String>(&args, "--reference")

@@ -45,6 +45,8 @@ fn without_reasons(p: &Explanation) -> Value {
             Value::Object(m) => {
                 m.remove("reason");
                 m.remove("min_width");
+                // the option rows have a test of their own
+                m.remove("options");
                 m.values_mut().for_each(strip);
             }
             Value::Array(a) => a.iter_mut().for_each(strip),
@@ -289,6 +291,48 @@ fn rough_coat_cosine_exit_and_no_specular() {
             ]),
         ),
     );
+}
+
+/// The mistake: `--explain` silent about options set away from their
+/// defaults, or naming them other than the option table does.
+#[test]
+fn options_away_from_their_defaults_are_listed_by_the_table() {
+    let s = load(&format!(
+        "{LAMP}{KETCHUP}axes = \"mis3\"\nprobe_pair = true\nrenormalize = false\n{BALL_SAUCE}"
+    ));
+    let p = plan_of(&s, IntegratorKind::Path, PassSet::EMPTY);
+    let sauce = p.materials.iter().find(|m| m.name == "sauce").unwrap();
+    let named: Vec<_> = sauce
+        .options
+        .iter()
+        .map(|o| (o.name.as_str(), o.value.as_str(), o.default.as_str()))
+        .collect();
+    // renormalize = false is the default: not listed
+    assert_eq!(
+        named,
+        [
+            ("axes", "mis3", "curvature"),
+            ("probe_pair", "true", "false")
+        ]
+    );
+    let text = lucent::integrator::plan::text::render(&p);
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| l.trim_start().starts_with("option "))
+        .collect();
+    assert_eq!(rows.len(), 2, "{text}");
+    assert!(
+        rows[0].contains("axes=mis3") && rows[0].ends_with("(default curvature)"),
+        "{}",
+        rows[0]
+    );
+    // a material with every default lists nothing
+    let plain = plan_of(
+        &load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}")),
+        IntegratorKind::Path,
+        PassSet::EMPTY,
+    );
+    assert!(plain.materials.iter().all(|m| m.options.is_empty()));
 }
 
 #[test]
@@ -554,7 +598,8 @@ fn stats_prints_rays_and_time_per_effect() {
 #[test]
 fn level_of_detail_at_distance_forced_or_off() {
     use lucent::integrator::plan::explain::SubsurfaceMethod;
-    use lucent::materials::{LodMode, Material, SubsurfaceOverrides};
+    use lucent::materials::estimator_options::Assignments;
+    use lucent::materials::{LodMode, Material};
     // auto (the default): LOD from 0.25 × Rmax of the widest active
     // channel, then the diffusion
     let s = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
@@ -588,12 +633,10 @@ fn level_of_detail_at_distance_forced_or_off() {
     // forced (--lod force): every hit under LOD, so the plan has no probe
     // query, and a render makes none, though it hits the ball
     let mut forced = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
-    SubsurfaceOverrides {
-        lod: Some(LodMode::Force),
-        ..SubsurfaceOverrides::default()
-    }
-    .apply_all(&mut forced.materials)
-    .unwrap();
+    Assignments::default()
+        .with("lod", LodMode::Force.name())
+        .apply_all(&mut forced.materials)
+        .unwrap();
     let p = plan_of(&forced, IntegratorKind::Path, PassSet::EMPTY);
     match &p.materials[1].subsurface[..] {
         [SubsurfaceMethod::LevelOfDetail { min_width, .. }] => assert_eq!(*min_width, 0.0),

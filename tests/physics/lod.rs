@@ -12,7 +12,8 @@ use common::mean_se;
 use lucent::accel::{self, Backend};
 use lucent::film::Film;
 use lucent::integrator::Counters;
-use lucent::materials::{LodMode, Material, SubsurfaceOverrides};
+use lucent::materials::estimator_options::Assignments;
+use lucent::materials::{LodMode, Material};
 use lucent::render::{render, RenderOptions};
 use lucent::scene::{self, load_str, Scene};
 
@@ -26,12 +27,10 @@ fn slab_scene() -> Scene {
 
 fn with_lod(scene: &Scene, lod: LodMode) -> Scene {
     let mut s = scene.clone();
-    SubsurfaceOverrides {
-        lod: Some(lod),
-        ..Default::default()
-    }
-    .apply_all(&mut s.materials)
-    .unwrap();
+    Assignments::default()
+        .with("lod", lod.name())
+        .apply_all(&mut s.materials)
+        .unwrap();
     s
 }
 

@@ -14,18 +14,17 @@
 //! - The Henyey–Greenstein g must lie in (−1, 1): g = −1 (pure
 //!   back-scattering) is rejected like g = 1.
 //! - Rescaling lengths by k rescales the random-walk medium by 1/k.
-//! - Material equality and `SubsurfaceOverrides::is_empty`.
+//! - Material equality and empty overrides.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use lucent::bssrdf::params::{dipole_reflectance, Medium};
-use lucent::bssrdf::{
-    ChannelStrategy, Fit, Measured, ProbeAxes, ProbeOptions, RadiusSampler, SubsurfaceParams,
-};
+use lucent::bssrdf::{Fit, Measured, ProbeAxes, ProbeOptions, SubsurfaceParams};
 use lucent::error::{Constraint, Param};
 use lucent::geometry::Vec3;
-use lucent::materials::{Material, Subsurface, SubsurfaceOverrides};
+use lucent::materials::estimator_options::Assignments as Overrides;
+use lucent::materials::{Material, Subsurface};
 
 /// Exact Fresnel reflectance for light arriving with cosine `c` at an
 /// interface of relative index `eta` (far side over near side).
@@ -194,38 +193,19 @@ fn materials_are_equal_exactly_when_their_settings_are() {
 
 #[test]
 fn overrides_are_empty_only_when_they_override_nothing() {
-    assert!(SubsurfaceOverrides::default().is_empty());
+    assert!(Overrides::default().is_empty());
     let one_each = [
-        SubsurfaceOverrides {
-            radius: Some(RadiusSampler::Uniform),
-            ..Default::default()
-        },
-        SubsurfaceOverrides {
-            rmax_quantile: Some(0.99),
-            ..Default::default()
-        },
-        SubsurfaceOverrides {
-            axes: Some(ProbeAxes::Normal),
-            ..Default::default()
-        },
-        SubsurfaceOverrides {
-            channel: Some(ChannelStrategy::Single),
-            ..Default::default()
-        },
-        SubsurfaceOverrides {
-            renormalize: Some(false),
-            ..Default::default()
-        },
-        SubsurfaceOverrides {
-            exit_sw: Some(true),
-            ..Default::default()
-        },
-        SubsurfaceOverrides {
-            specular: Some(true),
-            ..Default::default()
-        },
+        ("radius", "uniform"),
+        ("rmax_quantile", "0.99"),
+        ("axes", "normal"),
+        ("channel", "single"),
+        ("renormalize", "false"),
+        ("exit_sw", "true"),
+        ("specular", "true"),
     ];
-    for o in one_each {
+    for (name, value) in one_each {
+        let o = Overrides::default().with(name, value);
         assert!(!o.is_empty(), "{o:?}");
+        assert_eq!(o.value(name), Some(value));
     }
 }

@@ -24,7 +24,8 @@ use lucent::accel::{self, Backend};
 use lucent::bssrdf::{profile, ChannelStrategy, ProbeAxes, RadiusSampler};
 use lucent::film::Film;
 use lucent::geometry::{Mesh, Vec3};
-use lucent::materials::{Material, SubsurfaceOverrides};
+use lucent::materials::estimator_options::Assignments;
+use lucent::materials::Material;
 use lucent::render::{render, RenderOptions};
 use lucent::scene::{self, Camera, Object, Scene};
 
@@ -82,12 +83,12 @@ fn uniformly_lit_slab_reflects_its_albedo() {
     ] {
         for axes in [ProbeAxes::Curvature, ProbeAxes::Mis3, ProbeAxes::Normal] {
             for channel in [ChannelStrategy::Mis, ChannelStrategy::Single] {
-                configs.push(SubsurfaceOverrides {
-                    radius: Some(radius),
-                    axes: Some(axes),
-                    channel: Some(channel),
-                    ..Default::default()
-                });
+                configs.push(
+                    Assignments::default()
+                        .with("radius", radius.name())
+                        .with("axes", axes.name())
+                        .with("channel", channel.name()),
+                );
             }
         }
     }
@@ -108,7 +109,7 @@ fn uniformly_lit_slab_reflects_its_albedo() {
         for (backend, i) in runs {
             let ov = &configs[i];
             // the single-channel estimator carries 3× the variance
-            let spp = if ov.channel == Some(ChannelStrategy::Single) {
+            let spp = if ov.value("channel") == Some(ChannelStrategy::Single.name()) {
                 1024
             } else {
                 256

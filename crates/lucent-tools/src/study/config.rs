@@ -83,9 +83,10 @@ impl Axis {
     }
 }
 
-/// Sampling choices for every subsurface material; `None` keeps the
-/// material's own setting (the same overrides `lucent render` takes).
-pub use lucent::materials::SubsurfaceOverrides as Overrides;
+/// Sampling choices for every subsurface material, by the option table's
+/// names; an option not given keeps the material's own setting (the same
+/// overrides `lucent render` takes).
+pub use lucent::materials::estimator_options::Assignments as Overrides;
 
 /// One row group of the study: what is rendered and how.
 #[derive(Clone, Debug, PartialEq)]
@@ -121,14 +122,6 @@ pub(crate) fn parse_integrator(s: &str) -> Option<IntegratorKind> {
     }
 }
 
-fn axes_name(a: ProbeAxes) -> &'static str {
-    a.name()
-}
-
-fn channel_name(c: ChannelStrategy) -> &'static str {
-    c.name()
-}
-
 /// The baseline's probe options: the recommended defaults (exact analytic
 /// radius sampling, N/T/B probes with MIS, all channels per sample, Rmax at
 /// the 0.999 quantile, no renormalization).
@@ -140,22 +133,15 @@ pub(crate) fn baseline_probe() -> ProbeOptions {
 /// truncation of the configurations (0.999 by default) shows as bias.
 pub(crate) const REFERENCE_RMAX_QUANTILE: f64 = 0.99999;
 
+/// Every probe option of `o` given (the scene's Fresnel, random-walk and
+/// variance choices are not).
 fn full_probe(o: ProbeOptions) -> Overrides {
-    Overrides {
-        radius: Some(o.radius),
-        rmax_quantile: Some(o.rmax_quantile),
-        axes: Some(o.axes),
-        channel: Some(o.channel),
-        renormalize: Some(o.renormalize),
-        exit_sw: None,
-        specular: None,
-        boundary: None,
-        roughness: None,
-        lod: None,
-        // the scene's own variance reduction (the variance axis varies it)
-        control_variate: None,
-        probe_pair: None,
-    }
+    Overrides::default()
+        .with("radius", o.radius.name())
+        .with("rmax_quantile", o.rmax_quantile)
+        .with("axes", o.axes.name())
+        .with("channel", o.channel.name())
+        .with("renormalize", o.renormalize)
 }
 
 /// The overrides of the diffusion reference: the exact sampler, MIS axes
@@ -163,13 +149,11 @@ fn full_probe(o: ProbeOptions) -> Overrides {
 /// (the full estimator at every hit); Fresnel choices are the scene's (they
 /// change the model, not the estimator).
 pub(crate) fn reference_overrides() -> Overrides {
-    Overrides {
-        lod: Some(LodMode::Off),
-        ..full_probe(ProbeOptions {
-            rmax_quantile: REFERENCE_RMAX_QUANTILE,
-            ..baseline_probe()
-        })
-    }
+    full_probe(ProbeOptions {
+        rmax_quantile: REFERENCE_RMAX_QUANTILE,
+        ..baseline_probe()
+    })
+    .with("lod", LodMode::Off.name())
 }
 
 /// The first subsurface material's (exit_sw, specular): the scene's model
@@ -295,29 +279,26 @@ pub fn matrix(
     let (exit_sw, specular) = scene_fresnel(scene).ok_or(ConfigError::NoSubsurface)?;
     let base_probe = baseline_probe();
     let base_backend = backends[0];
-    let mut base_ov = full_probe(base_probe);
-    base_ov.exit_sw = Some(exit_sw);
-    base_ov.specular = Some(specular);
+    let base_ov = full_probe(base_probe)
+        .with("exit_sw", exit_sw)
+        .with("specular", specular);
     let mut m = Matrix {
         out: vec![Config {
             name: "baseline".into(),
             axis: Axis::Baseline,
             value: String::new(),
-            overrides: base_ov,
+            overrides: base_ov.clone(),
             backend: base_backend,
             integrator: IntegratorKind::Path,
         }],
-        base: base_ov,
+        base: base_ov.clone(),
         base_backend,
     };
     for r in radius_values(quick) {
         m.vary(
             Axis::Radius,
             radius_name(r),
-            Overrides {
-                radius: Some(r),
-                ..m.base
-            },
+            m.base.clone().with("radius", r.name()),
         );
     }
     let quantiles: &[f64] = if quick {
@@ -329,21 +310,15 @@ pub fn matrix(
         m.vary(
             Axis::RmaxQuantile,
             format!("{q}"),
-            Overrides {
-                rmax_quantile: Some(q),
-                ..m.base
-            },
+            m.base.clone().with("rmax_quantile", q),
         );
     }
     // every other axis rule (normal-only and mis3 for the default)
     for other_axes in ProbeAxes::ALL.into_iter().filter(|&a| a != base_probe.axes) {
         m.vary(
             Axis::Axes,
-            axes_name(other_axes).into(),
-            Overrides {
-                axes: Some(other_axes),
-                ..m.base
-            },
+            other_axes.name().into(),
+            m.base.clone().with("axes", other_axes.name()),
         );
     }
     let other_channel = match base_probe.channel {
@@ -352,39 +327,27 @@ pub fn matrix(
     };
     m.vary(
         Axis::Channel,
-        channel_name(other_channel).into(),
-        Overrides {
-            channel: Some(other_channel),
-            ..m.base
-        },
+        other_channel.name().into(),
+        m.base.clone().with("channel", other_channel.name()),
     );
     if !quick {
         let r = !base_probe.renormalize;
         m.vary(
             Axis::Renormalize,
             r.to_string(),
-            Overrides {
-                renormalize: Some(r),
-                ..m.base
-            },
+            m.base.clone().with("renormalize", r),
         );
     }
     m.vary(
         Axis::ExitSw,
         (!exit_sw).to_string(),
-        Overrides {
-            exit_sw: Some(!exit_sw),
-            ..m.base
-        },
+        m.base.clone().with("exit_sw", !exit_sw),
     );
     if !quick {
         m.vary(
             Axis::Specular,
             (!specular).to_string(),
-            Overrides {
-                specular: Some(!specular),
-                ..m.base
-            },
+            m.base.clone().with("specular", !specular),
         );
     }
     // Level of detail off: what the probe estimator costs where the
@@ -393,10 +356,7 @@ pub fn matrix(
     m.vary(
         Axis::Lod,
         LodMode::Off.name().into(),
-        Overrides {
-            lod: Some(LodMode::Off),
-            ..m.base
-        },
+        m.base.clone().with("lod", LodMode::Off.name()),
     );
     // The variance reduction at the camera vertex, each choice other than
     // the scene's (the default: the control variate alone); the quick
@@ -416,18 +376,17 @@ pub fn matrix(
         m.vary(
             Axis::Variance,
             name.into(),
-            Overrides {
-                control_variate: Some(cv),
-                probe_pair: Some(pair),
-                ..m.base
-            },
+            m.base
+                .clone()
+                .with("control_variate", cv)
+                .with("probe_pair", pair),
         );
     }
     for &b in &backends[1..] {
         m.add(
             Axis::Backend,
             b.name().into(),
-            base_ov,
+            base_ov.clone(),
             b,
             IntegratorKind::Path,
         );
@@ -435,7 +394,7 @@ pub fn matrix(
     m.add(
         Axis::Integrator,
         integrator_name(IntegratorKind::RandomWalk).into(),
-        base_ov,
+        base_ov.clone(),
         base_backend,
         IntegratorKind::RandomWalk,
     );
@@ -451,10 +410,7 @@ pub fn matrix(
         m.add(
             Axis::Boundary,
             other.name().into(),
-            Overrides {
-                boundary: Some(other),
-                ..base_ov
-            },
+            base_ov.clone().with("boundary", other.name()),
             base_backend,
             IntegratorKind::RandomWalk,
         );
@@ -470,41 +426,8 @@ pub fn apply(scene: &Scene, ov: &Overrides) -> Result<Scene, ConfigError> {
     Ok(out)
 }
 
-/// A one-line description of overrides for the report.
+/// A one-line description of overrides for the report: `name=value` in
+/// the option table's order and names.
 pub(crate) fn describe(ov: &Overrides) -> String {
-    let mut parts = Vec::new();
-    if let Some(r) = ov.radius {
-        parts.push(format!("radius {}", radius_name(r)));
-    }
-    if let Some(q) = ov.rmax_quantile {
-        parts.push(format!("Rmax quantile {q}"));
-    }
-    if let Some(a) = ov.axes {
-        parts.push(format!("axes {}", axes_name(a)));
-    }
-    if let Some(c) = ov.channel {
-        parts.push(format!("channel {}", channel_name(c)));
-    }
-    if let Some(r) = ov.renormalize {
-        parts.push(format!("renormalize {r}"));
-    }
-    if let Some(e) = ov.exit_sw {
-        parts.push(format!("exit_sw {e}"));
-    }
-    if let Some(s) = ov.specular {
-        parts.push(format!("specular {s}"));
-    }
-    if let Some(b) = ov.boundary {
-        parts.push(format!("random-walk boundary {}", b.name()));
-    }
-    if let Some(l) = ov.lod {
-        parts.push(format!("level of detail {}", l.name()));
-    }
-    if let Some(c) = ov.control_variate {
-        parts.push(format!("control variate {c}"));
-    }
-    if let Some(p) = ov.probe_pair {
-        parts.push(format!("probe pair {p}"));
-    }
-    parts.join(", ")
+    ov.canonical()
 }

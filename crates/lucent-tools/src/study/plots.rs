@@ -14,6 +14,7 @@
 
 use std::path::{Path, PathBuf};
 
+use lucent::bssrdf::RadiusSampler;
 use plotters::prelude::*;
 
 use super::config::{Axis, Config};
@@ -221,7 +222,10 @@ pub(crate) fn write_all(
         .filter(|c| c.axis == Axis::RmaxQuantile)
         .chain(baseline)
         .collect();
-    let nines = |c: &Config| c.overrides.rmax_quantile.map(|q| -(1.0 - q).log10());
+    let nines = |c: &Config| {
+        let q: f64 = c.overrides.value("rmax_quantile")?.parse().ok()?;
+        Some(-(1.0 - q).log10())
+    };
     let pts = bias_points(rows, &rmax_cfgs, nines);
     if pts.len() >= 2 {
         let p = dir.join("bias-vs-rmax.png");
@@ -238,8 +242,8 @@ pub(crate) fn write_all(
     }
 
     let table_size = |spacing: lucent::bssrdf::TableSpacing| {
-        move |c: &Config| match c.overrides.radius {
-            Some(lucent::bssrdf::RadiusSampler::Table { size, spacing: s }) if s == spacing => {
+        move |c: &Config| match c.overrides.value("radius").map(RadiusSampler::parse) {
+            Some(Ok(RadiusSampler::Table { size, spacing: s })) if s == spacing => {
                 Some((size as f64).log2())
             }
             _ => None,

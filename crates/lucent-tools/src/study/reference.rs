@@ -125,7 +125,7 @@ pub(super) fn reference(
         seed: ref_seed,
         seconds: f64::NAN,
         cached: false,
-        overrides,
+        overrides: overrides.clone(),
     };
     let (w, h) = (scene.camera.width, scene.camera.height);
     if let Some(film) = read_film(&path, w, h).map_err(|e| Error::Input(e.to_string()))? {

@@ -286,8 +286,8 @@ impl Channels<'_> {
     }
 
     /// A bad value of channel `name` (layer.channel).
-    fn located(&self, name: &str, problem: String) -> Error {
-        bad(self.path, Some(name), problem)
+    fn located(&self, name: &str, problem: impl std::fmt::Display) -> Error {
+        bad(self.path, Some(name), problem.to_string())
     }
 
     /// Reads every summed channel of `layers` into `sums`; the channels

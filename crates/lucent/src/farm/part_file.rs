@@ -106,7 +106,7 @@ fn check_structure(
     }
     let layout = layout_of(&header.identity).map_err(|e| e.at(path))?;
     for c in &exr.channels.list {
-        check_channel(c, header, layout.as_ref()).map_err(|p| bad(path, None, p))?;
+        check_channel(c, header, layout.as_ref()).map_err(|p| bad(path, None, p.to_string()))?;
     }
     let raw = r.area() as u128 * exr.channels.list.len() as u128 * 4;
     if raw > len as u128 * MAX_DEFLATE_RATIO as u128 {
@@ -125,13 +125,14 @@ fn check_channel(
     c: &ChannelDescription,
     header: &Header,
     layout: Option<&Layout>,
-) -> Result<(), String> {
+) -> Result<(), ChannelFault> {
     let name = c.name.to_string();
     if c.sample_type != SampleType::U32 || c.sampling != Vec2(1, 1) {
-        return Err(format!(
-            "channel {name}: {:?} samples every {}×{} pixels, parts hold u32 at every pixel",
-            c.sample_type, c.sampling.0, c.sampling.1
-        ));
+        return Err(ChannelFault::Samples {
+            name,
+            kind: format!("{:?}", c.sample_type),
+            every: (c.sampling.0, c.sampling.1),
+        });
     }
     let summed = header.layers.iter().any(|l| {
         l.channels
@@ -143,9 +144,26 @@ fn check_channel(
     if summed || nearest || is_coverage(&name, layout) {
         return Ok(());
     }
-    Err(format!(
-        "channel {name}: not a channel of this part's layers and passes"
-    ))
+    Err(ChannelFault::Foreign { name })
+}
+
+/// A channel no part writes.
+#[derive(Debug, thiserror::Error)]
+enum ChannelFault {
+    /// Not u32 at every pixel.
+    #[error(
+        "channel {name}: {kind} samples every {}×{} pixels, parts hold u32 at every pixel",
+        every.0,
+        every.1
+    )]
+    Samples {
+        name: String,
+        kind: String,
+        every: (usize, usize),
+    },
+    /// A name none of the part's layers and passes has.
+    #[error("channel {name}: not a channel of this part's layers and passes")]
+    Foreign { name: String },
 }
 
 /// Whether `name` is a coverage channel `coverage.<kind>.id{k}` / `n{k}`

@@ -53,15 +53,15 @@ impl<'a> PixelAt<'a> {
     }
 
     /// That `v` is a sum of the part's samples.
-    pub fn check_sum(&self, v: i128, j: usize) -> Result<(), String> {
+    pub fn check_sum(&self, v: i128, j: usize) -> Result<(), Unmade> {
         if v.unsigned_abs() <= self.n() << TERM_BITS {
             return Ok(());
         }
-        Err(format!(
-            "{}: sum {v} is beyond what {} samples can add up to (each at most 2^{TERM_BITS})",
-            self.pixel(j),
-            self.n()
-        ))
+        Err(Unmade::Sum {
+            pixel: self.pixel(j),
+            sum: v,
+            samples: self.n(),
+        })
     }
 
     /// The channel (`depth`, `sample`, …) at fault in nearest hit `h` of
@@ -101,14 +101,36 @@ impl<'a> PixelAt<'a> {
     }
 
     /// That `total` samples covering pixel `j` is at most its samples.
-    pub fn check_coverage(&self, total: u64, j: usize) -> Result<(), String> {
+    pub fn check_coverage(&self, total: u64, j: usize) -> Result<(), Unmade> {
         if total as u128 <= self.n() {
             return Ok(());
         }
-        Err(format!(
-            "{}: IDs cover {total} samples of {} (coverage above 1)",
-            self.pixel(j),
-            self.n()
-        ))
+        Err(Unmade::Coverage {
+            pixel: self.pixel(j),
+            total,
+            samples: self.n(),
+        })
     }
+}
+
+/// A value of a pixel that no render of the part's header makes.
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum Unmade {
+    /// A sum beyond what the part's samples can add up to.
+    #[error(
+        "{pixel}: sum {sum} is beyond what {samples} samples can add up to \
+         (each at most 2^{TERM_BITS})"
+    )]
+    Sum {
+        pixel: String,
+        sum: i128,
+        samples: u128,
+    },
+    /// IDs covering more samples than the part has.
+    #[error("{pixel}: IDs cover {total} samples of {samples} (coverage above 1)")]
+    Coverage {
+        pixel: String,
+        total: u64,
+        samples: u128,
+    },
 }

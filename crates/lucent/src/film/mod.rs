@@ -206,11 +206,10 @@ impl Film {
 }
 
 /// Encodes `img` as PNG into `file`.
-pub fn write_png(img: &image::RgbImage, file: &mut fs::File) -> Result<(), String> {
+pub fn write_png(img: &image::RgbImage, file: &mut fs::File) -> Result<(), image::ImageError> {
     let mut w = std::io::BufWriter::new(file);
-    img.write_to(&mut w, image::ImageFormat::Png)
-        .map_err(|e| e.to_string())?;
-    std::io::Write::flush(&mut w).map_err(|e| e.to_string())
+    img.write_to(&mut w, image::ImageFormat::Png)?;
+    Ok(std::io::Write::flush(&mut w)?)
 }
 
 /// The error of an allocation that failed: what it was for and its size.

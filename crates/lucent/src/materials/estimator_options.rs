@@ -467,6 +467,33 @@ impl Assignments {
         Ok(())
     }
 
+    /// These assignments with option `name` set to `value` in place of any
+    /// earlier value (for values written from the option's own names, as
+    /// a study builds its configurations).
+    ///
+    /// # Panics
+    /// If `name` is not an option of the table or `value` not one it
+    /// reads: the caller's mistake, never input.
+    pub fn with(mut self, name: &str, value: impl fmt::Display) -> Assignments {
+        let row = option(name).unwrap_or_else(|| panic!("no estimator option \"{name}\""));
+        let value = value.to_string();
+        self.0.retain(|(r, _)| !std::ptr::eq(*r, row));
+        if let Err(e) = self.push(row, &value) {
+            panic!("{name} = {value}: {e}");
+        }
+        self
+    }
+
+    /// The value given for option `name`, as given (the last one given).
+    pub fn value(&self, name: &str) -> Option<&str> {
+        let key = name.replace('-', "_");
+        self.0
+            .iter()
+            .rev()
+            .find(|(r, _)| r.name == key)
+            .map(|(_, v)| v.as_str())
+    }
+
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()
     }
@@ -492,7 +519,7 @@ impl Assignments {
 
     /// The options given, `name=value` in table order with the values as
     /// the scene format writes them (a part's identity).
-    pub(crate) fn canonical(&self) -> String {
+    pub fn canonical(&self) -> String {
         let o = self.over(EstimatorOptions::default());
         let given: Vec<String> = OPTIONS
             .iter()

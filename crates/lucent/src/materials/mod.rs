@@ -29,7 +29,7 @@ pub use lod::LodMode;
 pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;
 #[cfg(feature = "subsurface")]
-pub use subsurface::{Subsurface, SubsurfaceOverrides};
+pub use subsurface::Subsurface;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {

@@ -269,24 +269,6 @@ fn curvature_for(
     }
 }
 
-/// Sampling choices that replace a material's own (from the command line
-/// or a study configuration); `None` keeps the material's setting.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SubsurfaceOverrides {
-    pub radius: Option<crate::bssrdf::RadiusSampler>,
-    pub rmax_quantile: Option<f64>,
-    pub axes: Option<crate::bssrdf::ProbeAxes>,
-    pub channel: Option<crate::bssrdf::ChannelStrategy>,
-    pub renormalize: Option<bool>,
-    pub exit_sw: Option<bool>,
-    pub specular: Option<bool>,
-    pub boundary: Option<WalkBoundary>,
-    pub roughness: Option<f32>,
-    pub lod: Option<LodMode>,
-    pub control_variate: Option<bool>,
-    pub probe_pair: Option<bool>,
-}
-
 impl Subsurface {
     /// Every sampling option, `key=value` separated by spaces, with the
     /// names of the option table (for the EXR header).
@@ -300,122 +282,40 @@ impl Subsurface {
     }
 }
 
-impl SubsurfaceOverrides {
-    /// The options given, `key=value` separated by spaces in a fixed
-    /// order, with the names the scene format and the command line use (a
-    /// part's identity: stable across builds, unlike `Debug`).
-    pub fn canonical(&self) -> String {
-        let pairs: [(&str, Option<String>); 12] = [
-            ("radius", self.radius.map(|r| r.name())),
-            ("rmax_quantile", self.rmax_quantile.map(|q| q.to_string())),
-            ("axes", self.axes.map(|a| a.name().into())),
-            ("channel", self.channel.map(|c| c.name().into())),
-            ("renormalize", self.renormalize.map(|b| b.to_string())),
-            ("exit_sw", self.exit_sw.map(|b| b.to_string())),
-            ("specular", self.specular.map(|b| b.to_string())),
-            ("boundary", self.boundary.map(|b| b.name().into())),
-            ("roughness", self.roughness.map(|r| r.to_string())),
-            ("lod", self.lod.map(|l| l.name().into())),
-            (
-                "control_variate",
-                self.control_variate.map(|b| b.to_string()),
-            ),
-            ("probe_pair", self.probe_pair.map(|b| b.to_string())),
-        ];
-        let given: Vec<String> = pairs
-            .into_iter()
-            .filter_map(|(k, v)| Some(format!("{k}={}", v?)))
-            .collect();
-        given.join(" ")
-    }
-
-    pub fn is_empty(&self) -> bool {
-        *self == SubsurfaceOverrides::default()
-    }
-
-    /// `o` with these choices applied.
-    pub fn over(&self, o: &EstimatorOptions) -> EstimatorOptions {
-        let p = &o.probe;
-        EstimatorOptions {
-            probe: ProbeOptions {
-                radius: self.radius.unwrap_or(p.radius),
-                rmax_quantile: self.rmax_quantile.unwrap_or(p.rmax_quantile),
-                axes: self.axes.unwrap_or(p.axes),
-                channel: self.channel.unwrap_or(p.channel),
-                renormalize: self.renormalize.unwrap_or(p.renormalize),
-            },
-            exit_sw: self.exit_sw.unwrap_or(o.exit_sw),
-            specular: self.specular.unwrap_or(o.specular),
-            roughness: self.roughness.unwrap_or(o.roughness),
-            boundary: self.boundary.unwrap_or(o.boundary),
-            lod: self.lod.unwrap_or(o.lod),
-            control_variate: self.control_variate.unwrap_or(o.control_variate),
-            probe_pair: self.probe_pair.unwrap_or(o.probe_pair),
-            ..*o
-        }
-    }
-
-    /// The material with these choices applied (its parameters unchanged).
-    pub fn apply(&self, ss: &Subsurface) -> Result<Subsurface, ParamError> {
-        ss.with_options(&self.over(&ss.options))
-    }
-
-    /// Applies the overrides to every subsurface material of `materials`.
-    pub fn apply_all(&self, materials: &mut [super::Material]) -> Result<(), ParamError> {
-        for m in materials.iter_mut() {
-            if let super::Material::Subsurface(ss) = m {
-                *ss = std::sync::Arc::new(self.apply(ss)?);
-            }
-        }
-        Ok(())
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::bssrdf::{Fit, ProbeAxes, RadiusSampler};
+    use crate::materials::estimator_options::Assignments;
 
     #[test]
     fn overrides_replace_only_what_they_name() {
         let p = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
         let ss = Subsurface::new(p, &ProbeOptions::default(), true, true).unwrap();
-        let ov = SubsurfaceOverrides {
-            axes: Some(ProbeAxes::Normal),
-            specular: Some(false),
-            ..Default::default()
-        };
-        let out = ov.apply(&ss).unwrap();
+        let apply = |ov: &Assignments, ss: &Subsurface| ss.with_options(&ov.over(ss.options));
+        let ov = Assignments::default()
+            .with("axes", "normal")
+            .with("specular", false);
+        let out = apply(&ov, &ss).unwrap();
         assert_eq!(out.probe().options().axes, ProbeAxes::Normal);
         assert_eq!(out.probe().options().radius, RadiusSampler::Analytic);
         assert!(out.exit_sw() && !out.specular());
         assert_eq!(out.params(), ss.params());
         assert_eq!(out.boundary(), WalkBoundary::Dielectric);
-        let walk = SubsurfaceOverrides {
-            boundary: WalkBoundary::parse("Diffuse"),
-            ..Default::default()
-        }
-        .apply(&out)
-        .unwrap();
+        let walk = apply(&Assignments::default().with("boundary", "Diffuse"), &out).unwrap();
         assert_eq!(walk.boundary(), WalkBoundary::Diffuse { exit_nee: true });
         assert!(walk != out && walk.exit_sw() && !walk.specular());
         assert_eq!(WalkBoundary::parse("lambert"), None);
-        let bad = SubsurfaceOverrides {
-            rmax_quantile: Some(1.5),
-            ..Default::default()
-        };
-        assert!(bad.apply(&ss).is_err());
+        let bad = Assignments::default().with("rmax_quantile", 1.5);
+        assert!(apply(&bad, &ss).is_err());
         // the identity names options as the scene format does, not as Debug
         assert_eq!(ov.canonical(), "axes=normal specular=false");
-        assert_eq!(SubsurfaceOverrides::default().canonical(), "");
+        assert_eq!(Assignments::default().canonical(), "");
+        // a later value replaces an earlier one
+        assert_eq!(ov.clone().with("axes", "mis3").value("axes"), Some("mis3"));
         // lobe: Sw integrates to 1 against cos; the plain lobe is 1/π
         assert_eq!(out.lobe(-0.1), 0.0);
-        let plain = SubsurfaceOverrides {
-            exit_sw: Some(false),
-            ..Default::default()
-        }
-        .apply(&ss)
-        .unwrap();
+        let plain = apply(&Assignments::default().with("exit_sw", false), &ss).unwrap();
         assert_eq!(plain.lobe(0.3), std::f32::consts::FRAC_1_PI);
     }
 }

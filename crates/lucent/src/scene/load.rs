@@ -340,6 +340,39 @@ mod tests {
         .unwrap()
     }
 
+    /// The mistake: an option of the table the scene format has no key
+    /// for, or a key read but never handed to the table (the material
+    /// keeps the default).
+    #[cfg(feature = "subsurface")]
+    #[test]
+    fn every_estimator_option_is_a_scene_key_that_reaches_the_material() {
+        use crate::materials::{EstimatorOptions, OPTIONS};
+        let default = EstimatorOptions::default();
+        for row in &OPTIONS {
+            let d = (row.get)(&default);
+            // a value other than the default, as the scene format writes it
+            let other = match d.as_str() {
+                "true" => "false".to_string(),
+                "false" => "true".to_string(),
+                _ => match row.values.iter().chain(row.research).find(|v| **v != d) {
+                    Some(v) => format!("\"{v}\""),
+                    None => "0.5".to_string(),
+                },
+            };
+            let s = scene(&format!(
+                "[materials.m]\ntype = \"subsurface\"\npreset = \"marble\"\n{} = {other}\n\
+                 [[shapes]]\ntype = \"sphere\"\nmaterial = \"m\"\n",
+                row.name
+            ));
+            let Material::Subsurface(ss) = &s.materials[0] else {
+                panic!("{}: not a subsurface material", row.name)
+            };
+            let got = (row.get)(ss.options());
+            assert_ne!(got, d, "{} = {other} read as the default", row.name);
+            assert_eq!(got, other.trim_matches('"'), "{}", row.name);
+        }
+    }
+
     #[test]
     fn traversal_is_fast_unless_the_scene_asks_for_watertight() {
         assert_eq!(scene("").settings.traversal, Traversal::Fast);

@@ -37,7 +37,7 @@ use crate::integrator::IntegratorKind;
 use crate::scene::Scene;
 
 pub use super::choice::Choice;
-pub use super::materials::{Channels, MaterialPlan, SubsurfaceMethod};
+pub use super::materials::{Channels, MaterialPlan, OptionSetting, SubsurfaceMethod};
 pub use super::options::PlanOptions;
 
 /// The version of the JSON schema.

@@ -89,6 +89,22 @@ pub struct MaterialPlan {
     /// Subsurface materials: the channels simulated.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub channels: Option<Channels>,
+    /// Subsurface materials: the estimator options given a value other
+    /// than their default, in the option table's order and names.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub options: Vec<OptionSetting>,
+}
+
+/// An estimator option set away from its default
+/// ([`crate::materials::OPTIONS`]).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct OptionSetting {
+    /// The scene key (the flag with `-` for `_`).
+    pub name: String,
+    /// The value, as the scene format writes it.
+    pub value: String,
+    /// The default's value.
+    pub default: String,
 }
 
 const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
@@ -141,7 +157,25 @@ fn base_plan(scene: &Scene, i: usize, m: &Material) -> MaterialPlan {
         coat: None,
         exit_lobe: None,
         channels: None,
+        options: Vec::new(),
     }
+}
+
+/// The options of `ss` that differ from the table's defaults.
+#[cfg(feature = "subsurface")]
+fn changed_options(ss: &Subsurface) -> Vec<OptionSetting> {
+    crate::materials::OPTIONS
+        .iter()
+        .filter_map(|row| {
+            let value = (row.get)(ss.options());
+            let default = row.default_text();
+            (value != default).then(|| OptionSetting {
+                name: row.name.into(),
+                value,
+                default,
+            })
+        })
+        .collect()
 }
 
 /// Every material's row, in the scene's order.
@@ -190,6 +224,7 @@ pub(super) fn material_rows(scene: &Scene, opts: &PlanOptions, area_lights: bool
             #[cfg(feature = "subsurface")]
             Material::Subsurface(ss) if walk => {
                 walk_material(ss, &mut mp);
+                mp.options = changed_options(ss);
                 if ss.boundary() == WalkBoundary::Dielectric && ss.params().medium.is_some() {
                     rows.specular_materials.push(mname.clone());
                     rows.specular_why
@@ -199,6 +234,7 @@ pub(super) fn material_rows(scene: &Scene, opts: &PlanOptions, area_lights: bool
             #[cfg(feature = "subsurface")]
             Material::Subsurface(ss) => {
                 let active = diffusion_material(ss, opts, area_lights, &mut mp);
+                mp.options = changed_options(ss);
                 if active {
                     rows.probes_needed.push(mname.clone());
                 }

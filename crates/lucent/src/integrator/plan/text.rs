@@ -106,6 +106,17 @@ pub fn render(p: &Explanation) -> String {
             };
             row(r, "channels", &on, &c.reason);
         }
+        #[cfg(feature = "subsurface")]
+        for o in &m.options {
+            let what = crate::materials::estimator_options::option(&o.name)
+                .map_or("", |row| row.description);
+            row(
+                r,
+                "option",
+                &format!("{}={}", o.name, o.value),
+                &format!("{what} (default {})", o.default),
+            );
+        }
     }
     out
 }
