@@ -7,7 +7,8 @@
 #
 # TEST (default: all three):
 #   frame     one frame, 4 bands, array indices from 1 (not 0), ARGS that
-#             replace the scripts' --threads and --checkpoint
+#             replace the scripts' --threads and --checkpoint; then a
+#             finished task requeued: skipped, its log appended
 #   sequence  3 frames (shot.%04d.toml) x 2 parts in one array, one merge
 #             per frame
 #   timeout   one part under a 1-minute time limit that needs longer: the
@@ -95,8 +96,12 @@ CONF
 export SLURM_CONF=$WORK/slurm.conf
 
 stop() {
+  local d p
   for d in slurmd slurmctld; do
-    if [ -f "$WORK/$d.pid" ]; then kill "$(cat "$WORK/$d.pid")" 2>/dev/null || true; fi
+    [ -f "$WORK/$d.pid" ] || continue
+    p=$(cat "$WORK/$d.pid")
+    kill "$p" 2>/dev/null || continue
+    for _ in $(seq 30); do kill -0 "$p" 2>/dev/null || break; sleep 1; done
   done
   if [ -n "$started_munge" ] && [ -f /run/munge/munged.pid ]; then
     kill "$(cat /run/munge/munged.pid)" 2>/dev/null || true
@@ -140,6 +145,7 @@ drain() {
 check() {
   local frame=$1 scene=$2 single=${1%.exr}.single.exr
   shift 2
+  [ -f "$frame" ] || { echo "slurm: no merged frame $frame (logs in $WORK)" >&2; exit 1; }
   [ "$scene" = "$single" ] || "$LUCENT" render "$scene" --quiet -o "$single" "$@"
   if idiff -q -fail 0 -warn 0 "$frame" "$single" >/dev/null &&
     cmp "${frame%.exr}.png" "${single%.exr}.png"; then
@@ -164,6 +170,18 @@ test_frame() {
     ARGS="--threads 1 --checkpoint=30" "$ROOT/deploy/slurm/submit.sh")
   drain 600
   check "$d/out/frame.exr" "$d/cornell.toml"
+  # a finished task run again (as a requeue after its end would) leaves its
+  # part as it is, and its log keeps both runs
+  cp "$d/out/part-0.exr" "$d/part-0.before"
+  scontrol requeue "$(squeue -h -t all -o '%A %K' | awk '$2 == 1 {print $1}')"
+  drain 600 nudge
+  if ! grep -q 'exists: nothing to do' "$d"/lucent-part-*_1.log ||
+    [ "$(grep -c ' task ' "$d"/lucent-part-*_1.log)" != 2 ] ||
+    ! cmp "$d/out/part-0.exr" "$d/part-0.before"; then
+    echo "slurm: a finished part was rendered again (log: $d/lucent-part-*_1.log)" >&2
+    exit 1
+  fi
+  echo "  a finished task requeued: skipped, part unchanged, log appended"
 }
 
 test_sequence() {
