@@ -12,8 +12,8 @@
 #   FRAMES   A-B: the frames of a sequence (SCENE holds a printf pattern,
 #            e.g. shot.%04d.toml); default: SCENE is one frame
 #   BASE     the array's first index (default 0; any base works)
-#   MEM      memory per part, sbatch's --mem syntax (default: derived from
-#            the scene's resolution, the split and the passes, below)
+#   MEM      memory per part, sbatch's --mem syntax (default: deploy/memory.sh,
+#            from the scene's resolution, the split and the passes)
 #   MERGE_MEM  memory of each merge (default: derived the same way)
 # The options given go to the array's sbatch (e.g. --time=8:00:00
 # --cpus-per-task=4 --partition=render); SBATCH_* variables work too.
@@ -37,29 +37,13 @@ frames=$((last - FIRST + 1))
 mkdir -p "$OUT"
 export SCENE OUT PARTS FIRST SPLIT
 
-# Memory (docs/farm.md, "Memory"): per pixel of a part, the render keeps two
-# sets of sums and a checkpoint's copy: 48 + 48 + 48 B for the beauty
-# alone, about 900 + 900 + 900 B with every pass; a merge holds the frame's
-# sums and one part's (measured 2.7 GB at 1920x1080 with every pass: 1300
-# B/pixel). Plus 256 MB for the scene, its BVH and the process, and a
-# quarter for headroom. One frame's resolution stands for the sequence's.
-# shellcheck disable=SC2059 # SCENE may be a pattern
-scene1=$(printf "$SCENE" "$FIRST")
-read -r w h < <(sed -n 's/^[[:space:]]*resolution[[:space:]]*=[[:space:]]*\[[[:space:]]*\([0-9]*\)[[:space:]]*,[[:space:]]*\([0-9]*\).*/\1 \2/p' "$scene1" | head -1)
-: "${w:?no resolution = [W, H] in $scene1; set MEM and MERGE_MEM}"
-passes=0
-case " ${ARGS:-} " in
-  *" --aov none "* | *" --aov=none "*) ;;
-  *" --aov"*) passes=1 ;;
-  *) grep -Eq '^[[:space:]]*aovs[[:space:]]*=[[:space:]]*\[[[:space:]]*"' "$scene1" && passes=1 ;;
-esac
-pixels=$((w * h))
-[ "$SPLIT" = tiles ] && pixels=$((w * (h / PARTS + 1)))
-mb() { echo $(((256 + $1 / 1000000) * 5 / 4))M; }
-if [ "$passes" = 1 ]; then
-  : "${MEM:=$(mb $((pixels * 2700)))}" "${MERGE_MEM:=$(mb $((w * h * 1300)))}"
-else
-  : "${MEM:=$(mb $((pixels * 144)))}" "${MERGE_MEM:=$(mb $((w * h * 200)))}"
+# Memory: deploy/memory.sh (from docs/farm.md's figures); one frame's
+# resolution stands for the sequence's.
+if [ -z "${MEM:-}" ] || [ -z "${MERGE_MEM:-}" ]; then
+  # shellcheck disable=SC2059 # SCENE may be a pattern
+  sizes=$("$here/../memory.sh" "$(printf "$SCENE" "$FIRST")" "$PARTS" "$SPLIT")
+  MEM=${MEM:-${sizes% *}M}
+  MERGE_MEM=${MERGE_MEM:-${sizes#* }M}
 fi
 
 tasks=$((frames * PARTS))

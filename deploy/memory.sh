@@ -1,0 +1,33 @@
+#!/bin/bash
+# Prints the memory, in MB, that one part and one merge of a frame need:
+#
+#   [ARGS="render options"] deploy/memory.sh SCENE PARTS [tiles|samples]
+#   -> "PART_MB MERGE_MB"
+#
+# From the figures in docs/farm.md ("Memory"): per pixel of a part, the
+# render keeps two sets of sums and, while a checkpoint is written, a copy
+# of one: 3 x 48 B for the beauty alone, 3 x ~900 B with every pass
+# (measured: 832 MB peak for 640x480 with --aov all, 2.7 kB a pixel). A
+# merge holds the frame's sums and one part's: 2.7 GB measured at 1920x1080
+# with every pass (1300 B a pixel), 200 B a pixel for the beauty. Plus 256
+# MB for the scene, its BVH and the process, and a quarter for headroom.
+# Passes count as on when ARGS has --aov (but not --aov none) or the scene
+# has a non-empty `aovs` list; a band (tiles) holds ceil(H / PARTS) rows.
+set -euo pipefail
+scene=$1 parts=$2 split=${3:-tiles}
+read -r w h < <(sed -n 's/^[[:space:]]*resolution[[:space:]]*=[[:space:]]*\[[[:space:]]*\([0-9]*\)[[:space:]]*,[[:space:]]*\([0-9]*\).*/\1 \2/p' "$scene" | head -1) || true
+if [ -z "${w:-}" ] || [ -z "${h:-}" ]; then
+  echo "$scene: no 'resolution = [W, H]' line to size memory from" >&2
+  exit 2
+fi
+passes=0
+case " ${ARGS:-} " in
+  *" --aov none "* | *" --aov=none "*) ;;
+  *" --aov"*) passes=1 ;;
+  *) if grep -Eq '^[[:space:]]*aovs[[:space:]]*=[[:space:]]*\[[[:space:]]*"' "$scene"; then passes=1; fi ;;
+esac
+pixels=$((w * h))
+[ "$split" = tiles ] && pixels=$((w * ((h + parts - 1) / parts)))
+if [ "$passes" = 1 ]; then part_b=2700 merge_b=1300; else part_b=144 merge_b=200; fi
+mb() { echo $(((256 + $1 / 1000000) * 5 / 4)); }
+echo "$(mb $((pixels * part_b))) $(mb $((w * h * merge_b)))"
