@@ -35,6 +35,7 @@ if [ "$(id -u)" != 0 ]; then
   exit 2
 fi
 if ! command -v slurmctld >/dev/null || ! command -v munged >/dev/null; then
+  apt-get update -qq
   DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends slurm-wlm munge
 fi
 if [ -z "${LUCENT:-}" ]; then
