@@ -4,13 +4,10 @@
 #   [ARGS="render options"] deploy/memory.sh SCENE PARTS [tiles|samples]
 #   -> "PART_MB MERGE_MB"
 #
-# From the figures in docs/farm.md ("Memory"): per pixel of a part, the
-# render keeps two sets of sums and, while a checkpoint is written, a copy
-# of one: 3 x 48 B for the beauty alone, 3 x ~900 B with every pass
-# (measured: 832 MB peak for 640x480 with --aov all, 2.7 kB a pixel). A
-# merge holds the frame's sums and one part's: 2.7 GB measured at 1920x1080
-# with every pass (1300 B a pixel), 200 B a pixel for the beauty. Plus 256
-# MB for the scene, its BVH and the process, and a quarter for headroom.
+# The per-pixel figures and where they come from: docs/farm.md, "Memory on
+# a scheduler". A part: 144 B a pixel of its region for the beauty alone,
+# 2700 B with passes; a merge: 200 B and 1300 B a pixel of the frame. Plus
+# 256 MB for the scene, its BVH and the process, and a quarter more.
 # Passes count as on when ARGS has --aov (but not --aov none) or the scene
 # has a non-empty `aovs` list; a band (tiles) holds ceil(H / PARTS) rows.
 set -euo pipefail
