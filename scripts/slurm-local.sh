@@ -5,7 +5,7 @@
 #
 #   sudo [LUCENT=path/to/lucent] bash scripts/slurm-local.sh [TEST...]
 #
-# TEST (default: all three):
+# TEST (default: all four):
 #   frame     one frame, 4 bands, array indices from 1 (not 0), ARGS that
 #             replace the scripts' --threads and --checkpoint; then a
 #             finished task requeued: skipped, its log appended
@@ -13,6 +13,8 @@
 #             per frame
 #   timeout   one part under a 1-minute time limit that needs longer: the
 #             task is warned, requeues itself, resumes and completes
+#   cancel    scancel of a running part: its samples kept, the merge
+#             cancelled; the same submission again resumes and completes
 # Each submits through deploy/slurm/submit.sh, waits for the queue to empty,
 # renders the same frames in one process and compares pixels bit for bit
 # (idiff, zero thresholds) and PNGs byte for byte. Prints each test's wall
@@ -29,7 +31,7 @@ cd "$(dirname "$0")/.."
 ROOT=$PWD
 WORK=${WORK:-/tmp/lucent-slurm}
 tests=("$@")
-[ ${#tests[@]} -gt 0 ] || tests=(frame sequence timeout)
+[ ${#tests[@]} -gt 0 ] || tests=(frame sequence timeout cancel)
 if [ "$(id -u)" != 0 ]; then
   echo "slurm-local.sh: needs root (starts munged, slurmctld, slurmd)" >&2
   exit 2
@@ -198,22 +200,29 @@ test_sequence() {
   for f in 1 2 3; do check "$d/out/shot.000$f.exr" "$d/shot.000$f.toml"; done
 }
 
+# The spp at which a 256x256 cornell.toml needs about $2 s of one core on
+# this machine, measured in directory $1 (at least 64).
+spp_for() {
+  local t0 t1 spp
+  shot "$1/probe.toml" 256 8
+  t0=$(date +%s%N)
+  "$LUCENT" render "$1/probe.toml" --threads 1 --quiet -o "$1/probe.exr"
+  t1=$(date +%s%N)
+  spp=$(($2 * 8 * 1000000000 / (t1 - t0 + 1)))
+  [ "$spp" -ge 64 ] && echo "$spp" || echo 64
+}
+
 # Slurm checks time limits every 30 s or so: with --time=1 and a lead of
 # 40 s the warning comes 20 to 50 s after the start. The render is sized to
-# need about 75 s of one core on this machine (measured first), so it is
-# warned at least once and done in a few runs; the single-process render
-# runs on the other core meanwhile.
+# need about 75 s of one core on this machine, so it is warned at least
+# once and done in a few runs; the single-process render runs on the other
+# core meanwhile.
 test_timeout() {
-  local d=$WORK/timeout t0 t1 spp ref
+  local d=$WORK/timeout spp ref
   mkdir -p "$d/out"
-  shot "$d/probe.toml" 256 8
-  t0=$(date +%s%N)
-  "$LUCENT" render "$d/probe.toml" --threads 1 --quiet -o "$d/probe.exr"
-  t1=$(date +%s%N)
-  spp=$((75 * 8 * 1000000000 / (t1 - t0 + 1)))
-  [ "$spp" -ge 64 ] || spp=64
+  spp=$(spp_for "$d" 75)
   shot "$d/cornell.toml" 256 "$spp"
-  echo "  256x256 at $spp spp (8 spp took $(((t1 - t0) / 1000000)) ms)"
+  echo "  256x256 at $spp spp"
   (cd "$d" && SCENE=$d/cornell.toml OUT=$d/out PARTS=1 \
     "$ROOT/deploy/slurm/submit.sh" --time=1 --signal=B:USR1@40)
   "$LUCENT" render "$d/cornell.toml" --threads 1 --quiet -o "$d/out/frame.single.exr" &
@@ -225,6 +234,35 @@ test_timeout() {
     exit 1
   }
   echo "  runs: $(grep -c ' task ' "$d"/lucent-part-*.log) ($(grep -c requeueing "$d"/lucent-part-*.log) requeue(s))"
+  check "$d/out/frame.exr" "$d/out/frame.single.exr"
+}
+
+# scancel of a running part (about 20 s of work) once it has run 3 s: lucent
+# keeps its samples, the frame's merge is cancelled rather than left
+# pending, and the same submission again resumes and completes the frame.
+test_cancel() {
+  local d=$WORK/cancel spp ref task
+  mkdir -p "$d/out"
+  spp=$(spp_for "$d" 20)
+  shot "$d/cornell.toml" 256 "$spp"
+  "$LUCENT" render "$d/cornell.toml" --threads 1 --quiet -o "$d/out/frame.single.exr" &
+  ref=$!
+  (cd "$d" && SCENE=$d/cornell.toml OUT=$d/out PARTS=1 "$ROOT/deploy/slurm/submit.sh")
+  for _ in $(seq 60); do grep -qs '^/' "$d"/lucent-part-*.log && break; sleep 1; done
+  sleep 3
+  task=$(squeue -h -t R -n lucent-part -o %A)
+  [ -n "$task" ] || { echo "slurm: the part was not running to be cancelled" >&2; exit 1; }
+  scancel "$task"
+  drain 120
+  if [ -f "$d/out/frame.exr" ] || [ ! -f "$d/out/part-0.partial.exr" ]; then
+    echo "slurm: after scancel: a frame, or no kept samples (log: $d/lucent-part-*.log)" >&2
+    exit 1
+  fi
+  echo "  cancelled: $(grep -o 'samples 0\.\.[0-9]* of 0\.\.[0-9]* kept' "$d"/lucent-part-*.log), merge cancelled"
+  (cd "$d" && SCENE=$d/cornell.toml OUT=$d/out PARTS=1 "$ROOT/deploy/slurm/submit.sh")
+  drain 300
+  grep -q -- '--resume' "$d"/lucent-part-*.log || { echo "slurm: the resubmitted part did not resume" >&2; exit 1; }
+  wait "$ref"
   check "$d/out/frame.exr" "$d/out/frame.single.exr"
 }
 
