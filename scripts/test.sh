@@ -34,8 +34,8 @@ LUCENT=$PWD/target/debug/lucent scripts/check-deploy.sh
 # A real Slurm cluster of one node (this machine): one frame, a 3-frame
 # sequence and a task past its time limit that requeues itself, each frame
 # checked bitwise against one process. Needs root and starts daemons, so
-# only when asked; .ci/run asks when it runs as root (about 2.5 min with
-# the test binary; docs/farm.md). tests/cli/farm.rs runs a multi-process
+# only when asked; .ci/run asks when it runs as root (about 2 min with
+# the test binary, plus installing slurm-wlm; docs/farm.md). tests/cli/farm.rs runs a multi-process
 # split + merge always.
 if [ "${LUCENT_SLURM_TEST:-}" = 1 ]; then
   echo "--- Slurm, one node (LUCENT_SLURM_TEST=1) ---"
