@@ -21,6 +21,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
 LUCENT=${LUCENT:-$ROOT/target/debug/lucent}
+[ -x "$LUCENT" ] || { echo "${0##*/}: no lucent binary at $LUCENT (build it, or set LUCENT)" >&2; exit 2; }
 LUCENT=$(realpath "$LUCENT")
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

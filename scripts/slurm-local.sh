@@ -44,6 +44,7 @@ if [ -z "${LUCENT:-}" ]; then
   cargo build --profile quick --quiet
   LUCENT=$ROOT/target/quick/lucent
 fi
+[ -x "$LUCENT" ] || { echo "${0##*/}: no lucent binary at $LUCENT (build it, or set LUCENT)" >&2; exit 2; }
 LUCENT=$(realpath "$LUCENT")
 export LUCENT
 
