@@ -4,10 +4,11 @@
 # pkg-config (to find it), a C compiler (for the FFI layout test), the
 # DejaVu Sans font (text in `lucent study` plots, read by path),
 # OpenImageIO's tools (`oiiotool`, `iinfo`: tests/cli/exr_oiio.rs reads the EXR
-# files back with them), and an Embree 4 for the tests of the `embree4`
-# backend (Debian 12 has none: the 4.4.0 library and the TBB it needs, from
-# the `embreex` wheel on PyPI, unpacked into .cache/embree4/, which
-# scripts/test.sh points LUCENT_EMBREE4 at). Safe to run any number of times.
+# files back with them), shellcheck and PyYAML (scripts/check-deploy.sh),
+# and an Embree 4 for the tests of the `embree4` backend (Debian 12 has
+# none: the 4.4.0 library and the TBB it needs, from the `embreex` wheel on
+# PyPI, unpacked into .cache/embree4/, which scripts/test.sh points
+# LUCENT_EMBREE4 at). Safe to run any number of times.
 set -euo pipefail
 
 need=()
@@ -16,6 +17,8 @@ command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
 command -v cc >/dev/null 2>&1 || need+=(gcc libc6-dev)
 [ -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || need+=(fonts-dejavu-core)
 command -v oiiotool >/dev/null 2>&1 || need+=(openimageio-tools)
+command -v shellcheck >/dev/null 2>&1 || need+=(shellcheck)
+python3 -c 'import yaml' >/dev/null 2>&1 || need+=(python3-yaml)
 
 if ((${#need[@]})); then
   sudo=""

@@ -26,13 +26,20 @@ cargo clippy --workspace --no-default-features --all-targets -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps
 cargo test --workspace --all-targets
 
-# A real Slurm cluster of one node (this machine): a job array of parts and
-# a dependent merge, checked bitwise against one process. Needs root and
-# starts daemons, so only when asked (about 45 s after the build;
-# docs/farm.md). tests/cli/farm.rs runs a multi-process split + merge always.
+# deploy/ without a cluster: shellcheck, the Kubernetes manifests parsed and
+# checked against themselves, their pods' scripts run with the binary just
+# built (a 3-part frame, bitwise), hadolint when installed (a few seconds).
+LUCENT=$PWD/target/debug/lucent scripts/check-deploy.sh
+
+# A real Slurm cluster of one node (this machine): one frame, a 3-frame
+# sequence and a task past its time limit that requeues itself, each frame
+# checked bitwise against one process. Needs root and starts daemons, so
+# only when asked; .ci/run asks when it runs as root (about 2 min with
+# the test binary, plus installing slurm-wlm; docs/farm.md). tests/cli/farm.rs runs a multi-process
+# split + merge always.
 if [ "${LUCENT_SLURM_TEST:-}" = 1 ]; then
   echo "--- Slurm, one node (LUCENT_SLURM_TEST=1) ---"
-  scripts/slurm-local.sh
+  LUCENT=$PWD/target/debug/lucent scripts/slurm-local.sh
 fi
 
 # The BVH's portable box and triangle tests, which other architectures
