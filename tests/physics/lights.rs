@@ -111,8 +111,8 @@ fn a_sphere_lights_power_is_its_radiance_and_its_irradiance() {
     let Light::Sphere(l) = s.lights[0] else {
         panic!("not a sphere light")
     };
-    for c in 0..3 {
-        let want = p[c] / (4.0 * PI * PI * r * r);
+    for (c, p) in p.iter().enumerate() {
+        let want = p / (4.0 * PI * PI * r * r);
         let rel = (l.radiance[c] as f64 / want - 1.0).abs();
         assert!(
             rel < 1e-6,
