@@ -183,6 +183,50 @@ fn light_paths_and_light_groups_sum_to_the_beauty_with_both_integrators() {
     }
 }
 
+/// [`MIXED`] with a sun (group `sun`), a sphere light (group `key`) and a
+/// spot light (no group: `default`) besides its emitters.
+fn mixed_with_lights() -> String {
+    format!(
+        "{MIXED}
+[[lights]]
+type = \"distant\"
+direction = [-1, -2, -0.5]
+angle = 5
+irradiance = [2, 1.8, 1.5]
+light_group = \"sun\"
+[[lights]]
+type = \"sphere\"
+position = [-1, 3, 1]
+radius = 0.2
+radiance = [20, 20, 20]
+light_group = \"key\"
+[[lights]]
+type = \"sphere\"
+position = [2, 3, 1]
+radius = 0.05
+power = [1, 1, 1]
+spot_direction = [0, -1, -0.3]
+spot_angle = 30
+spot_falloff = 10
+"
+    )
+}
+
+#[test]
+fn light_paths_and_light_groups_sum_to_the_beauty_with_sphere_spot_and_distant_lights() {
+    let s = scene(&mixed_with_lights());
+    let groups = ["RGBA_default", "RGBA_key", "RGBA_sky", "RGBA_sun"];
+    for integrator in [IntegratorKind::Path, IntegratorKind::RandomWalk] {
+        let out = render_with(&s, PassSet::all(), integrator, 2, None);
+        let what = format!("{integrator:?}");
+        assert_sum_is_beauty(&out, &light_path_names(), &format!("{what} light paths"));
+        assert_sum_is_beauty(&out, &groups, &format!("{what} light groups"));
+        for name in light_path_names().into_iter().chain(groups) {
+            assert!(max(layer(&out, name)) > 0.0, "{what}: {name} is black");
+        }
+    }
+}
+
 #[test]
 fn each_light_group_holds_the_light_of_its_own_lights() {
     // One colour per group: key red, the ungrouped bulb green, the sky

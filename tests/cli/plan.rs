@@ -155,6 +155,28 @@ fn lights_and_glass_without_subsurface() {
     );
 }
 
+#[test]
+fn sphere_spot_and_distant_lights_are_light_sampled() {
+    let lights = "[[lights]]\ntype = \"distant\"\ndirection = [0, -1, 0]\nirradiance = [1, 1, 1]\n\
+                  [[lights]]\ntype = \"sphere\"\nposition = [0, 2, 0]\nradius = 0.1\n\
+                  power = [5, 5, 5]\nspot_direction = [0, -1, 0]\nspot_angle = 30\n";
+    // Without an emitting shape, the [[lights]] alone are sampled.
+    let s = load(&format!("{SPHERE_ENV}{lights}"));
+    let p = plan_of(&s, IntegratorKind::Path, PassSet::EMPTY);
+    assert_eq!(p.direct_lighting.method, "next-event estimation");
+    let r = &p.direct_lighting.reason;
+    assert!(r.contains("lights[0] distant, lights[1] spot"), "{r}");
+    // With one, both are said.
+    let s = load(&format!("{LAMP}{SPHERE_ENV}{lights}"));
+    let r = plan_of(&s, IntegratorKind::Path, PassSet::EMPTY)
+        .direct_lighting
+        .reason;
+    assert!(
+        r.contains("1 emitting object(s) (light)") && r.contains("2 light(s)"),
+        "{r}"
+    );
+}
+
 const KETCHUP: &str = "[materials.sauce]\ntype = \"subsurface\"\npreset = \"ketchup\"\n";
 const BALL_SAUCE: &str = "[[shapes]]\nname = \"ball\"\ntype = \"sphere\"\nmaterial = \"sauce\"\n";
 

@@ -38,6 +38,7 @@ impl TestScene {
             environment: self
                 .environment
                 .map(lucent::environment::Environment::Constant),
+            lights: Vec::new(),
             units_per_mm: 1.0,
             source: None,
             output: Default::default(),

@@ -22,6 +22,7 @@ mod glossy;
 mod hard_cases;
 #[cfg(feature = "subsurface")]
 mod heavy_tails;
+mod lights;
 #[cfg(feature = "subsurface")]
 mod lod;
 #[cfg(feature = "subsurface")]

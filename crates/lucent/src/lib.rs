@@ -9,6 +9,7 @@
 //! reports its progress through [`progress::Progress`].
 
 pub mod accel;
+pub mod analytic_lights;
 #[cfg(feature = "subsurface")]
 pub mod bssrdf;
 pub mod environment;

@@ -14,6 +14,7 @@
 //! `control_variate`, `randomwalk` and `diffuse_boundary` exist only with
 //! the `subsurface` feature (the default).
 
+mod analytic_nee;
 pub mod aov;
 mod branch;
 #[cfg(feature = "subsurface")]

@@ -10,6 +10,7 @@
 //! antithetic probe pair and level of detail: `docs/bssrdf.md` §5, §6
 //! "The coat", §11.
 
+use super::analytic_nee::{self, record_analytic};
 use super::aov::{self, Event, Recorder, Source};
 use super::branch::{roulette, At, Branch, Branches, Next};
 use super::env_nee::{escaped, record_environment};
@@ -103,7 +104,11 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
     let mut path = start;
     let max_depth = ctx.scene.settings.max_depth;
     for depth in start.depth..=max_depth {
-        let Some(hit) = nearest::<R, T>(ctx, &path, depth, st) else {
+        let nearest_hit = nearest::<R, T>(ctx, &path, depth, st);
+        if ctx.plan.analytic_lights {
+            l += analytic_nee::found(ctx, &path, nearest_hit.map(|h| h.t), depth, st.rec);
+        }
+        let Some(hit) = nearest_hit else {
             if ctx.plan.environment {
                 l += environment(ctx, &path, depth, st.rec);
             }
@@ -145,6 +150,10 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
         if ctx.plan.environment_map {
             let beta = nee.scale * path.beta;
             l += record_environment::<R, T>(ctx, vertex, st, beta, path.event, depth);
+        }
+        if ctx.plan.analytic_lights {
+            let beta = nee.scale * path.beta;
+            l += record_analytic::<R, T>(ctx, vertex, st, beta, path.event, depth);
         }
         let Some(b) = vertex.bounce(ctx.ray_epsilon, path.beta, st.rng.uniform2_packed()) else {
             break;

@@ -76,6 +76,9 @@ pub struct SceneFile {
     #[serde(default)]
     pub shapes: Vec<Spanned<ShapeDef>>,
     pub environment: Option<Spanned<EnvironmentDef>>,
+    /// `[[lights]]`: sphere, spot and distant lights.
+    #[serde(default)]
+    pub lights: Vec<Spanned<LightDef>>,
     #[serde(default)]
     pub output: OutputDef,
 }
@@ -148,6 +151,71 @@ pub struct EnvironmentDef {
     pub intensity: Option<Spanned<f64>>,
     /// Stops: a further factor 2^exposure.
     pub exposure: Option<Spanned<f64>>,
+}
+
+/// The `type` of a `[[lights]]` entry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightKind {
+    Sphere,
+    Distant,
+}
+
+/// One `[[lights]]` entry: the keys of both types (which a `type`
+/// accepts is checked by the loader).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightDef {
+    /// Required.
+    #[serde(rename = "type")]
+    pub kind: Option<Spanned<LightKind>>,
+    /// Radiance L (sphere; distant with an `angle` > 0).
+    pub radiance: Option<Spanned<Triple3>>,
+    /// The light group (`RGBA_<group>` pass).
+    pub light_group: Option<Spanned<String>>,
+    // sphere
+    pub position: Option<Spanned<Triple3>>,
+    pub radius: Option<Spanned<f64>>,
+    /// Emitted power in W per channel.
+    pub power: Option<Spanned<Triple3>>,
+    /// The spot cone's axis (the direction its light travels).
+    pub spot_direction: Option<Spanned<Triple3>>,
+    /// The spot cone's half-angle, degrees.
+    pub spot_angle: Option<Spanned<f64>>,
+    /// The width of the spot's soft edge inside the cone, degrees.
+    pub spot_falloff: Option<Spanned<f64>>,
+    // distant
+    /// The direction the light travels (from the light into the scene).
+    pub direction: Option<Spanned<Triple3>>,
+    /// Angular diameter, degrees.
+    pub angle: Option<Spanned<f64>>,
+    /// W/m² on a surface facing the light, per channel.
+    pub irradiance: Option<Spanned<Triple3>>,
+}
+
+impl LightDef {
+    /// The type-specific keys that are present, with their spans.
+    pub(crate) fn present_type_keys(&self) -> Vec<(&'static str, Range<usize>)> {
+        let mut v = Vec::new();
+        let mut key = |name, span: Option<Range<usize>>| {
+            if let Some(s) = span {
+                v.push((name, s));
+            }
+        };
+        key("position", self.position.as_ref().map(|x| x.span()));
+        key("radius", self.radius.as_ref().map(|x| x.span()));
+        key("power", self.power.as_ref().map(|x| x.span()));
+        key(
+            "spot_direction",
+            self.spot_direction.as_ref().map(|x| x.span()),
+        );
+        key("spot_angle", self.spot_angle.as_ref().map(|x| x.span()));
+        key("spot_falloff", self.spot_falloff.as_ref().map(|x| x.span()));
+        key("direction", self.direction.as_ref().map(|x| x.span()));
+        key("angle", self.angle.as_ref().map(|x| x.span()));
+        key("irradiance", self.irradiance.as_ref().map(|x| x.span()));
+        v
+    }
 }
 
 /// The `type` of a `[materials.NAME]` table.
@@ -315,6 +383,8 @@ pub struct ShapeDef {
     /// The material's name. Required.
     pub material: Option<Spanned<String>>,
     pub emission: Option<Spanned<Triple3>>,
+    /// Emitted power in W per channel: the other form of `emission`.
+    pub power: Option<Spanned<Triple3>>,
     /// The light group of an emitter (`RGBA_<group>` pass).
     pub light_group: Option<Spanned<String>>,
     pub scale: Option<Spanned<Scale>>,

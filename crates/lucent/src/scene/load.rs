@@ -17,6 +17,7 @@ use super::checked::{Cx, Res};
 use super::environment::environment;
 use super::format::{CameraDef, RenderDef, SceneFile, Spanned};
 use super::lens::lens;
+use super::lights::light;
 use super::material::material;
 use super::objects::{generated_triangles, object};
 use super::output::output;
@@ -131,7 +132,7 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
     let mut objects = Vec::with_capacity(def.shapes.len());
     let mut total = planned;
     for (i, s) in def.shapes.iter().enumerate() {
-        let (mesh, obj) = object(cx, scene_dir, i, s, &material_index)?;
+        let (mesh, obj) = object(cx, scene_dir, i, s, &material_index, units_per_mm)?;
         if let Some(f) = &s.get_ref().file {
             total += mesh.triangle_count() as u64;
             if total > MAX_TRIANGLES {
@@ -152,6 +153,9 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         None => None,
     };
 
+    let lights = (def.lights.iter().enumerate())
+        .map(|(i, l)| light(cx, i, l, units_per_mm))
+        .collect::<Res<Vec<_>>>()?;
     let output = output(cx, &def, &objects)?;
 
     Ok(Scene {
@@ -161,6 +165,7 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         objects,
         materials,
         environment,
+        lights,
         units_per_mm,
         source: Some(cx.file.to_path_buf()),
         output,

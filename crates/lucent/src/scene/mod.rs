@@ -10,6 +10,7 @@ pub mod format;
 mod glossy_material;
 pub mod key_path;
 mod lens;
+mod lights;
 pub mod load;
 mod material;
 pub mod obj;
@@ -24,6 +25,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 pub use camera::Camera;
+pub use lights::SUN_ANGLE;
 pub use load::{load, load_str};
 pub use output::{Output, DEFAULT_GROUP};
 pub use output_file::OutputSettings;
@@ -100,6 +102,8 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// What rays that escape see; None: black.
     pub environment: Option<crate::environment::Environment>,
+    /// The sphere, spot and distant lights (`[[lights]]`).
+    pub lights: Vec<crate::analytic_lights::Light>,
     /// Scene units per millimetre (subsurface parameters are in mm).
     pub units_per_mm: f32,
     /// Where the scene came from, for messages and caches.

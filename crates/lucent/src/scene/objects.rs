@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use super::checked::{Cx, Res};
 use super::format::{Numbers, ShapeDef, ShapeKind, Spanned};
 use super::key_path::{key_segment, quoted};
+use super::lights::shape_emission;
 use super::obj::{first_vertex_where, load_obj};
 use super::regular_file::read_regular_file;
 use super::transform::Transform;
@@ -48,6 +49,7 @@ pub(super) fn object(
     i: usize,
     s: &Spanned<ShapeDef>,
     materials: &HashMap<&str, usize>,
+    units_per_mm: f32,
 ) -> Res<(Mesh, Object)> {
     let field = format!("shapes[{i}]");
     let sd = s.get_ref();
@@ -66,16 +68,11 @@ pub(super) fn object(
             format!("unknown material {} ({known})", quoted(m.get_ref())),
         ));
     };
-    let emission = match &sd.emission {
-        Some(e) => {
-            Some(cx.rgb(e, &format!("{field}.emission"), false)?).filter(|e| *e != Vec3::ZERO)
-        }
-        None => None,
-    };
     let (mut mesh, source) = shape_mesh(cx, dir, &field, s)?;
     let tf = transform(cx, &field, sd)?;
     tf.apply(&mut mesh);
     check_range(cx, &field, s, &mesh, &tf, source.as_ref())?;
+    let emission = shape_emission(cx, &field, &sd.emission, &sd.power, &mesh, units_per_mm)?;
     let object = Object {
         name: sd.name.clone().unwrap_or(field),
         material: mat,

@@ -33,6 +33,9 @@ pub struct Output {
     pub object_group: Vec<u32>,
     /// The environment's group.
     pub environment_group: u32,
+    /// Per light of `[[lights]]` (by index), its group's index in
+    /// `light_groups` (missing entries are group 0).
+    pub analytic_group: Vec<u32>,
     /// Material names by material index, as the scene file gives them.
     pub material_names: Vec<String>,
     /// How the frame is stored (`[output]`'s storage keys; the CLI's
@@ -134,7 +137,18 @@ pub(super) fn output(cx: &Cx, def: &SceneFile, objects: &[Object]) -> Res<Output
         },
         None => None,
     };
-    let names: BTreeSet<&String> = shape_groups.iter().chain([&env_group]).flatten().collect();
+    let mut light_def_groups = Vec::with_capacity(def.lights.len());
+    for (i, l) in def.lights.iter().enumerate() {
+        let g = match &l.get_ref().light_group {
+            Some(g) => group_name(cx, g, &format!("lights[{i}].light_group"))?,
+            None => DEFAULT_GROUP.to_string(),
+        };
+        light_def_groups.push(Some(g));
+    }
+    let names: BTreeSet<&String> = (shape_groups.iter().chain([&env_group]))
+        .chain(&light_def_groups)
+        .flatten()
+        .collect();
     let light_groups: Vec<String> = names.into_iter().cloned().collect();
     let index = |g: &Option<String>| {
         g.as_ref()
@@ -145,6 +159,7 @@ pub(super) fn output(cx: &Cx, def: &SceneFile, objects: &[Object]) -> Res<Output
         aovs,
         object_group: shape_groups.iter().map(index).collect(),
         environment_group: index(&env_group),
+        analytic_group: light_def_groups.iter().map(index).collect(),
         light_groups: light_groups.clone(),
         material_names: def.materials.keys().cloned().collect(),
         file: output_file(cx, &def.output)?,

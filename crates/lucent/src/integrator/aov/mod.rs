@@ -34,8 +34,8 @@
 //! a sum of non-negative terms: within a few ulps per term).
 //!
 //! **Light groups.** Each contribution also goes to the group of its light
-//! (`crate::scene::Output`): the emitter hit, the emitter sampled, or the
-//! environment; these sum to the beauty the same way.
+//! (`crate::scene::Output`): the emitter hit, the emitter sampled, the
+//! environment, or a light of `[[lights]]`; these sum to the beauty the same way.
 //!
 //! **Cost.** The bounce loop is generic over a [`Recorder`]; [`NoAov`],
 //! used when no pass is asked for, does nothing and its `ON` is false, so
@@ -76,6 +76,9 @@ pub enum Source {
     Light(u32),
     /// The environment, reached by an escaping ray.
     Environment,
+    /// A light of `[[lights]]` (its index in the scene's `lights`), hit,
+    /// reached by an escaping ray or sampled.
+    Analytic(u32),
 }
 
 /// The light index of a light sample that found no light.
@@ -164,6 +167,8 @@ pub struct Setup {
     /// Per emissive triangle of the light set, its light group.
     pub light_group: Vec<u32>,
     pub environment_group: u32,
+    /// Per light of `[[lights]]`, its light group.
+    pub analytic_group: Vec<u32>,
     /// The camera's position and unit view direction: depth Z is
     /// (p − origin) · forward.
     pub origin: Vec3,
@@ -229,6 +234,9 @@ impl Setup {
             object_group,
             light_group,
             environment_group: group(out.environment_group),
+            analytic_group: (0..scene.lights.len())
+                .map(|i| group(out.analytic_group.get(i).copied().unwrap_or(0)))
+                .collect(),
             origin: c.look_from,
             forward: (c.look_at - c.look_from).normalize(),
             object_material: scene.objects.iter().map(|o| o.material as u32).collect(),

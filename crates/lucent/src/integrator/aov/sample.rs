@@ -52,6 +52,7 @@ impl Recorder for SampleAovs<'_> {
                 None => return, // NO_LIGHT
             },
             Source::Environment => s.environment_group,
+            Source::Analytic(i) => s.analytic_group[i as usize],
         };
         debug_assert!(LIGHT_PATHS.contains(&path), "{path:?} is not a light path");
         self.paths[path as usize] += l;

@@ -136,7 +136,7 @@ fn direct_lighting(scene: &Scene, flags: &Plan) -> Choice {
         .filter(|o| emits(o.emission))
         .map(|o| o.name.as_str())
         .collect();
-    if flags.area_lights {
+    let mut c = if flags.area_lights {
         choice(
             "next-event estimation",
             format!(
@@ -148,7 +148,35 @@ fn direct_lighting(scene: &Scene, flags: &Plan) -> Choice {
         )
     } else {
         choice("none", "no object emits: no light samples, no shadow rays")
+    };
+    if flags.analytic_lights {
+        let reason = analytic_lights(scene);
+        c = if flags.area_lights {
+            choice(&c.method, format!("{}; {reason}", c.reason))
+        } else {
+            choice("next-event estimation", reason)
+        };
     }
+    c
+}
+
+/// What is done for the `[[lights]]`.
+fn analytic_lights(scene: &Scene) -> String {
+    let kinds: Vec<String> = scene
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| format!("lights[{i}] {}", l.kind()))
+        .collect();
+    format!(
+        "{} light(s) of [[lights]] ({}): one picked uniformly, a direction sampled in the \
+         cone it subtends and a shadow ray per non-specular vertex (subsurface entry points \
+         and coats included), MIS with lobe sampling; rays crossing a sphere or spot light \
+         and rays escaping inside a distant light's cone find its light (a distant light of \
+         angle 0 is a delta, only sampled)",
+        kinds.len(),
+        kinds.join(", ")
+    )
 }
 
 /// The environment: escaping rays where it is not black.

@@ -36,6 +36,9 @@ pub struct Plan {
     pub environment_map: bool,
     /// Some object has a subsurface material: probe rays will be cast.
     pub subsurface: bool,
+    /// The scene has `[[lights]]`: light-sample them where lights are
+    /// sampled, and weigh what rays find of them by MIS.
+    pub analytic_lights: bool,
 }
 
 impl Plan {
@@ -51,6 +54,7 @@ impl Plan {
                 .objects
                 .iter()
                 .any(|o| scene.materials[o.material].is_subsurface()),
+            analytic_lights: !scene.lights.is_empty(),
         }
     }
 }

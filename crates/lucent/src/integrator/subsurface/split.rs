@@ -4,6 +4,7 @@
 //! (`docs/bssrdf.md` §5, §6 "The coat").
 
 use crate::geometry::Vec3;
+use crate::integrator::analytic_nee::record_analytic;
 use crate::integrator::aov::{Event, Recorder};
 use crate::integrator::branch::{roulette, At, Branch, Branches, Next};
 use crate::integrator::coated::Coated;
@@ -38,6 +39,9 @@ pub(crate) fn resolve<'v, 's, R: Recorder, T: Clock>(
     }
     if let (Some(w), true) = (&c.coat, ctx.plan.environment_map) {
         *l += record_environment::<R, T>(ctx, &w.vertex, st, w.beta, coat_event, at.depth);
+    }
+    if let (Some(w), true) = (&c.coat, ctx.plan.analytic_lights) {
+        *l += record_analytic::<R, T>(ctx, &w.vertex, st, w.beta, coat_event, at.depth);
     }
     let (next, follow_reflected) = match (&c.entry, c.reflected) {
         // Both: this path enters the medium, the reflection waits on the
@@ -115,6 +119,9 @@ fn entry<R: Recorder, T: Clock>(
         if ctx.plan.environment_map {
             *l +=
                 record_environment::<R, T>(ctx, &twin.vertex, st, twin.beta, path.event, at.depth);
+        }
+        if ctx.plan.analytic_lights {
+            *l += record_analytic::<R, T>(ctx, &twin.vertex, st, twin.beta, path.event, at.depth);
         }
         nee.scale = 0.5;
     }
