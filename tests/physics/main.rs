@@ -36,3 +36,4 @@ mod randomwalk;
 mod slab;
 #[cfg(feature = "subsurface")]
 mod specular_coat;
+mod textures;

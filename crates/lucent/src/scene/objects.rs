@@ -12,7 +12,7 @@ use super::key_path::{key_segment, quoted};
 use super::obj::{first_vertex_where, load_obj};
 use super::regular_file::read_regular_file;
 use super::transform::Transform;
-use super::{shapes, show_point, Object, MAX_COORDINATE};
+use super::{shape_uvs, shapes, show_point, Object, MAX_COORDINATE};
 use crate::error::InputError;
 use crate::geometry::{Mesh, Vec3};
 
@@ -41,13 +41,16 @@ pub(super) fn generated_triangles(d: &ShapeDef) -> u64 {
 }
 
 /// Shape `i` (entry `s`): its transformed mesh and its object. `materials`
-/// maps material names to indices; OBJ paths are relative to `dir`.
+/// maps material names to indices, `reads_textures` says per material
+/// whether its meshes need texture coordinates (kept or generated there,
+/// dropped elsewhere); OBJ paths are relative to `dir`.
 pub(super) fn object(
     cx: &Cx,
     dir: &Path,
     i: usize,
     s: &Spanned<ShapeDef>,
     materials: &HashMap<&str, usize>,
+    reads_textures: &[bool],
 ) -> Res<(Mesh, Object)> {
     let field = format!("shapes[{i}]");
     let sd = s.get_ref();
@@ -73,6 +76,11 @@ pub(super) fn object(
         None => None,
     };
     let (mut mesh, source) = shape_mesh(cx, dir, &field, s)?;
+    if reads_textures[mat] {
+        texture_coordinates(cx, &field, s, &mut mesh, source.as_ref())?;
+    } else {
+        mesh.uvs = None;
+    }
     let tf = transform(cx, &field, sd)?;
     tf.apply(&mut mesh);
     check_range(cx, &field, s, &mesh, &tf, source.as_ref())?;
@@ -84,10 +92,44 @@ pub(super) fn object(
     Ok((mesh, object))
 }
 
+/// Gives the untransformed `mesh` of shape `field` texture coordinates for
+/// a material that reads a texture: generated for a built-in shape; an OBJ
+/// file without them is refused.
+fn texture_coordinates(
+    cx: &Cx,
+    field: &str,
+    s: &Spanned<ShapeDef>,
+    mesh: &mut Mesh,
+    source: Option<&ObjSource>,
+) -> Res<()> {
+    if mesh.uvs.is_some() {
+        return Ok(());
+    }
+    let d = s.get_ref();
+    let material = d.material.as_ref().map_or("", |m| m.get_ref().as_str());
+    match (source, d.kind.as_ref()) {
+        (Some(src), _) => Err(InputError::new(
+            &src.path,
+            format!(
+                "material {} of `{field}` in {} reads a texture, but this OBJ file has no \
+                 texture coordinates on every face vertex (`vt`, faces `f v/vt ...`)",
+                quoted(material),
+                cx.file.display()
+            ),
+        )
+        .in_field(format!("{field}.file"))),
+        (None, Some(kind)) => {
+            mesh.uvs = shape_uvs::generated_uvs(*kind.get_ref(), mesh);
+            Ok(())
+        }
+        (None, None) => Ok(()),
+    }
+}
+
 /// An OBJ file's path and text, kept to locate an out-of-range vertex.
-struct ObjSource {
-    path: PathBuf,
-    text: String,
+pub(super) struct ObjSource {
+    pub path: PathBuf,
+    pub text: String,
 }
 
 /// Rejects a shape with a vertex beyond ±[`MAX_COORDINATE`] after its
@@ -95,7 +137,7 @@ struct ObjSource {
 /// range by itself, else the OBJ file's first `v` line that lands out of
 /// range if it is out of range as written, else the `scale` (or the
 /// `rotate`, with no scale).
-fn check_range(
+pub(super) fn check_range(
     cx: &Cx,
     field: &str,
     s: &Spanned<ShapeDef>,
@@ -224,7 +266,7 @@ fn shape_mesh(
 }
 
 /// The shape's scale, rotations and translation.
-fn transform(cx: &Cx, field: &str, d: &ShapeDef) -> Res<Transform> {
+pub(super) fn transform(cx: &Cx, field: &str, d: &ShapeDef) -> Res<Transform> {
     let scale = match &d.scale {
         Some(s) => {
             let f = format!("{field}.scale");
