@@ -3,7 +3,6 @@
 //! material of the same name overrides, ignored keys are listed on
 //! stderr, and a key lucent does not know is an error at its line.
 
-use std::path::Path;
 use std::process::Command;
 
 use lucent::film::Film;

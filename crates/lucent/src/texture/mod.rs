@@ -1,7 +1,7 @@
 //! Image textures: a MIP pyramid of linear RGB texels ([`mip`]), looked up
 //! with bilinear filtering between the two levels a footprint falls between
 //! (trilinear), read once per file from PNG, OpenEXR or Radiance `.hdr`
-//! ([`file`]) and shared between the materials that name it.
+//! ([`mod@file`]) and shared between the materials that name it.
 //! `docs/scene-format.md`, "Textures".
 
 pub mod file;
