@@ -123,6 +123,13 @@ impl Scene {
     /// The distinct textures its materials read and their bytes (all MIP
     /// levels), each counted once however many materials share it.
     pub fn texture_memory(&self) -> (usize, usize) {
+        let seen = self.textures();
+        let bytes = seen.iter().map(|t| t.bytes()).sum();
+        (seen.len(), bytes)
+    }
+
+    /// The distinct textures its materials read, in material order.
+    pub fn textures(&self) -> Vec<&Arc<crate::texture::Texture>> {
         let mut seen: Vec<&Arc<crate::texture::Texture>> = Vec::new();
         for m in &self.materials {
             if let Material::Textured(t) = m {
@@ -133,8 +140,7 @@ impl Scene {
                 }
             }
         }
-        let bytes = seen.iter().map(|t| t.bytes()).sum();
-        (seen.len(), bytes)
+        seen
     }
 }
 

@@ -77,6 +77,12 @@ impl Texture {
         (self.levels[0].width, self.levels[0].height)
     }
 
+    /// The bits of level 0's texels (R, G, B per texel, row by row).
+    pub fn texel_bits(&self) -> impl ExactSizeIterator<Item = u32> + '_ {
+        let l = &self.levels[0];
+        (0..l.texels.len() * 3).map(|i| l.texels[i / 3][i % 3].to_bits())
+    }
+
     /// Bytes held by all levels.
     pub fn bytes(&self) -> usize {
         self.levels
