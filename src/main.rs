@@ -524,11 +524,22 @@ fn run_render(r: &session::Request, quiet: bool) -> Result<(), Error> {
         eprintln!("{w}");
     }
     let o = session::run(r)?;
+    // said even with --quiet: input the render did not use
+    for note in &o.notes {
+        eprintln!("note: {note}");
+    }
     if !quiet {
         tell!("{}", o.summary(&r.output));
     }
     if r.opts.stats {
         let _ = write!(std::io::stderr(), "{}", effects::summary(&o.stats.counters));
+        let (n, bytes) = o.textures;
+        if n > 0 {
+            eprintln!(
+                "textures: {n}, {bytes} bytes with their MIP levels ({:.1} MiB)",
+                bytes as f64 / (1u64 << 20) as f64
+            );
+        }
     }
     report_rejected_rays(o.rejected_rays);
     Ok(())

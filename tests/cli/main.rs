@@ -13,6 +13,7 @@ mod cli;
 mod environment_image;
 mod exr_oiio;
 mod farm;
+mod obj_mtl;
 #[cfg(feature = "subsurface")]
 mod plan;
 mod scene_errors;
@@ -20,3 +21,4 @@ mod session;
 #[cfg(feature = "subsurface")]
 mod study;
 mod subsurface_feature;
+mod textures;

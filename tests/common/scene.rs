@@ -42,6 +42,7 @@ impl TestScene {
             units_per_mm: 1.0,
             source: None,
             output: Default::default(),
+            notes: Vec::new(),
         }
     }
 }

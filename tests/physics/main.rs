@@ -37,3 +37,4 @@ mod randomwalk;
 mod slab;
 #[cfg(feature = "subsurface")]
 mod specular_coat;
+mod textures;

@@ -30,5 +30,6 @@ pub mod sampling;
 pub mod scene;
 pub mod session;
 pub mod stats;
+pub mod texture;
 
 pub use error::Error;

@@ -1,10 +1,11 @@
 //! The scene's content hash that parts carry: which scene they are of,
 //! whatever its file is called or where it lies.
 //!
-//! It hashes the scene file's bytes and every mesh as loaded (vertex
-//! positions, shading normals and triangles, as the bits of their f32 and
-//! u32 values), so an edited scene file or a changed OBJ gives another
-//! hash, and the same files copied to another machine give the same one.
+//! It hashes the scene file's bytes, every mesh as loaded (vertex
+//! positions, shading normals, triangles and, where a material reads a
+//! texture, texture coordinates, as the bits of their f32 and u32 values)
+//! and the texels of its textures, so an edited scene file, a changed OBJ
+//! or texture gives another hash, and the same files copied to another machine give the same one.
 //! It is 64 bits of a non-cryptographic mix (the SplitMix64 finalizer,
 //! Steele et al. 2014, applied to each 64-bit word of the input): it
 //! catches mistakes — a part of last week's scene — not forgeries. A
@@ -77,6 +78,19 @@ pub fn scene_hash(file_bytes: &[u8], scene: &Scene) -> String {
             ),
             None => h.word(u64::MAX),
         }
+        // texture coordinates and textures only where a material reads
+        // them: other scenes keep their hash
+        if let Some(uv) = &m.uvs {
+            let bits = uv
+                .iter()
+                .flatten()
+                .flat_map(|t| [t.x, t.y])
+                .map(f32::to_bits);
+            h.u32s(bits.collect::<Vec<_>>().into_iter());
+        }
+    }
+    for t in scene.textures() {
+        h.u32s(t.texel_bits());
     }
     format!("{:016x}", h.0)
 }
@@ -114,5 +128,23 @@ mod tests {
             scene_hash(SCENE.as_bytes(), &s),
             scene_hash(SCENE.as_bytes(), &t)
         );
+    }
+
+    #[test]
+    fn a_changed_texture_changes_the_hash() {
+        let dir = tempfile::tempdir().unwrap();
+        let text = SCENE.replace(
+            "albedo = [0.5, 0.5, 0.5]",
+            "albedo_texture = \"t\"\n[textures.t]\nfile = \"t.png\"",
+        );
+        let hash = |v: u8| {
+            image::RgbImage::from_pixel(2, 2, image::Rgb([v, v, v]))
+                .save(dir.path().join("t.png"))
+                .unwrap();
+            let s = crate::scene::load::load_str(&text, &dir.path().join("s.toml")).unwrap();
+            scene_hash(text.as_bytes(), &s)
+        };
+        assert_eq!(hash(10), hash(10));
+        assert_ne!(hash(10), hash(20));
     }
 }

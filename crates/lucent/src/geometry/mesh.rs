@@ -1,8 +1,11 @@
 //! An indexed triangle mesh in world space: positions (padded for
-//! Embree), optional shading normals, and face normals and bounds computed
-//! on first use.
+//! Embree), optional shading normals, optional texture coordinates (kept
+//! only where a material reads a texture), and face normals and bounds
+//! computed on first use.
 
 use std::sync::OnceLock;
+
+use glam::Vec2;
 
 use super::Vec3;
 
@@ -25,6 +28,10 @@ pub struct Mesh {
     pub indices: Vec<[u32; 3]>,
     /// Optional per-vertex shading normals (unit length), same count as vertices.
     pub normals: Option<Vec<Vec3>>,
+    /// Optional texture coordinates of each triangle's three corners, in
+    /// the order of its indices (per triangle, so a seam needs no split
+    /// vertices). Kept only for meshes whose material reads a texture.
+    pub uvs: Option<Vec<[Vec2; 3]>>,
     face_normals: OnceLock<Vec<Vec3>>,
     bounding_radius: OnceLock<f32>,
 }
@@ -44,6 +51,7 @@ impl Mesh {
             positions: p,
             indices,
             normals,
+            uvs: None,
             face_normals: OnceLock::new(),
             bounding_radius: OnceLock::new(),
         }
@@ -90,6 +98,9 @@ impl Mesh {
     pub fn flip_winding(&mut self) {
         self.face_normals = OnceLock::new();
         for t in &mut self.indices {
+            t.swap(1, 2);
+        }
+        for t in self.uvs.iter_mut().flatten() {
             t.swap(1, 2);
         }
     }

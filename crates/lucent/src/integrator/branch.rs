@@ -58,6 +58,8 @@ pub(crate) struct At<'a> {
     #[cfg_attr(not(feature = "subsurface"), allow(dead_code))]
     pub(crate) t: f32,
     pub(crate) depth: u32,
+    /// The hit's barycentrics (u, v) on its triangle.
+    pub(crate) bary: [f32; 2],
     pub(crate) first: bool,
     pub(crate) cone_specular: Cone,
     pub(crate) cone_rough: Cone,

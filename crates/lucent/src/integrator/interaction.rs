@@ -1,6 +1,8 @@
 //! The local geometry at a ray hit: position, geometric and shading normals
 //! and which face the ray arrived at.
 
+use glam::Vec2;
+
 use crate::accel::Hit;
 use crate::geometry::{Frame, Mesh, Ray, Vec3};
 
@@ -12,6 +14,60 @@ pub struct MeshShading {
     tris: Vec<TriGeometry>,
     /// The vertex normals of each triangle, when the mesh has them.
     normals: Option<Vec<[Vec3; 3]>>,
+    /// The texture coordinates and tangent of each triangle, when the
+    /// mesh has texture coordinates (only where its material reads a
+    /// texture).
+    uvs: Option<Vec<TriUv>>,
+}
+
+/// A triangle's texture coordinates (per corner), the ratio of its UV to
+/// its world size, √(area in UV / area), and its unit tangent (the world
+/// direction of increasing u) with the handedness of the bitangent
+/// (increasing v): b = sign · n × t (MikkTSpace's per-pixel form).
+#[derive(Clone, Copy, Debug)]
+pub struct TriUv {
+    pub uv: [Vec2; 3],
+    pub uv_per_unit: f32,
+    pub tangent: Vec3,
+    pub sign: f32,
+}
+
+impl TriUv {
+    /// The record of the triangle with corners `p` and texture coordinates
+    /// `uv`; a triangle degenerate in UV gets a tangent perpendicular to
+    /// its normal and scale 0.
+    pub fn new(p: [Vec3; 3], uv: [Vec2; 3]) -> Self {
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+        let n = e1.cross(e2);
+        let det = d1.x * d2.y - d2.x * d1.y;
+        let area = n.length();
+        let t = (e1 * d2.y - e2 * d1.y) / det;
+        let b = (e2 * d1.x - e1 * d2.x) / det;
+        let ng = n.normalize_or_zero();
+        let (tangent, sign) = match t.try_normalize() {
+            Some(t) if det != 0.0 && b.is_finite() => {
+                (t, if ng.cross(t).dot(b) < 0.0 { -1.0 } else { 1.0 })
+            }
+            _ => (
+                Frame::from_normal(if ng == Vec3::ZERO { Vec3::Z } else { ng }).t,
+                1.0,
+            ),
+        };
+        let ratio = (det.abs() / area).sqrt();
+        TriUv {
+            uv,
+            uv_per_unit: if ratio.is_finite() { ratio } else { 0.0 },
+            tangent,
+            sign,
+        }
+    }
+
+    /// The texture coordinates at barycentrics (u, v).
+    #[inline]
+    pub fn at(&self, [u, v]: [f32; 2]) -> Vec2 {
+        self.uv[0] * (1.0 - u - v) + self.uv[1] * u + self.uv[2] * v
+    }
 }
 
 /// The vertex a and the edges b − a, c − a (the same f32 subtractions the
@@ -48,7 +104,21 @@ impl MeshShading {
                 .map(|idx| idx.map(|i| ns[i as usize]))
                 .collect()
         });
-        MeshShading { tris, normals }
+        let uvs = mesh.uvs.as_ref().map(|uvs| {
+            mesh.indices
+                .iter()
+                .zip(uvs)
+                .map(|(&idx, &uv)| TriUv::new(mesh.vertices(idx), uv))
+                .collect()
+        });
+        MeshShading { tris, normals, uvs }
+    }
+
+    /// Triangle `prim`'s texture coordinates and tangent, when the mesh
+    /// has texture coordinates.
+    #[inline]
+    pub fn uv(&self, prim: u32) -> Option<&TriUv> {
+        self.uvs.as_ref().map(|u| &u[prim as usize])
     }
 }
 
@@ -113,6 +183,13 @@ impl Interaction {
             geom: hit.geom,
             prim: hit.prim,
         }
+    }
+
+    /// This interaction with the unit shading normal `n` (flipped into
+    /// the hemisphere of `ng`, as [`Interaction::new`] does).
+    pub(crate) fn with_shading_normal(&self, n: Vec3) -> Interaction {
+        let ns = if n.dot(self.ng) < 0.0 { -n } else { n };
+        Interaction { ns, ..*self }
     }
 
     /// The shading frame oriented towards the side the ray came from.

@@ -10,7 +10,8 @@
 //! [`control_variate`] is its plane control variate; [`footprint`] is the
 //! path's ray cone; [`culling`] answers rays proven to meet nothing;
 //! [`aov`] records what the passes measure; [`effects`] (with [`crate::stats`])
-//! tally ray queries and time per effect for `--stats`. `probe`,
+//! tally ray queries and time per effect for `--stats`; `texturing` reads
+//! a textured material's parameters at a hit. `probe`,
 //! `control_variate`, `randomwalk` and `diffuse_boundary` exist only with
 //! the `subsurface` feature (the default).
 
@@ -43,6 +44,7 @@ mod scatter;
 mod state;
 #[cfg(feature = "subsurface")]
 mod subsurface;
+mod texturing;
 
 pub use crate::stats::{Counters, Effect, EFFECTS};
 pub use context::Context;

@@ -217,6 +217,7 @@ fn at<'a, R: Recorder>(si: &'a Interaction, path: &Branch, hit: &Hit, depth: u32
         wo: -path.ray.d,
         t: hit.t,
         depth,
+        bary: [hit.u, hit.v],
         first: R::ON && depth == 0,
         cone_specular: path.cone.specular(hit.t),
         cone_rough: path.cone.rough(hit.t),
@@ -259,6 +260,23 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
         Material::Diffuse { albedo } => {
             Scatter::Vertex(diffuse_vertex(ctx, at.si, at.wo, *albedo, st.rec))
         }
+        Material::Textured(t) => {
+            let width = path.cone.width_at(at.t);
+            let r = super::texturing::resolve(ctx, t, at.si, at.bary, at.wo, width);
+            match (&t.base, r.albedo) {
+                (Material::Diffuse { albedo }, a) => Scatter::Vertex(diffuse_vertex(
+                    ctx,
+                    &r.si,
+                    at.wo,
+                    a.unwrap_or(*albedo),
+                    st.rec,
+                )),
+                (base, _) => {
+                    let at = At { si: &r.si, ..*at };
+                    textured_base::<R, T, S>(ctx, base, &at, path, st, subsurface)
+                }
+            }
+        }
         Material::Dielectric { eta } => {
             let (next, e) = dielectric_bounce(ctx, *eta, at.si, at.wo, &mut path.beta, st.rng);
             path.from = ctx.leaving_towards(at.si, next.d);
@@ -282,6 +300,20 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
             subsurface_hit::<R, T, S>(ctx, &h, &mut path.beta, st, subsurface)
         }
     }
+}
+
+/// What the base of a textured material scatters into at `at` (its
+/// shading normal already the normal map's).
+#[inline(never)]
+fn textured_base<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
+    ctx: &'s Context,
+    base: &'s Material,
+    at: &At,
+    path: &mut Branch,
+    st: &mut PathState<R>,
+    subsurface: &mut S,
+) -> Scatter<'s> {
+    scatter_at::<R, T, S>(ctx, base, at, path, st, subsurface)
 }
 
 /// The nearest hit along the path's ray, timed as the camera's (depth 0)

@@ -1,6 +1,7 @@
 //! Surface materials: Lambertian, smooth and rough dielectric, conductor,
 //! coated diffuse ("plastic") and subsurface (a dielectric boundary over
-//! the Burley BSSRDF); each variant's scattering lives in its own file. Fresnel reflectance is [`crate::fresnel`], shared
+//! the Burley BSSRDF), and any of them with textured parameters; each
+//! variant's scattering lives in its own file. Fresnel reflectance is [`crate::fresnel`], shared
 //! with the BSSRDF.
 
 pub mod albedo_table;
@@ -18,6 +19,7 @@ pub mod plastic;
 pub mod rough_dielectric;
 #[cfg(feature = "subsurface")]
 pub mod subsurface;
+pub mod textured;
 
 use std::sync::Arc;
 
@@ -30,6 +32,7 @@ pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;
 #[cfg(feature = "subsurface")]
 pub use subsurface::Subsurface;
+pub use textured::Textured;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {
@@ -49,9 +52,24 @@ pub enum Material {
     /// (only with the `subsurface` feature).
     #[cfg(feature = "subsurface")]
     Subsurface(Arc<Subsurface>),
+    /// A base material with parameters read from textures at each hit.
+    Textured(Arc<Textured>),
 }
 
 impl Material {
+    /// Whether a hit on it reads texture coordinates.
+    pub fn reads_textures(&self) -> bool {
+        matches!(self, Material::Textured(_))
+    }
+
+    /// The material that scatters: the base of a textured one, else itself.
+    pub fn base(&self) -> &Material {
+        match self {
+            Material::Textured(t) => &t.base,
+            m => m,
+        }
+    }
+
     /// Whether this is a subsurface material.
     #[cfg(feature = "subsurface")]
     pub(crate) fn is_subsurface(&self) -> bool {

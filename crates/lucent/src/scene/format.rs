@@ -81,6 +81,23 @@ pub struct SceneFile {
     pub lights: Vec<Spanned<LightDef>>,
     #[serde(default)]
     pub output: OutputDef,
+    /// Image textures by name, read once and shared by the materials that
+    /// name them.
+    #[serde(default)]
+    pub textures: BTreeMap<String, Spanned<TextureDef>>,
+}
+
+/// `[textures.NAME]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureDef {
+    /// A PNG, OpenEXR or Radiance `.hdr` image, relative to the scene
+    /// file's directory. Required.
+    pub file: Option<Spanned<String>>,
+    /// `"srgb"` (the default) or `"linear"`: how PNG values are decoded.
+    pub color_space: Option<Spanned<String>>,
+    /// `"repeat"` (the default) or `"clamp"`.
+    pub wrap: Option<Spanned<String>>,
 }
 
 /// `[camera]`.
@@ -250,6 +267,10 @@ pub struct MaterialDef {
     #[serde(rename = "type")]
     pub kind: Option<Spanned<MaterialKind>>,
     pub albedo: Option<Spanned<Triple3>>,
+    /// A texture's name: the diffuse albedo (times `albedo`, if given).
+    pub albedo_texture: Option<Spanned<String>>,
+    /// A texture's name: a tangent-space normal map.
+    pub normal_map: Option<Spanned<String>>,
     pub eta: Option<Spanned<f64>>,
     // subsurface: parameters (one of three forms)
     pub preset: Option<Spanned<String>>,
@@ -295,6 +316,11 @@ impl MaterialDef {
             }
         };
         add("albedo", self.albedo.as_ref().map(|x| x.span()));
+        add(
+            "albedo_texture",
+            self.albedo_texture.as_ref().map(|x| x.span()),
+        );
+        add("normal_map", self.normal_map.as_ref().map(|x| x.span()));
         add("metal", self.metal.as_ref().map(|x| x.span()));
         add("n", self.n.as_ref().map(|x| x.span()));
         add("k", self.k.as_ref().map(|x| x.span()));

@@ -19,14 +19,17 @@ use super::format::{CameraDef, RenderDef, SceneFile, Spanned};
 use super::lens::lens;
 use super::lights::light;
 use super::material::material;
+use super::obj_materials::{self, MtlMaterials};
 use super::objects::{generated_triangles, object};
 use super::output::output;
 pub use super::regular_file::read_regular_file;
 use super::regular_file::{read_regular_bytes, utf8_text};
+use super::textures;
 use super::{show_point, Camera, RenderSettings, Scene, MAX_COORDINATE};
 use crate::accel::Traversal;
 use crate::error::InputError;
 use crate::geometry::Vec3;
+use crate::materials::Material;
 
 /// OBJ loading, also used on its own (the benchmark's meshes).
 pub use super::obj::load_obj;
@@ -100,18 +103,16 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
 
     // Materials: indexed in name order (the map is sorted), so the same file
     // always gives the same indices.
+    let scene_dir = cx.file.parent().unwrap_or(Path::new(""));
+    let texture_table = textures::table(cx, scene_dir, &def.textures)?;
     let mut materials = Vec::with_capacity(def.materials.len());
     let mut material_index = HashMap::new();
     for (name, m) in &def.materials {
         material_index.insert(name.as_str(), materials.len());
-        materials.push(material(
-            cx,
-            name,
-            m,
-            units_per_mm,
-            def.units_per_mm.as_ref(),
-        )?);
+        let base = material(cx, name, m, units_per_mm, def.units_per_mm.as_ref())?;
+        materials.push(textures::textured(cx, name, m, base, &texture_table)?);
     }
+    let reads_textures: Vec<bool> = materials.iter().map(Material::reads_textures).collect();
 
     // The generated shapes' triangles are counted before any is built, the
     // OBJ meshes' as they are read: a scene beyond MAX_TRIANGLES fails
@@ -127,26 +128,42 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
             return Err(too_many_triangles(cx, s.span(), &field, planned));
         }
     }
-    let scene_dir = cx.file.parent().unwrap_or(Path::new(""));
     let mut meshes = Vec::with_capacity(def.shapes.len());
     let mut objects = Vec::with_capacity(def.shapes.len());
     let mut total = planned;
+    // An OBJ shape without `material` takes its MTL file's: one object per
+    // material, the added materials numbered after the scene's.
+    let mut mtl = MtlMaterials::default();
+    let mut shape_of = Vec::with_capacity(def.shapes.len());
     for (i, s) in def.shapes.iter().enumerate() {
-        let (mesh, obj) = object(cx, scene_dir, i, s, &material_index, units_per_mm)?;
-        if let Some(f) = &s.get_ref().file {
-            total += mesh.triangle_count() as u64;
-            if total > MAX_TRIANGLES {
-                return Err(too_many_triangles(
-                    cx,
-                    f.span(),
-                    &format!("shapes[{i}].file"),
-                    total,
-                ));
+        let parts = if obj_materials::from_mtl(s.get_ref()) {
+            let known = (&material_index, &reads_textures[..], materials.len());
+            obj_materials::objects(cx, scene_dir, i, s, known, units_per_mm, &mut mtl)?
+        } else {
+            vec![object(
+                cx,
+                scene_dir,
+                i,
+                s,
+                &material_index,
+                &reads_textures,
+                units_per_mm,
+            )?]
+        };
+        for (mesh, obj) in parts {
+            if let Some(f) = &s.get_ref().file {
+                total += mesh.triangle_count() as u64;
+                if total > MAX_TRIANGLES {
+                    let field = format!("shapes[{i}].file");
+                    return Err(too_many_triangles(cx, f.span(), &field, total));
+                }
             }
+            meshes.push(mesh);
+            objects.push(obj);
+            shape_of.push(i);
         }
-        meshes.push(mesh);
-        objects.push(obj);
     }
+    materials.extend(mtl.materials);
 
     let environment = match &def.environment {
         Some(env) => environment(cx, scene_dir, env)?,
@@ -156,7 +173,7 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
     let lights = (def.lights.iter().enumerate())
         .map(|(i, l)| light(cx, i, l, units_per_mm))
         .collect::<Res<Vec<_>>>()?;
-    let output = output(cx, &def, &objects)?;
+    let output = output(cx, &def, &objects, &shape_of, mtl.names)?;
 
     Ok(Scene {
         camera,
@@ -169,6 +186,7 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
         units_per_mm,
         source: Some(cx.file.to_path_buf()),
         output,
+        notes: mtl.notes,
     })
 }
 

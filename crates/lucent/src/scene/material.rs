@@ -75,11 +75,15 @@ pub(super) fn material(
     };
     match kind {
         MaterialKind::Diffuse => {
-            cx.only_keys(&field, kind.name(), d.present_keys(), &["albedo"])?;
-            let a = d.albedo.as_ref().ok_or_else(|| missing("albedo"))?;
-            Ok(Material::Diffuse {
-                albedo: cx.rgb(a, &format!("{field}.albedo"), true)?,
-            })
+            let keys = ["albedo", "albedo_texture", "normal_map"];
+            cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
+            // With a texture the albedo is a factor on it, 1 by default.
+            let albedo = match (&d.albedo, &d.albedo_texture) {
+                (Some(a), _) => cx.rgb(a, &format!("{field}.albedo"), true)?,
+                (None, Some(_)) => crate::geometry::Vec3::ONE,
+                (None, None) => return Err(missing("albedo")),
+            };
+            Ok(Material::Diffuse { albedo })
         }
         MaterialKind::Dielectric => {
             cx.only_keys(&field, kind.name(), d.present_keys(), &["eta", "roughness"])?;
@@ -88,12 +92,12 @@ pub(super) fn material(
             glossy_material::dielectric(cx, &field, d, eta)
         }
         MaterialKind::Conductor => {
-            let keys = ["metal", "n", "k", "roughness"];
+            let keys = ["metal", "n", "k", "roughness", "normal_map"];
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             glossy_material::conductor(cx, &field, m)
         }
         MaterialKind::Plastic => {
-            let keys = ["albedo", "eta", "roughness"];
+            let keys = ["albedo", "eta", "roughness", "normal_map"];
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             glossy_material::plastic(cx, &field, m)
         }

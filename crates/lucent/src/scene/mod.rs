@@ -13,12 +13,16 @@ mod lens;
 mod lights;
 pub mod load;
 mod material;
+mod mtl;
 pub mod obj;
+mod obj_materials;
 mod objects;
 mod output;
 mod output_file;
 pub mod regular_file;
+mod shape_uvs;
 pub mod shapes;
+mod textures;
 pub mod transform;
 
 use std::path::PathBuf;
@@ -110,11 +114,37 @@ pub struct Scene {
     pub source: Option<PathBuf>,
     /// Its passes, light groups and material names.
     pub output: Output,
+    /// What loading read past or approximated (MTL keys lucent ignores),
+    /// one line each, for the user.
+    pub notes: Vec<String>,
 }
 
 impl Scene {
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(|m| m.triangle_count()).sum()
+    }
+
+    /// The distinct textures its materials read and their bytes (all MIP
+    /// levels), each counted once however many materials share it.
+    pub fn texture_memory(&self) -> (usize, usize) {
+        let seen = self.textures();
+        let bytes = seen.iter().map(|t| t.bytes()).sum();
+        (seen.len(), bytes)
+    }
+
+    /// The distinct textures its materials read, in material order.
+    pub fn textures(&self) -> Vec<&Arc<crate::texture::Texture>> {
+        let mut seen: Vec<&Arc<crate::texture::Texture>> = Vec::new();
+        for m in &self.materials {
+            if let Material::Textured(t) = m {
+                for tex in t.textures() {
+                    if !seen.iter().any(|s| Arc::ptr_eq(s, tex)) {
+                        seen.push(tex);
+                    }
+                }
+            }
+        }
+        seen
     }
 }
 

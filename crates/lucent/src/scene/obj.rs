@@ -8,13 +8,27 @@
 use std::borrow::Cow;
 use std::path::Path;
 
+use glam::Vec2;
+
 use crate::error::InputError;
 use crate::geometry::{Mesh, Vec3};
 
 /// Loads an OBJ file's faces (all objects and groups) as one mesh. Shading
-/// normals are kept only if every vertex has one; materials (`mtllib`) are
-/// ignored — the scene file assigns the material.
+/// normals and texture coordinates (`vt`) are kept only if every vertex
+/// has them; materials (`mtllib`) are ignored — the scene file assigns the
+/// material.
 pub fn load_obj(text: &str, path: &Path) -> Result<Mesh, InputError> {
+    load_obj_parts(text, path, &[]).map(|(mesh, _)| mesh)
+}
+
+/// [`load_obj`], and each triangle's material: the index in
+/// `material_names` of the `usemtl` its face came under (None before any
+/// `usemtl`, or under a name not in the list).
+pub(super) fn load_obj_parts(
+    text: &str,
+    path: &Path,
+    material_names: &[String],
+) -> Result<(Mesh, Vec<Option<u32>>), InputError> {
     check_obj(text).map_err(|(line, msg)| InputError::new(path, msg).at_line(line))?;
     let text = &*without_vertex_colours(text);
     let opts = tobj::LoadOptions {
@@ -23,9 +37,19 @@ pub fn load_obj(text: &str, path: &Path) -> Result<Mesh, InputError> {
         ignore_points: true,
         ignore_lines: true,
     };
+    // tobj is given the names alone (the MTL file was read by `super::mtl`),
+    // so it only numbers the `usemtl` statements.
+    let names: String = material_names
+        .iter()
+        .map(|n| format!("newmtl {n}\n"))
+        .collect();
     let result = std::panic::catch_unwind(|| {
         tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| {
-            Err(tobj::LoadError::GenericFailure)
+            if material_names.is_empty() {
+                Err(tobj::LoadError::GenericFailure)
+            } else {
+                tobj::load_mtl_buf(&mut names.as_bytes())
+            }
         })
     });
     let models = match result {
@@ -42,9 +66,16 @@ pub fn load_obj(text: &str, path: &Path) -> Result<Mesh, InputError> {
     let mut positions = Vec::new();
     let mut normals = Vec::new();
     let mut all_normals = true;
+    let mut texcoords: Vec<Vec2> = Vec::new();
+    let mut all_texcoords = true;
     let mut indices = Vec::new();
+    let mut tri_material = Vec::new();
     for m in &models {
         let m = &m.mesh;
+        let id = m
+            .material_id
+            .and_then(|i| u32::try_from(i).ok())
+            .filter(|&i| (i as usize) < material_names.len());
         let base = positions.len();
         let nv = m.positions.len() / 3;
         if m.positions.len() % 3 != 0 || m.indices.len() % 3 != 0 {
@@ -65,6 +96,11 @@ pub fn load_obj(text: &str, path: &Path) -> Result<Mesh, InputError> {
         } else {
             all_normals = false;
         }
+        if m.texcoords.len() == 2 * nv {
+            texcoords.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+        } else {
+            all_texcoords = false;
+        }
         for t in m.indices.chunks_exact(3) {
             if t.iter().any(|&i| i as usize >= nv) {
                 return Err(InputError::new(
@@ -74,7 +110,10 @@ pub fn load_obj(text: &str, path: &Path) -> Result<Mesh, InputError> {
             }
             let off = |i: u32| u32::try_from(base + i as usize);
             match (off(t[0]), off(t[1]), off(t[2])) {
-                (Ok(a), Ok(b), Ok(c)) => indices.push([a, b, c]),
+                (Ok(a), Ok(b), Ok(c)) => {
+                    indices.push([a, b, c]);
+                    tri_material.push(id);
+                }
                 _ => return Err(InputError::new(path, "OBJ file has too many vertices")),
             }
         }
@@ -93,7 +132,19 @@ pub fn load_obj(text: &str, path: &Path) -> Result<Mesh, InputError> {
     }
     let normals = (all_normals && normals.iter().all(|n| n.is_finite() && n.length() > 0.0))
         .then(|| normals.into_iter().map(Vec3::normalize).collect());
-    Ok(Mesh::new(positions, indices, normals))
+    let uvs = (all_texcoords && texcoords.iter().all(|t| t.is_finite()))
+        .then(|| corner_uvs(&texcoords, &indices));
+    let mut mesh = Mesh::new(positions, indices, normals);
+    mesh.uvs = uvs;
+    Ok((mesh, tri_material))
+}
+
+/// Each triangle's corner texture coordinates, from per-vertex ones.
+fn corner_uvs(texcoords: &[Vec2], indices: &[[u32; 3]]) -> Vec<[Vec2; 3]> {
+    indices
+        .iter()
+        .map(|t| t.map(|i| texcoords[i as usize]))
+        .collect()
 }
 
 /// The first `v` line of `text` (1-based) whose vertex (after the division

@@ -13,7 +13,7 @@ use super::lights::shape_emission;
 use super::obj::{first_vertex_where, load_obj};
 use super::regular_file::read_regular_file;
 use super::transform::Transform;
-use super::{shapes, show_point, Object, MAX_COORDINATE};
+use super::{shape_uvs, shapes, show_point, Object, MAX_COORDINATE};
 use crate::error::InputError;
 use crate::geometry::{Mesh, Vec3};
 
@@ -42,13 +42,16 @@ pub(super) fn generated_triangles(d: &ShapeDef) -> u64 {
 }
 
 /// Shape `i` (entry `s`): its transformed mesh and its object. `materials`
-/// maps material names to indices; OBJ paths are relative to `dir`.
+/// maps material names to indices, `reads_textures` says per material
+/// whether its meshes need texture coordinates (kept or generated there,
+/// dropped elsewhere); OBJ paths are relative to `dir`.
 pub(super) fn object(
     cx: &Cx,
     dir: &Path,
     i: usize,
     s: &Spanned<ShapeDef>,
     materials: &HashMap<&str, usize>,
+    reads_textures: &[bool],
     units_per_mm: f32,
 ) -> Res<(Mesh, Object)> {
     let field = format!("shapes[{i}]");
@@ -69,6 +72,11 @@ pub(super) fn object(
         ));
     };
     let (mut mesh, source) = shape_mesh(cx, dir, &field, s)?;
+    if reads_textures[mat] {
+        texture_coordinates(cx, &field, s, &mut mesh, source.as_ref())?;
+    } else {
+        mesh.uvs = None;
+    }
     let tf = transform(cx, &field, sd)?;
     tf.apply(&mut mesh);
     check_range(cx, &field, s, &mesh, &tf, source.as_ref())?;
@@ -81,10 +89,44 @@ pub(super) fn object(
     Ok((mesh, object))
 }
 
+/// Gives the untransformed `mesh` of shape `field` texture coordinates for
+/// a material that reads a texture: generated for a built-in shape; an OBJ
+/// file without them is refused.
+fn texture_coordinates(
+    cx: &Cx,
+    field: &str,
+    s: &Spanned<ShapeDef>,
+    mesh: &mut Mesh,
+    source: Option<&ObjSource>,
+) -> Res<()> {
+    if mesh.uvs.is_some() {
+        return Ok(());
+    }
+    let d = s.get_ref();
+    let material = d.material.as_ref().map_or("", |m| m.get_ref().as_str());
+    match (source, d.kind.as_ref()) {
+        (Some(src), _) => Err(InputError::new(
+            &src.path,
+            format!(
+                "material {} of `{field}` in {} reads a texture, but this OBJ file has no \
+                 texture coordinates on every face vertex (`vt`, faces `f v/vt ...`)",
+                quoted(material),
+                cx.file.display()
+            ),
+        )
+        .in_field(format!("{field}.file"))),
+        (None, Some(kind)) => {
+            mesh.uvs = shape_uvs::generated_uvs(*kind.get_ref(), mesh);
+            Ok(())
+        }
+        (None, None) => Ok(()),
+    }
+}
+
 /// An OBJ file's path and text, kept to locate an out-of-range vertex.
-struct ObjSource {
-    path: PathBuf,
-    text: String,
+pub(super) struct ObjSource {
+    pub path: PathBuf,
+    pub text: String,
 }
 
 /// Rejects a shape with a vertex beyond ±[`MAX_COORDINATE`] after its
@@ -92,7 +134,7 @@ struct ObjSource {
 /// range by itself, else the OBJ file's first `v` line that lands out of
 /// range if it is out of range as written, else the `scale` (or the
 /// `rotate`, with no scale).
-fn check_range(
+pub(super) fn check_range(
     cx: &Cx,
     field: &str,
     s: &Spanned<ShapeDef>,
@@ -221,7 +263,7 @@ fn shape_mesh(
 }
 
 /// The shape's scale, rotations and translation.
-fn transform(cx: &Cx, field: &str, d: &ShapeDef) -> Res<Transform> {
+pub(super) fn transform(cx: &Cx, field: &str, d: &ShapeDef) -> Res<Transform> {
     let scale = match &d.scale {
         Some(s) => {
             let f = format!("{field}.scale");

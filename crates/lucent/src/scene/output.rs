@@ -97,8 +97,15 @@ fn group_name(cx: &Cx, name: &Spanned<String>, field: &str) -> Res<String> {
 }
 
 /// `[output]`, the `light_group` keys and the material names of `def`,
-/// whose shapes became `objects`.
-pub(super) fn output(cx: &Cx, def: &SceneFile, objects: &[Object]) -> Res<Output> {
+/// whose shapes became `objects` (object k from shape `shape_of[k]`), with
+/// the names of the materials its MTL files added after its own.
+pub(super) fn output(
+    cx: &Cx,
+    def: &SceneFile,
+    objects: &[Object],
+    shape_of: &[usize],
+    added_materials: Vec<String>,
+) -> Res<Output> {
     let aovs = match def.output.aovs.as_ref() {
         Some(names) => {
             PassSet::from_names(names.iter().map(|n| n.get_ref().as_str())).map_err(|e| {
@@ -114,7 +121,8 @@ pub(super) fn output(cx: &Cx, def: &SceneFile, objects: &[Object]) -> Res<Output
 
     // Each light's group name, checked; then indices into the sorted set.
     let mut shape_groups = Vec::with_capacity(objects.len());
-    for (i, (s, o)) in def.shapes.iter().zip(objects).enumerate() {
+    for (&i, o) in shape_of.iter().zip(objects) {
+        let s = &def.shapes[i];
         let field = format!("shapes[{i}].light_group");
         let g = match &s.get_ref().light_group {
             Some(g) if o.emission.is_none() => {
@@ -161,7 +169,12 @@ pub(super) fn output(cx: &Cx, def: &SceneFile, objects: &[Object]) -> Res<Output
         environment_group: index(&env_group),
         analytic_group: light_def_groups.iter().map(index).collect(),
         light_groups: light_groups.clone(),
-        material_names: def.materials.keys().cloned().collect(),
+        material_names: def
+            .materials
+            .keys()
+            .cloned()
+            .chain(added_materials)
+            .collect(),
         file: output_file(cx, &def.output)?,
     })
 }

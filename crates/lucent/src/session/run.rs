@@ -35,6 +35,11 @@ pub struct Outcome {
     pub stats: RenderStats,
     /// Ray queries the backend refused as out of range.
     pub rejected_rays: u64,
+    /// The scene's distinct textures and their bytes
+    /// ([`crate::scene::Scene::texture_memory`]).
+    pub textures: (usize, usize),
+    /// What loading the scene read past ([`crate::scene::Scene::notes`]).
+    pub notes: Vec<String>,
 }
 
 impl Outcome {
@@ -237,6 +242,8 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
         accel_name: accel.name().into(),
         stats: done.stats,
         rejected_rays: accel.rejected_rays(),
+        textures: scene.texture_memory(),
+        notes: scene.notes.clone(),
     })
 }
 

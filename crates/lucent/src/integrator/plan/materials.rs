@@ -143,13 +143,14 @@ fn material_name(scene: &Scene, i: usize) -> String {
 fn base_plan(scene: &Scene, i: usize, m: &Material) -> MaterialPlan {
     MaterialPlan {
         name: material_name(scene, i),
-        kind: match m {
+        kind: match m.base() {
             Material::Diffuse { .. } => "diffuse",
             Material::Dielectric { .. } | Material::RoughDielectric(_) => "dielectric",
             Material::Conductor(_) => "conductor",
             Material::Plastic(_) => "plastic",
             #[cfg(feature = "subsurface")]
             Material::Subsurface(_) => "subsurface",
+            Material::Textured(_) => "textured",
         }
         .into(),
         objects: users(scene, i),
@@ -193,7 +194,7 @@ pub(super) fn material_rows(scene: &Scene, opts: &PlanOptions, area_lights: bool
         let mut mp = base_plan(scene, i, m);
         let used = !mp.objects.is_empty();
         let mname = mp.name.clone();
-        match m {
+        match m.base() {
             Material::Dielectric { .. } if used => {
                 rows.specular_materials.push(mname.clone());
                 rows.specular_why

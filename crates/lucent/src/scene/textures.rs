@@ -1,0 +1,199 @@
+//! `[textures.NAME]` → the scene's texture table (each image read once,
+//! shared by every material that names it), and the materials that name
+//! textures (`albedo_texture`, `normal_map`) → [`Textured`] materials
+//! (`docs/scene-format.md`, "Textures").
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+use std::sync::Arc;
+
+use super::checked::{Cx, Res};
+use super::format::{MaterialDef, Spanned, TextureDef};
+use super::key_path::{key_segment, quoted};
+use super::regular_file::{open_regular, read_regular_bytes};
+use crate::geometry::Vec3;
+use crate::materials::{Material, Textured};
+use crate::texture::file::{self, Format, TextureError};
+use crate::texture::{ColorSpace, Texture, TextureRef, Wrap};
+
+/// The largest PNG file read (bytes); its decoded size is bounded by
+/// [`file::MAX_TEXELS`] besides.
+const MAX_PNG_BYTES: u64 = 1 << 30;
+
+/// A loaded texture and how its values were decoded.
+pub(super) struct Entry {
+    texture: Arc<Texture>,
+    space: ColorSpace,
+}
+
+/// The scene's textures by name.
+pub(super) type Table = HashMap<String, Entry>;
+
+/// Every `[textures.NAME]` of the scene, read from files relative to `dir`.
+pub(super) fn table(
+    cx: &Cx,
+    dir: &Path,
+    defs: &BTreeMap<String, Spanned<TextureDef>>,
+) -> Res<Table> {
+    let mut out = HashMap::new();
+    for (name, d) in defs {
+        let field = format!("textures.{}", key_segment(name));
+        out.insert(name.clone(), entry(cx, dir, &field, d)?);
+    }
+    Ok(out)
+}
+
+fn entry(cx: &Cx, dir: &Path, field: &str, d: &Spanned<TextureDef>) -> Res<Entry> {
+    let t = d.get_ref();
+    let file_key = format!("{field}.file");
+    let f = cx.required(&t.file, Some(d.span()), &file_key)?;
+    let space = choice(
+        cx,
+        field,
+        "color_space",
+        &t.color_space,
+        ColorSpace::parse,
+        "\"srgb\" or \"linear\"",
+    )?
+    .unwrap_or(ColorSpace::Srgb);
+    let wrap = choice(
+        cx,
+        field,
+        "wrap",
+        &t.wrap,
+        Wrap::parse,
+        "\"repeat\" or \"clamp\"",
+    )?
+    .unwrap_or(Wrap::Repeat);
+    let path = dir.join(f.get_ref());
+    let refuse = |e: String| {
+        cx.err(
+            f.span(),
+            &file_key,
+            format!("texture image {}: {e}", path.display()),
+        )
+    };
+    Ok(Entry {
+        texture: load(&path, space, wrap).map_err(refuse)?,
+        space,
+    })
+}
+
+/// The texture of the image at `path`, or why it cannot be used.
+pub(super) fn load(path: &Path, space: ColorSpace, wrap: Wrap) -> Result<Arc<Texture>, String> {
+    let texels = read(path, space)?;
+    Ok(Arc::new(Texture::new(
+        texels.width,
+        texels.height,
+        texels.data,
+        wrap,
+    )))
+}
+
+/// The value of the optional key `key` of table `field`, one of `names`.
+fn choice<T>(
+    cx: &Cx,
+    field: &str,
+    key: &str,
+    v: &Option<Spanned<String>>,
+    parse: fn(&str) -> Option<T>,
+    names: &str,
+) -> Res<Option<T>> {
+    let Some(v) = v else { return Ok(None) };
+    parse(v.get_ref()).map(Some).ok_or_else(|| {
+        cx.err(
+            v.span(),
+            &format!("{field}.{key}"),
+            format!("expected {names}, found {}", quoted(v.get_ref())),
+        )
+    })
+}
+
+/// The image at `path`, decoded per `space` (PNG only: float images are
+/// linear).
+fn read(path: &Path, space: ColorSpace) -> Result<crate::environment::image::Texels, String> {
+    let format = file::format_of(path).map_err(|e| e.to_string())?;
+    let cannot = |e: std::io::Error| format!("cannot read it: {e}");
+    match format {
+        Format::Png => {
+            let bytes = read_regular_bytes(path, MAX_PNG_BYTES).map_err(cannot)?;
+            file::read_png(&bytes, space).map_err(|e| TextureError::from(e).to_string())
+        }
+        Format::Float => {
+            open_regular(path).map_err(cannot)?;
+            file::read_float(path).map_err(|e| TextureError::from(e).to_string())
+        }
+    }
+}
+
+/// `base`, the material `name` (table `m`) built from its other keys, with
+/// the textures it names; `base` itself when it names none.
+pub(super) fn textured(
+    cx: &Cx,
+    name: &str,
+    m: &Spanned<MaterialDef>,
+    base: Material,
+    table: &Table,
+) -> Res<Material> {
+    let d = m.get_ref();
+    if d.albedo_texture.is_none() && d.normal_map.is_none() {
+        return Ok(base);
+    }
+    let field = format!("materials.{}", key_segment(name));
+    let albedo = match &d.albedo_texture {
+        Some(t) => {
+            let e = lookup(cx, &format!("{field}.albedo_texture"), t, table)?;
+            let scale = match &base {
+                Material::Diffuse { albedo } => *albedo,
+                _ => Vec3::ONE,
+            };
+            Some(TextureRef {
+                texture: e.texture.clone(),
+                scale,
+            })
+        }
+        None => None,
+    };
+    let normal = match &d.normal_map {
+        Some(t) => {
+            let key = format!("{field}.normal_map");
+            let e = lookup(cx, &key, t, table)?;
+            if e.space != ColorSpace::Linear {
+                return Err(cx.err(
+                    t.span(),
+                    &key,
+                    format!(
+                        "texture {} is declared sRGB, but a normal map is data: give it \
+                         color_space = \"linear\"",
+                        quoted(t.get_ref())
+                    ),
+                ));
+            }
+            Some(e.texture.clone())
+        }
+        None => None,
+    };
+    Ok(Material::Textured(Arc::new(Textured {
+        base,
+        albedo,
+        normal,
+    })))
+}
+
+/// The texture `t` names, or an error at `field` listing those defined.
+fn lookup<'t>(cx: &Cx, field: &str, t: &Spanned<String>, table: &'t Table) -> Res<&'t Entry> {
+    table.get(t.get_ref()).ok_or_else(|| {
+        let mut known: Vec<String> = table.keys().map(|k| key_segment(k)).collect();
+        known.sort_unstable();
+        let known = if known.is_empty() {
+            "no [textures] are defined".to_string()
+        } else {
+            format!("defined: {}", known.join(", "))
+        };
+        cx.err(
+            t.span(),
+            field,
+            format!("unknown texture {} ({known})", quoted(t.get_ref())),
+        )
+    })
+}

@@ -1,0 +1,174 @@
+//! Textures that cannot be used are scene errors: exit 2 naming the file,
+//! its line and the field, and why, with nothing written; a textured scene
+//! renders and `--stats` reports the textures' memory.
+
+use std::path::Path;
+use std::process::Command;
+
+const CAM: &str = "[camera]\nlook_from = [0, 0, 5]\nlook_at = [0, 0, 0]\nresolution = [4, 4]\n\
+                   [render]\nspp = 2\n[environment]\nradiance = [1, 1, 1]\n";
+
+/// Renders `scene` (beside what `setup` writes) with `args`: exit code,
+/// stderr, and whether the output was written.
+fn render(scene: &str, args: &[&str], setup: impl FnOnce(&Path)) -> (Option<i32>, String, bool) {
+    let dir = tempfile::tempdir().unwrap();
+    setup(dir.path());
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.path().join("out.exr");
+    let res = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .arg("render")
+        .arg(&path)
+        .arg("-o")
+        .arg(&out)
+        .args(args)
+        .output()
+        .expect("run lucent");
+    (
+        res.status.code(),
+        String::from_utf8_lossy(&res.stderr).into_owned(),
+        out.exists(),
+    )
+}
+
+fn png(path: &Path, w: u32, h: u32) {
+    image::RgbImage::from_pixel(w, h, image::Rgb([100, 150, 200]))
+        .save(path)
+        .unwrap();
+}
+
+/// A diffuse quad with the texture `tex` (its table's body `def`).
+fn scene(def: &str, material_key: &str) -> String {
+    format!(
+        "{CAM}[textures.t]\n{def}\n[materials.m]\ntype = \"diffuse\"\n{material_key}\n\
+         [[shapes]]\ntype = \"quad\"\nmaterial = \"m\"\n"
+    )
+}
+
+#[test]
+fn a_textured_scene_renders_and_reports_its_texture_memory() {
+    let s = scene("file = \"a.png\"", "albedo_texture = \"t\"");
+    let (code, stderr, written) = render(&s, &["--stats"], |d| png(&d.join("a.png"), 16, 8));
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(written);
+    // 16×8 + 8×4 + 4×2 + 2×1 + 1×1 texels of 12 bytes
+    let bytes = (128 + 32 + 8 + 2 + 1) * 12;
+    let want = format!("textures: 1, {bytes} bytes");
+    assert!(stderr.contains(&want), "no {want:?} in {stderr}");
+}
+
+#[test]
+fn unusable_textures_exit_2_naming_file_line_field_and_reason() {
+    type Setup = Box<dyn FnOnce(&Path)>;
+    let albedo = "albedo_texture = \"t\"";
+    let rows: Vec<(String, Setup, &str, &str)> = vec![
+        (
+            scene("file = \"absent.png\"", albedo),
+            Box::new(|_| {}),
+            "textures.t.file",
+            "absent.png: cannot read it",
+        ),
+        (
+            scene("file = \"a.jpg\"", albedo),
+            Box::new(|d| std::fs::write(d.join("a.jpg"), b"\xff\xd8\xff").unwrap()),
+            "textures.t.file",
+            "unsupported texture format \"jpg\"",
+        ),
+        (
+            scene("file = \"bad.png\"", albedo),
+            Box::new(|d| std::fs::write(d.join("bad.png"), b"\x89PNG\r\n\x1a\nnot").unwrap()),
+            "textures.t.file",
+            "bad.png: cannot read it",
+        ),
+        (
+            scene("file = \"big.png\"", albedo),
+            Box::new(|d| {
+                image::GrayImage::new(8200, 4100)
+                    .save(d.join("big.png"))
+                    .unwrap()
+            }),
+            "textures.t.file",
+            "the image is 8200×4100 = 33620000 texels, more than the 33554432",
+        ),
+        (
+            scene("file = \"nan.exr\"", albedo),
+            Box::new(|d| {
+                exr::prelude::write_rgb_file(d.join("nan.exr"), 4, 2, |x, y| {
+                    let g = if (x, y) == (3, 1) { f32::INFINITY } else { 1.0 };
+                    (1.0, g, 1.0)
+                })
+                .unwrap()
+            }),
+            "textures.t.file",
+            "texel (column 3, row 1) has G = inf",
+        ),
+        (
+            scene("file = \"a.png\"\ncolor_space = \"rec2020\"", albedo),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "textures.t.color_space",
+            "expected \"srgb\" or \"linear\"",
+        ),
+        (
+            scene("file = \"a.png\"\nwrap = \"mirror\"", albedo),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "textures.t.wrap",
+            "expected \"repeat\" or \"clamp\"",
+        ),
+        (
+            scene("file = \"a.png\"", "albedo_texture = \"wood\""),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "materials.m.albedo_texture",
+            "unknown texture \"wood\" (defined: t)",
+        ),
+        (
+            scene("file = \"a.png\"", "albedo = [1, 1, 1]\nnormal_map = \"t\""),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "materials.m.normal_map",
+            "a normal map is data: give it color_space = \"linear\"",
+        ),
+    ];
+    for (scene, setup, field, fragment) in rows {
+        let (code, stderr, written) = render(&scene, &[], setup);
+        assert_eq!(code, Some(2), "{fragment:?}: {stderr}");
+        assert!(
+            stderr.contains(fragment),
+            "stderr lacks {fragment:?}: {stderr}"
+        );
+        assert!(
+            stderr.contains("scene.toml:") && stderr.contains(&format!("field `{field}`")),
+            "no line or field {field}: {stderr}"
+        );
+        assert!(!written, "output written for {fragment:?}");
+    }
+}
+
+/// An OBJ without texture coordinates under a textured material: exit 2
+/// naming the OBJ file and the shape's field.
+#[test]
+fn an_obj_without_texture_coordinates_under_a_texture_exits_2() {
+    let s = format!(
+        "{CAM}[textures.t]\nfile = \"a.png\"\n[materials.m]\ntype = \"diffuse\"\n\
+         albedo_texture = \"t\"\n[[shapes]]\ntype = \"obj\"\nfile = \"tri.obj\"\nmaterial = \"m\"\n"
+    );
+    let (code, stderr, written) = render(&s, &[], |d| {
+        png(&d.join("a.png"), 2, 2);
+        std::fs::write(d.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    });
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("tri.obj") && stderr.contains("shapes[0].file"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("no texture coordinates"), "{stderr}");
+    assert!(!written);
+    // with `vt` on every face vertex it renders
+    let (code, stderr, _) = render(&s, &[], |d| {
+        png(&d.join("a.png"), 2, 2);
+        std::fs::write(
+            d.join("tri.obj"),
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+        )
+        .unwrap();
+    });
+    assert_eq!(code, Some(0), "{stderr}");
+}
