@@ -15,6 +15,7 @@ mod exr_oiio;
 mod farm;
 #[cfg(feature = "subsurface")]
 mod plan;
+mod region;
 mod scene_errors;
 mod session;
 #[cfg(feature = "subsurface")]

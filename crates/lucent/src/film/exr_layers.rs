@@ -25,6 +25,9 @@
 //!   keeps them sorted). Sorting keeps the header's length, so the offset
 //!   table stays valid. Same inputs → the same bytes, except that the
 //!   render time is one of the inputs.
+//! - **Windows:** the display window is the whole frame; the data window
+//!   is the pixels the file holds ([`Window`]): the frame, or the region of
+//!   a region render (`--region`), a normal EXR every viewer places.
 //! - **Atomic:** every file (and the PNG preview) is written to a temporary
 //!   file and all are committed together ([`super::commit_all`]): all
 //!   appear, or none does.
@@ -34,14 +37,15 @@ use std::path::{Path, PathBuf};
 
 use exr::meta::attribute::{AttributeValue, Text};
 use exr::prelude::{
-    f16, AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image,
-    LayerAttributes, LineOrder, SmallVec, WritableImage,
+    f16, AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, IntegerBounds,
+    LayerAttributes, LineOrder, SmallVec, Vec2, WritableImage,
 };
 
 use super::cryptomatte::{self, DEFAULT_RANKS};
 use super::exr_attributes::text;
 pub use super::exr_attributes::FrameHeader;
 use super::layers::{Coverage, Layer, LayerKind};
+use super::region::Region;
 use super::{commit_all, preview_path, Film, Staged, ToneMap};
 use crate::error::Error;
 
@@ -167,6 +171,25 @@ pub fn split_path(path: &Path, pass: &str) -> PathBuf {
     path.with_file_name(format!("{stem}.{pass}.exr"))
 }
 
+/// Where a file's pixels sit in the frame: the display window is the
+/// whole `frame` (width, height) from (0, 0); the data window, the pixels
+/// the file holds, is `data` (the frame itself, or a region).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Window {
+    pub frame: (u32, u32),
+    pub data: Region,
+}
+
+impl Window {
+    /// The whole `width`×`height` frame.
+    pub fn full(width: u32, height: u32) -> Window {
+        Window {
+            frame: (width, height),
+            data: Region::full(width, height),
+        }
+    }
+}
+
 /// Writes the frame: beauty from `film`, the passes `layers` and the
 /// Cryptomatte of each `coverage`, with `header`'s attributes, as `opts`
 /// says, plus the PNG preview; every file appears or none does.
@@ -178,13 +201,31 @@ pub fn write_frame(
     header: &FrameHeader,
     opts: &OutputOptions,
 ) -> Result<(), Error> {
-    commit_all(stage_frame(path, film, layers, coverage, header, opts)?)
+    let window = Window::full(film.width, film.height);
+    write_window(path, window, film, layers, coverage, header, opts)
 }
 
-/// [`write_frame`] to temporary files only, for [`commit_all`] (with other
-/// outputs of the same command).
+/// [`write_frame`] for the pixels of `window.data` (`film`, the layers and
+/// the coverage are that region's) placed in the frame `window.frame`.
+pub fn write_window(
+    path: &Path,
+    window: Window,
+    film: &Film,
+    layers: &[Layer],
+    coverage: &[Coverage],
+    header: &FrameHeader,
+    opts: &OutputOptions,
+) -> Result<(), Error> {
+    commit_all(stage_frame(
+        path, window, film, layers, coverage, header, opts,
+    )?)
+}
+
+/// [`write_window`] to temporary files only, for [`commit_all`] (with
+/// other outputs of the same command).
 pub(crate) fn stage_frame(
     path: &Path,
+    window: Window,
     film: &Film,
     layers: &[Layer],
     coverage: &[Coverage],
@@ -192,8 +233,17 @@ pub(crate) fn stage_frame(
     opts: &OutputOptions,
 ) -> Result<Vec<Staged>, Error> {
     let pixels = film.pixels.len();
+    let d = window.data;
+    if (d.width(), d.height()) != (film.width, film.height)
+        || !d.within(&Region::full(window.frame.0, window.frame.1))
+    {
+        return Err(Error::Runtime(format!(
+            "cannot write a {}×{} image as the pixels {d} of a {}×{} frame",
+            film.width, film.height, window.frame.0, window.frame.1
+        )));
+    }
     check_layers(layers, coverage, pixels)?;
-    let attributes = header.attributes(film.width, film.height);
+    let attributes = header.attributes(window.frame.0, window.frame.1);
     let mut files: Vec<File> = vec![File {
         path: path.to_path_buf(),
         planes: beauty_planes(film)?,
@@ -236,7 +286,7 @@ pub(crate) fn stage_frame(
     }
     let mut staged = Vec::with_capacity(files.len() + 1);
     for f in files {
-        staged.push(f.stage(film.width, film.height, opts.compression)?);
+        staged.push(f.stage(window, opts.compression)?);
     }
     if let Some(p) = opts.preview {
         staged.push(film.stage_png(&preview_path(path), p.tonemap, p.exposure)?);
@@ -258,9 +308,13 @@ struct File {
 }
 
 impl File {
-    fn stage(self, width: u32, height: u32, compression: ExrCompression) -> Result<Staged, Error> {
+    fn stage(self, window: Window, compression: ExrCompression) -> Result<Staged, Error> {
         // the standard attributes the exr crate keeps in fields of their own
-        let mut attributes = LayerAttributes::default();
+        let d = window.data;
+        let mut attributes = LayerAttributes {
+            layer_position: Vec2(d.x0 as i32, d.y0 as i32),
+            ..LayerAttributes::default()
+        };
         for (name, value) in self.attributes {
             match (name.as_str(), value) {
                 ("software", AttributeValue::Text(t)) => attributes.software_name = Some(t),
@@ -288,17 +342,28 @@ impl File {
             line_order: LineOrder::Increasing,
         };
         let layer = exr::image::Layer::new(
-            (width as usize, height as usize),
+            (d.width() as usize, d.height() as usize),
             attributes,
             encoding,
             AnyChannels::sort(channels),
         );
-        let image = Image::from_layer(layer);
-        Staged::write(&self.path, |tmp| {
-            image.write().non_parallel().to_unbuffered(&mut *tmp)?;
-            sort_header_in_file(tmp)
-        })
+        let mut image = Image::from_layer(layer);
+        let (w, h) = (window.frame.0 as usize, window.frame.1 as usize);
+        image.attributes.display_window = IntegerBounds::new((0, 0), (w, h));
+        stage_image(&self.path, &image)
     }
+}
+
+/// A flat single-layer EXR image with any channels, as the exr crate holds it.
+pub type AnyImage = Image<exr::image::Layer<AnyChannels<FlatSamples>>>;
+
+/// Stages `image` at `path` with deterministic bytes: blocks compressed
+/// and written in order, the header's attributes sorted by name.
+pub(crate) fn stage_image(path: &Path, image: &AnyImage) -> Result<Staged, Error> {
+    Staged::write(path, |tmp| {
+        image.write().non_parallel().to_unbuffered(&mut *tmp)?;
+        sort_header_in_file(tmp)
+    })
 }
 
 /// Why the frame's EXR could not be written to its temporary file: the

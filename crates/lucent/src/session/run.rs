@@ -14,7 +14,7 @@ use crate::accel;
 use crate::error::{Error, InputError};
 use crate::farm::part;
 use crate::film::exr_attributes::FrameHeader;
-use crate::film::exr_layers::{self, OutputOptions};
+use crate::film::exr_layers::{self, OutputOptions, Window};
 use crate::film::passes::PassSet;
 use crate::film::region::Region;
 use crate::film::Sums;
@@ -81,14 +81,17 @@ fn check_counts(r: &Request) -> Result<(), Error> {
 
 /// The pixels `split` asks for, inside the `w`×`h` frame.
 fn region_of(split: &Split, w: u32, h: u32) -> Result<Region, Error> {
-    Ok(match (split.crop, split.tile) {
-        (Some(c), _) if !c.within(&Region::full(w, h)) => {
+    let rect = [("--crop", split.crop), ("--region", split.region)]
+        .into_iter()
+        .find_map(|(flag, r)| r.map(|r| (flag, r)));
+    Ok(match (rect, split.tile) {
+        (Some((flag, c)), _) if !c.within(&Region::full(w, h)) => {
             return Err(Error::Argument {
-                argument: "--crop".into(),
+                argument: flag.into(),
                 problem: format!("{c} is not inside the {w}×{h} frame"),
             })
         }
-        (Some(c), _) => c,
+        (Some((_, c)), _) => c,
         (None, Some((i, n))) => Region::band(i, n, w, h).ok_or_else(|| Error::Argument {
             argument: "--tile".into(),
             problem: format!("{i}/{n}: the {w}×{h} frame splits into at most {h} bands"),
@@ -222,7 +225,11 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
             date: Some(super::provenance::date_now()),
             ..frame.clone()
         };
-        write_frame(r, &done.sums, &header, &out)?;
+        let window = Window {
+            frame: (w, h),
+            data: region,
+        };
+        write_frame(r, window, &done.sums, &header, &out)?;
     }
     if this.owns(&keep) {
         checkpoint::clean(&keep);
@@ -291,14 +298,16 @@ fn keep_interrupted(
     })
 }
 
-/// Writes the finished frame's layers to the output EXR.
+/// Writes the finished frame's layers to the output EXR, its pixels at
+/// `window`.
 fn write_frame(
     r: &Request,
+    window: Window,
     sums: &Sums,
     header: &FrameHeader,
     out: &OutputOptions,
 ) -> Result<(), Error> {
     let (layers, coverage) = sums.layers()?;
     let film = sums.film()?;
-    exr_layers::write_frame(&r.output, &film, &layers, &coverage, header, out)
+    exr_layers::write_window(&r.output, window, &film, &layers, &coverage, header, out)
 }
