@@ -438,7 +438,7 @@ fn layer_planes(layer: &Layer, precision: Precision) -> Vec<Plane> {
         .map(|(c, ch)| {
             let values = layer.values.iter().skip(c).step_by(n).copied();
             Plane {
-                name: format!("{}.{ch}", layer.name),
+                name: channel_name(layer, ch),
                 samples: if half {
                     FlatSamples::F16(values.map(f16::from_f32).collect())
                 } else {
@@ -447,6 +447,17 @@ fn layer_planes(layer: &Layer, precision: Precision) -> Vec<Plane> {
             }
         })
         .collect()
+}
+
+/// The EXR channel of `layer`'s channel `ch`: `layer.ch`, or the bare
+/// name for a layer of one channel of its own name (depth: `Z`, what
+/// compositors read as depth).
+fn channel_name(layer: &Layer, ch: &str) -> String {
+    if layer.channels.len() == 1 && layer.name == ch {
+        ch.to_string()
+    } else {
+        format!("{}.{ch}", layer.name)
+    }
 }
 
 /// Layer and channel names that make well-formed, distinct channels, and

@@ -238,7 +238,7 @@ pub fn layers<'b>(
             let sums = &aov.sums[i * st..(i + 1) * st];
             let near = aov.nearest.get(i).copied().unwrap_or(Nearest::NONE);
             for (layer, slot) in layers.iter_mut().zip(layout.slots()) {
-                let v = slot_value(slot, sums, beauty, near, n);
+                let v = slot_value(slot, sums, beauty, near, n, 1.0);
                 layer.values.extend_from_slice(&v[..slot.channels.len()]);
             }
             let fractions = |counts: &[(u32, u32)]| {
@@ -279,14 +279,27 @@ fn empty_layers(layout: &Layout, pixels: usize) -> Result<Vec<Layer>, Error> {
     Ok(layers)
 }
 
+/// The depth `Z` of a pixel no camera ray hit: a large finite value (as
+/// Cycles writes), so filters and blurs over an edge stay finite.
+pub const DEPTH_MISS: f32 = 1e10;
+
 /// A pixel's value of the layer of `slot` (its first channels), from the
-/// pixel's pass sums, its beauty sums, its nearest hit and `n` samples.
-fn slot_value(slot: &Slot, sums: &[i128], beauty: &[i128], near: Nearest, n: u64) -> [f32; 3] {
+/// pixel's pass sums, its beauty sums, its nearest hit, `n` samples and
+/// the frame's alpha there.
+fn slot_value(
+    slot: &Slot,
+    sums: &[i128],
+    beauty: &[i128],
+    near: Nearest,
+    n: u64,
+    alpha: f32,
+) -> [f32; 4] {
     const F: FixedPoint = FixedPoint::RADIANCE;
     let o = slot.offset;
     let mean = |k: usize| F.mean(sums[o + k], n);
-    match slot.pass {
+    let [x, y, z] = match slot.pass {
         Pass::Position => near.p,
+        Pass::Depth if near.object == 0 => [DEPTH_MISS, 0.0, 0.0],
         Pass::Depth => [near.z, 0.0, 0.0],
         Pass::ObjectId => [near.object as f32, 0.0, 0.0],
         Pass::MaterialId => [near.material as f32, 0.0, 0.0],
@@ -296,7 +309,8 @@ fn slot_value(slot: &Slot, sums: &[i128], beauty: &[i128], near: Nearest, n: u64
             variance(beauty[c], &sums[w..w + SQUARE_WORDS], n)
         }),
         _ => [mean(0), mean(1), mean(2)],
-    }
+    };
+    [x, y, z, alpha]
 }
 
 #[cfg(test)]
