@@ -77,6 +77,11 @@ pub(crate) struct FileArgs {
     /// Cryptomatte ranks per pixel, 1 to 64 (default 6).
     #[arg(long)]
     cryptomatte_ranks: Option<usize>,
+    /// A transparent film: the environment seen directly is left out of
+    /// the beauty, and A is the fraction of camera rays that hit
+    /// (premultiplied; docs/output.md, "Transparent film").
+    #[arg(long, num_args = 0..=1, default_missing_value = "true")]
+    transparent: Option<bool>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -120,6 +125,7 @@ impl FileArgs {
             }),
             split: self.aov_split,
             cryptomatte_ranks: self.cryptomatte_ranks,
+            transparent: self.transparent,
         })
     }
 }

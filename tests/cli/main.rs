@@ -21,3 +21,4 @@ mod session;
 #[cfg(feature = "subsurface")]
 mod study;
 mod subsurface_feature;
+mod transparent;

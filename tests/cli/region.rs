@@ -14,14 +14,14 @@ const FIXTURE: &str = "tests/fixtures/marble-ball.toml";
 
 /// A flat EXR's display window (x0, y0, w, h), data window (x0, y0, w,
 /// h) and channels: name, then every sample's bits.
-struct Exr {
-    display: (i32, i32, usize, usize),
-    data: (i32, i32, usize, usize),
-    channels: Vec<(String, Vec<u32>)>,
+pub(crate) struct Exr {
+    pub display: (i32, i32, usize, usize),
+    pub data: (i32, i32, usize, usize),
+    pub channels: Vec<(String, Vec<u32>)>,
 }
 
 impl Exr {
-    fn read(path: &Path) -> Exr {
+    pub fn read(path: &Path) -> Exr {
         let image = exr::prelude::read()
             .no_deep_data()
             .largest_resolution_level()
@@ -54,12 +54,12 @@ impl Exr {
     }
 
     /// Channel `c`'s sample bits at frame pixel (x, y).
-    fn at(&self, c: usize, x: i32, y: i32) -> u32 {
+    pub fn at(&self, c: usize, x: i32, y: i32) -> u32 {
         let (x0, y0, w, _) = self.data;
         self.channels[c].1[(y - y0) as usize * w + (x - x0) as usize]
     }
 
-    fn names(&self) -> Vec<&str> {
+    pub fn names(&self) -> Vec<&str> {
         self.channels.iter().map(|c| c.0.as_str()).collect()
     }
 }

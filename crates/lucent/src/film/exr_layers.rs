@@ -147,6 +147,9 @@ pub struct OutputOptions {
     pub cryptomatte_ranks: usize,
     /// The PNG preview beside the EXR, if any.
     pub preview: Option<Preview>,
+    /// A transparent film: the environment seen directly is left out of
+    /// the beauty and `A` is the camera rays' coverage.
+    pub transparent: bool,
 }
 
 impl Default for OutputOptions {
@@ -157,6 +160,7 @@ impl Default for OutputOptions {
             split: false,
             cryptomatte_ranks: DEFAULT_RANKS,
             preview: None,
+            transparent: false,
         }
     }
 }
@@ -244,9 +248,17 @@ pub(crate) fn stage_frame(
     }
     check_layers(layers, coverage, pixels)?;
     let attributes = header.attributes(window.frame.0, window.frame.1);
+    // a transparent film's alpha replaces the opaque A, beside R, G, B
+    let alpha = layers.iter().find(|l| l.name == "A");
+    let mut beauty = beauty_planes(film, alpha.is_none())?;
+    beauty.extend(
+        alpha
+            .map(|a| layer_planes(a, Precision::Float))
+            .unwrap_or_default(),
+    );
     let mut files: Vec<File> = vec![File {
         path: path.to_path_buf(),
-        planes: beauty_planes(film)?,
+        planes: beauty,
         attributes: attributes.clone(),
     }];
     let mut add = |name: &str, planes: Vec<Plane>, extra: Vec<(String, AttributeValue)>| {
@@ -265,6 +277,9 @@ pub(crate) fn stage_frame(
         }
     };
     for layer in layers {
+        if layer.name == "A" {
+            continue;
+        }
         add(&layer.name, layer_planes(layer, opts.precision), Vec::new());
     }
     for cov in coverage {
@@ -403,10 +418,10 @@ fn sort_header_in_file(f: &mut std::fs::File) -> Result<(), FrameWriteError> {
     }
 }
 
-/// Beauty: `R`, `G`, `B` from the film, `A` = 1, 32-bit float (16 bytes a
-/// pixel beside the film's 12; failing with a message, not aborting, when
-/// that cannot be allocated).
-fn beauty_planes(film: &Film) -> Result<Vec<Plane>, Error> {
+/// Beauty: `R`, `G`, `B` from the film and, when `opaque`, `A` = 1, 32-bit
+/// float (16 bytes a pixel beside the film's 12; failing with a message,
+/// not aborting, when that cannot be allocated).
+fn beauty_planes(film: &Film, opaque: bool) -> Result<Vec<Plane>, Error> {
     let n = film.pixels.len();
     let plane = |name: &str, f: fn(&crate::geometry::Vec3) -> f32| {
         let mut v = Vec::new();
@@ -418,12 +433,15 @@ fn beauty_planes(film: &Film) -> Result<Vec<Plane>, Error> {
             samples: FlatSamples::F32(v),
         })
     };
-    Ok(vec![
+    let mut planes = vec![
         plane("R", |p| p.x)?,
         plane("G", |p| p.y)?,
         plane("B", |p| p.z)?,
-        plane("A", |_| 1.0)?,
-    ])
+    ];
+    if opaque {
+        planes.push(plane("A", |_| 1.0)?);
+    }
+    Ok(planes)
 }
 
 /// A pass's channels `layer.channel`, half only for light passes at half
@@ -472,7 +490,9 @@ fn check_layers(layers: &[Layer], coverage: &[Coverage], pixels: usize) -> Resul
         .map(|c| cryptomatte::layer_name(&c.kind))
         .collect();
     for l in layers {
-        if !ok_name(&l.name) || ["R", "G", "B", "A"].contains(&l.name.as_str()) {
+        // `A` only as the one-channel alpha of a transparent film
+        let alpha = l.name == "A" && l.channels == ["A"];
+        if !ok_name(&l.name) || (["R", "G", "B", "A"].contains(&l.name.as_str()) && !alpha) {
             return bad(format!("\"{}\": not a layer name", l.name));
         }
         if l.channels.is_empty() || !l.channels.iter().all(|c| ok_name(c)) {

@@ -104,7 +104,8 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
     let max_depth = ctx.scene.settings.max_depth;
     for depth in start.depth..=max_depth {
         let Some(hit) = nearest::<R, T>(ctx, &path, depth, st) else {
-            if ctx.plan.environment {
+            // a transparent film leaves the environment seen directly out
+            if ctx.plan.environment && !(depth == 0 && ctx.plan.transparent) {
                 l += environment(ctx, &path, depth, st.rec);
             }
             break;

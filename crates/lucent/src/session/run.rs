@@ -122,6 +122,10 @@ fn load(r: &Request) -> Result<(Scene, String, String), Error> {
     let text = scene::load::read_regular_file(&r.scene, scene::load::MAX_SCENE_BYTES)
         .map_err(|e| InputError::new(&r.scene, format!("cannot read scene file: {e}")))?;
     let options = overrides::apply(&r.overrides, &mut scene.materials)?;
+    // the film is the renderer's to know (`integrator::plan::Plan`)
+    if let Some(t) = r.file.transparent {
+        scene.output.file.transparent = Some(t);
+    }
     Ok((scene, text, options))
 }
 
@@ -136,9 +140,9 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let region = region_of(&r.split, w, h)?;
     let samples = samples_of(&r.split, settings.spp)?;
-    let passes = r.aov.unwrap_or(scene.output.aovs);
-    let layout = (!passes.is_empty()).then(|| crate::integrator::aov::layout(&scene, passes));
     let mut out = output_options(r, &scene);
+    let passes = film_passes(r.aov.unwrap_or(scene.output.aovs), &out);
+    let layout = (!passes.is_empty()).then(|| crate::integrator::aov::layout(&scene, passes));
     // parts and resumes record the backend this machine resolves to
     let backend = r.backend.resolve().unwrap_or(r.backend);
     let identity = identity::identity(
@@ -254,6 +258,16 @@ fn output_options(r: &Request, scene: &Scene) -> OutputOptions {
         .over(scene.output.file.over(OutputOptions::default()))
 }
 
+/// The passes a render sums: those asked for, and with a transparent film
+/// the object coverage (its counts of camera rays that hit are `A`).
+fn film_passes(asked: PassSet, out: &OutputOptions) -> PassSet {
+    let mut passes = asked;
+    if out.transparent {
+        passes.insert(crate::film::passes::Pass::CryptoObject);
+    }
+    passes
+}
+
 /// The scene file's name, for part headers.
 fn scene_name(r: &Request) -> String {
     r.scene
@@ -307,7 +321,7 @@ fn write_frame(
     header: &FrameHeader,
     out: &OutputOptions,
 ) -> Result<(), Error> {
-    let (layers, coverage) = sums.layers()?;
+    let (layers, coverage) = sums.layers(out.transparent)?;
     let film = sums.film()?;
     exr_layers::write_window(&r.output, window, &film, &layers, &coverage, header, out)
 }

@@ -36,6 +36,8 @@ pub struct Plan {
     pub environment_map: bool,
     /// Some object has a subsurface material: probe rays will be cast.
     pub subsurface: bool,
+    /// A transparent film: camera rays that escape add nothing.
+    pub transparent: bool,
 }
 
 impl Plan {
@@ -51,6 +53,7 @@ impl Plan {
                 .objects
                 .iter()
                 .any(|o| scene.materials[o.material].is_subsurface()),
+            transparent: scene.output.file.transparent == Some(true),
         }
     }
 }
