@@ -9,10 +9,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
-use lucent::film::cryptomatte;
-use lucent::film::exr_layers::{ExrCompression, Precision, Preview};
+use lucent::film::exr_layers::Preview;
 use lucent::film::passes::PassSet;
-use lucent::film::region::Region;
 use lucent::film::ToneMap;
 use lucent::integrator::{effects, plan, IntegratorKind};
 #[cfg(feature = "subsurface")]
@@ -22,8 +20,10 @@ use lucent::scene;
 use lucent::session;
 use lucent::Error;
 
+mod args;
 mod values;
-use values::{parse_aov, parse_checkpoint, parse_crop, parse_samples, parse_tile};
+use args::{FileArgs, SplitArgs};
+use values::parse_aov;
 
 #[derive(Parser)]
 #[command(
@@ -175,6 +175,28 @@ enum Command {
         #[arg(long)]
         mixed_backends: bool,
     },
+    /// Paste a region render (`render --region`) into a frame: only the
+    /// region's pixels change, bit for bit, in every channel; the frame's
+    /// header and storage stay. The files must have the same display
+    /// window and channels. Writes the EXR and its PNG preview.
+    Paste {
+        /// The region render.
+        region: PathBuf,
+        /// The frame it goes into.
+        frame: PathBuf,
+        /// Output OpenEXR path; the preview goes to the same path with `.png`.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Tone map of the PNG preview (the EXR is always linear).
+        #[arg(long, value_enum, default_value = "filmic")]
+        tonemap: ToneMapArg,
+        /// Exposure of the PNG preview in stops.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = exposure_stops)]
+        exposure: f32,
+        /// No summary line.
+        #[arg(short, long)]
+        quiet: bool,
+    },
     /// Benchmark the ray-query backends on the same meshes and rays: build
     /// time and memory, Mrays/s of camera, incoherent, shadow and probe
     /// rays; bench.csv, report.txt and plots in the output directory. With
@@ -188,43 +210,6 @@ enum Command {
     /// directory (resumes from results.csv; see src/tools/study/mod.rs).
     #[cfg(feature = "subsurface")]
     Study(lucent_tools::study::cli::StudyArgs),
-}
-
-/// Splitting a frame into parts, checkpoints and resuming (docs/farm.md).
-#[derive(clap::Args)]
-struct SplitArgs {
-    /// Render only the pixels X0 ≤ x < X1, Y0 ≤ y < Y1; the output is a
-    /// part for `lucent merge`.
-    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop, conflicts_with = "tile")]
-    crop: Option<Region>,
-    /// Render band I (0-based) of N balanced horizontal bands; the output
-    /// is a part for `lucent merge`.
-    #[arg(long, value_name = "I/N", value_parser = parse_tile)]
-    tile: Option<(u32, u32)>,
-    /// Render only the sample indices A ≤ s < B of each pixel; the output
-    /// is a part for `lucent merge`.
-    #[arg(long, value_name = "A..B", value_parser = parse_samples)]
-    samples: Option<std::ops::Range<u32>>,
-    /// Every SECONDS (at the end of a pass), save the finished samples to
-    /// OUT.partial.exr, atomically, for --resume.
-    #[arg(long, value_name = "SECONDS", value_parser = parse_checkpoint)]
-    checkpoint: Option<f64>,
-    /// Continue from a part this same render left (at a signal or a
-    /// checkpoint): the result is bitwise the uninterrupted render's.
-    #[arg(long, value_name = "PART.exr")]
-    resume: Option<PathBuf>,
-}
-
-impl From<SplitArgs> for session::Split {
-    fn from(a: SplitArgs) -> session::Split {
-        session::Split {
-            crop: a.crop,
-            tile: a.tile,
-            samples: a.samples,
-            checkpoint: a.checkpoint,
-            resume: a.resume,
-        }
-    }
 }
 
 /// The subsurface sampling options, one flag per row of the option table
@@ -280,71 +265,6 @@ impl clap::Args for SubsurfaceArgs {
 impl SubsurfaceArgs {
     fn overrides(&self) -> session::Overrides {
         self.0.clone()
-    }
-}
-
-/// How the EXR is stored (docs/output.md); each overrides the scene's
-/// `[output]` key of the same name.
-#[derive(clap::Args)]
-struct FileArgs {
-    /// Precision of light passes: half | float (data passes, IDs and beauty
-    /// are always float).
-    #[arg(long, value_enum)]
-    aov_precision: Option<PrecisionArg>,
-    /// Lossless EXR compression: none | rle | zips | zip (default) | piz.
-    #[arg(long, value_enum)]
-    exr_compression: Option<CompressionArg>,
-    /// One file per pass (OUT.PASS.exr beside OUT.exr) instead of one
-    /// multi-layer file.
-    #[arg(long, num_args = 0..=1, default_missing_value = "true")]
-    aov_split: Option<bool>,
-    /// Cryptomatte ranks per pixel, 1 to 64 (default 6).
-    #[arg(long)]
-    cryptomatte_ranks: Option<usize>,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum PrecisionArg {
-    Half,
-    Float,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum CompressionArg {
-    None,
-    Rle,
-    Zips,
-    Zip,
-    Piz,
-}
-
-impl FileArgs {
-    /// The command line's settings, in the scene's form (they override it).
-    fn settings(&self) -> Result<scene::OutputSettings, Error> {
-        if let Some(n) = self
-            .cryptomatte_ranks
-            .filter(|n| !(1..=cryptomatte::MAX_RANKS).contains(n))
-        {
-            return Err(Error::Argument {
-                argument: "--cryptomatte-ranks".into(),
-                problem: format!("{n} is not in 1 to {}", cryptomatte::MAX_RANKS),
-            });
-        }
-        Ok(scene::OutputSettings {
-            precision: self.aov_precision.map(|p| match p {
-                PrecisionArg::Half => Precision::Half,
-                PrecisionArg::Float => Precision::Float,
-            }),
-            compression: self.exr_compression.map(|c| match c {
-                CompressionArg::None => ExrCompression::None,
-                CompressionArg::Rle => ExrCompression::Rle,
-                CompressionArg::Zips => ExrCompression::Zips,
-                CompressionArg::Zip => ExrCompression::Zip,
-                CompressionArg::Piz => ExrCompression::Piz,
-            }),
-            split: self.aov_split,
-            cryptomatte_ranks: self.cryptomatte_ranks,
-        })
     }
 }
 
@@ -467,6 +387,24 @@ fn main() -> ExitCode {
             session::merge_parts(&parts, &output, preview, mixed_backends).map(|m| {
                 if !quiet {
                     tell!("{}", m.summary(&output));
+                }
+            })
+        }
+        Command::Paste {
+            region,
+            frame,
+            output,
+            tonemap,
+            exposure,
+            quiet,
+        } => {
+            let preview = Preview {
+                tonemap: tonemap.into(),
+                exposure,
+            };
+            session::paste(&region, &frame, &output, preview).map(|p| {
+                if !quiet {
+                    tell!("{}", p.summary(&output));
                 }
             })
         }

@@ -431,14 +431,17 @@ fn data_passes_of_a_sphere_and_coverage_that_sums_to_one() {
 }
 
 #[test]
-fn a_pixel_no_sample_hits_has_infinite_depth_and_no_ids() {
+fn a_pixel_no_sample_hits_has_the_far_depth_and_no_ids() {
     let s = scene(
         "[camera]\nlook_from = [0, 0, 5]\nlook_at = [0, 0, 0]\nresolution = [4, 4]\n\
          [environment]\nradiance = [1, 1, 1]\n",
     );
     let out = render(&s, "Z,P,object_id,crypto_object,noise");
     for p in 0..16 {
-        assert_eq!(layer(&out, "Z").get(p, 0), f32::INFINITY);
+        assert_eq!(
+            layer(&out, "Z").get(p, 0),
+            lucent::film::pass_sums::DEPTH_MISS
+        );
         assert_eq!(layer(&out, "object_id").get(p, 0), 0.0);
         assert_eq!(layer(&out, "P").get(p, 1), 0.0);
         assert!(out.coverage[0].pixels[p].is_empty());

@@ -455,3 +455,158 @@ fn a_single_and_a_merged_frame_carry_the_same_provenance() {
         "{plan}"
     );
 }
+
+/// `oiiotool PATH --cut WxH+X+Y --printstats`: per channel, (min, max)
+/// over that window.
+fn oiio_min_max(path: &Path, window: &str) -> Vec<(f64, f64)> {
+    let out = Command::new("oiiotool")
+        .arg(path)
+        .args(["--cut", window, "--printstats"])
+        .output()
+        .expect("cannot run oiiotool");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let row = |key: &str| -> Vec<f64> {
+        let line = text
+            .lines()
+            .find_map(|l| l.trim().strip_prefix(key))
+            .unwrap_or_else(|| panic!("no {key} in {text}"));
+        line.split_whitespace()
+            .filter_map(|v| v.parse().ok())
+            .collect()
+    };
+    row("Stats Min:")
+        .into_iter()
+        .zip(row("Stats Max:"))
+        .collect()
+}
+
+/// Whether `name` matches `pattern`, where `<…>` stands for one or more
+/// letters, digits or `_`.
+fn matches_pattern(pattern: &str, name: &str) -> bool {
+    match pattern.find('<') {
+        None => pattern == name,
+        Some(i) => {
+            let end = pattern[i..].find('>').map(|j| i + j + 1).unwrap();
+            let (head, rest) = (&pattern[..i], &pattern[end..]);
+            let Some(tail) = name.strip_prefix(head) else {
+                return false;
+            };
+            (1..=tail.len()).any(|k| {
+                tail[..k]
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_')
+                    && matches_pattern(rest, &tail[k..])
+            })
+        }
+    }
+}
+
+/// The rows of docs/output.md's "Compositing conventions" table: channel
+/// patterns, type, miss value.
+fn conventions_table() -> Vec<(Vec<String>, String, String)> {
+    let doc = std::fs::read_to_string("docs/output.md").unwrap();
+    let (_, after) = doc.split_once("### Compositing conventions").unwrap();
+    after
+        .lines()
+        .skip_while(|l| !l.starts_with("| channels |"))
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            let channels = cells[1]
+                .split('`')
+                .map(str::trim)
+                .filter(|c| !c.is_empty())
+                .map(String::from)
+                .collect();
+            (channels, cells[2].to_string(), cells[3].to_string())
+        })
+        .collect()
+}
+
+/// The conventions table of docs/output.md is what a render with every
+/// pass writes, as oiiotool reads it: every channel matches one row, of
+/// the row's type, and a pixel that sees only the environment has each
+/// row's miss value (depth finite). Caught: depth written as `Z.Z` or
+/// +∞ on a miss, light groups without A, a row for a channel no longer
+/// written.
+#[test]
+fn the_conventions_table_is_what_a_render_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("s.toml"),
+        "[camera]\nlook_from = [0, 0, 4]\nlook_at = [0, 0, 0]\nresolution = [16, 12]\n\
+         [render]\nspp = 2\n[environment]\nradiance = [0.5, 0.5, 0.5]\n\
+         [materials.white]\ntype = \"diffuse\"\nalbedo = [0.8, 0.8, 0.8]\n\
+         [materials.lamp]\ntype = \"diffuse\"\nalbedo = [0, 0, 0]\n\
+         [[shapes]]\ntype = \"sphere\"\nmaterial = \"white\"\n\
+         [[shapes]]\ntype = \"quad\"\nmaterial = \"lamp\"\nemission = [4, 4, 4]\n\
+         light_group = \"key\"\nrotate = [[90, 1, 0, 0]]\ntranslate = [0, 5, 0]\n",
+    )
+    .unwrap();
+    lucent_ok(
+        d,
+        &["render", "s.toml", "--quiet", "--aov", "all", "-o", "f.exr"],
+    );
+    let f = d.join("f.exr");
+    let info = Info::parse(&oiio_info(&f));
+    let table = conventions_table();
+    assert!(table.len() >= 10, "{table:?}");
+    let corner = oiio_min_max(&f, "2x2+0+0");
+    let whole = oiio_min_max(&f, "16x12+0+0");
+    assert_eq!(corner.len(), info.channels.len());
+    let mut used = vec![false; table.len()];
+    for (k, (name, ty)) in info.channels.iter().enumerate() {
+        // the most specific row: the matching pattern with the most fixed
+        // characters (`RGBA_<group>.A` before `<path>.A`)
+        let fixed = |p: &str| {
+            let mut inside = false;
+            p.chars()
+                .filter(|&c| {
+                    inside = (inside || c == '<') && c != '>';
+                    !inside && c != '>'
+                })
+                .count()
+        };
+        let row = table
+            .iter()
+            .enumerate()
+            .flat_map(|(i, (pats, _, _))| pats.iter().map(move |p| (i, p)))
+            .filter(|(_, p)| matches_pattern(p, name))
+            .max_by_key(|(_, p)| fixed(p))
+            .map(|(i, _)| i)
+            .unwrap_or_else(|| panic!("channel {name} is in no row of the table"));
+        used[row] = true;
+        let (_, want_ty, miss) = &table[row];
+        assert!(
+            want_ty.starts_with(ty.as_str()),
+            "{name}: {ty}, the table says {want_ty}"
+        );
+        if let Ok(v) = miss.parse::<f64>() {
+            assert_eq!(
+                corner[k],
+                (v, v),
+                "{name} where only the environment is seen"
+            );
+        }
+        // finite everywhere but the one-sample variance
+        assert!(
+            whole[k].1.is_finite() && whole[k].0.is_finite(),
+            "{name}: {:?}",
+            whole[k]
+        );
+    }
+    for (row, u) in table.iter().zip(used) {
+        assert!(u, "no channel written for the row {:?}", row.0);
+    }
+    // not vacuous: the sphere is hit in the middle, nearer than the far value
+    let z = info.channels.iter().position(|c| c.0 == "Z").unwrap();
+    let mid = oiio_min_max(&f, "2x2+7+5");
+    assert!(mid[z].1 < 4.0, "{:?}", mid[z]);
+}

@@ -16,9 +16,11 @@ mod farm;
 mod obj_mtl;
 #[cfg(feature = "subsurface")]
 mod plan;
+mod region;
 mod scene_errors;
 mod session;
 #[cfg(feature = "subsurface")]
 mod study;
 mod subsurface_feature;
 mod textures;
+mod transparent;

@@ -51,7 +51,7 @@ fn negatives(path: &Path, spp: u32) -> Vec<(String, usize, f32)> {
         ..Job::full(&scene, spp)
     };
     let r = render::render_job(&scene, a.as_ref(), &opts, &job, None, &mut |_| Ok(())).unwrap();
-    let (layers, _) = r.sums.layers().unwrap();
+    let (layers, _) = r.sums.layers(false).unwrap();
     let film = r.sums.film().unwrap();
     let mut found = Vec::new();
     let beauty: Vec<f32> = film.pixels.iter().flat_map(|p| p.to_array()).collect();

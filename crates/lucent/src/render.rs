@@ -530,6 +530,12 @@ pub fn render_passes(
     passes: PassSet,
 ) -> Result<RenderOutput, Error> {
     let spp = Settings::resolved(scene, opts).spp;
+    // a transparent film's A is the object coverage's count of hits
+    let transparent = scene.output.file.transparent == Some(true);
+    let mut passes = passes;
+    if transparent {
+        passes.insert(crate::film::passes::Pass::CryptoObject);
+    }
     let job = Job {
         passes,
         ..Job::full(scene, spp)
@@ -538,7 +544,7 @@ pub fn render_passes(
     if let Some(sig) = r.interrupted {
         return Err(Error::Interrupted(sig));
     }
-    let (layers, coverage) = r.sums.layers()?;
+    let (layers, coverage) = r.sums.layers(transparent)?;
     Ok(RenderOutput {
         film: r.sums.film()?,
         layers,

@@ -385,11 +385,17 @@ fn ascii(json: String) -> String {
 /// The file options of a frame, as `lucent.output` says them.
 pub fn output_text(o: &OutputOptions) -> String {
     format!(
-        "precision={} compression={} split={} ranks={}",
+        "precision={} compression={} split={} ranks={}{}",
         o.precision.name(),
         o.compression.name(),
         o.split,
-        o.cryptomatte_ranks
+        o.cryptomatte_ranks,
+        // said only when on: an opaque film's text is what it always was
+        if o.transparent {
+            " transparent=true"
+        } else {
+            ""
+        }
     )
 }
 
@@ -404,11 +410,19 @@ pub fn parse_output(s: &str) -> Option<OutputOptions> {
             "compression" => o.compression = ExrCompression::parse(v)?,
             "split" => o.split = v.parse().ok()?,
             "ranks" => o.cryptomatte_ranks = v.parse().ok()?,
+            "transparent" if v == "true" && seen == 4 => {
+                o.transparent = true;
+                seen += 1;
+                continue;
+            }
             _ => return None,
         }
         seen += 1;
+        if seen > 4 {
+            return None;
+        }
     }
-    (seen == 4).then_some(o)
+    (seen == 4 || (seen == 5 && o.transparent)).then_some(o)
 }
 
 /// The layout a part's identity describes (None: no passes).

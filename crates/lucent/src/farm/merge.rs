@@ -276,7 +276,7 @@ pub fn merge(paths: &[PathBuf], mixed_backends: bool) -> Result<Merged, Error> {
             }
         }
     }
-    let (layers, coverage) = sums.layers()?;
+    let (layers, coverage) = sums.layers(output.transparent)?;
     Ok(Merged {
         film: sums.film()?,
         layers,

@@ -25,6 +25,9 @@
 //!   keeps them sorted). Sorting keeps the header's length, so the offset
 //!   table stays valid. Same inputs → the same bytes, except that the
 //!   render time is one of the inputs.
+//! - **Windows:** the display window is the whole frame; the data window
+//!   is the pixels the file holds ([`Window`]): the frame, or the region of
+//!   a region render (`--region`), a normal EXR every viewer places.
 //! - **Atomic:** every file (and the PNG preview) is written to a temporary
 //!   file and all are committed together ([`super::commit_all`]): all
 //!   appear, or none does.
@@ -34,14 +37,18 @@ use std::path::{Path, PathBuf};
 
 use exr::meta::attribute::{AttributeValue, Text};
 use exr::prelude::{
-    f16, AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image,
-    LayerAttributes, LineOrder, SmallVec, WritableImage,
+    f16, AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, IntegerBounds,
+    LayerAttributes, LineOrder, SmallVec, Vec2, WritableImage,
 };
+
+mod read;
+pub use read::{read_attributes, text_attribute};
 
 use super::cryptomatte::{self, DEFAULT_RANKS};
 use super::exr_attributes::text;
 pub use super::exr_attributes::FrameHeader;
 use super::layers::{Coverage, Layer, LayerKind};
+use super::region::Region;
 use super::{commit_all, preview_path, Film, Staged, ToneMap};
 use crate::error::Error;
 
@@ -143,6 +150,9 @@ pub struct OutputOptions {
     pub cryptomatte_ranks: usize,
     /// The PNG preview beside the EXR, if any.
     pub preview: Option<Preview>,
+    /// A transparent film: the environment seen directly is left out of
+    /// the beauty and `A` is the camera rays' coverage.
+    pub transparent: bool,
 }
 
 impl Default for OutputOptions {
@@ -153,6 +163,7 @@ impl Default for OutputOptions {
             split: false,
             cryptomatte_ranks: DEFAULT_RANKS,
             preview: None,
+            transparent: false,
         }
     }
 }
@@ -167,6 +178,25 @@ pub fn split_path(path: &Path, pass: &str) -> PathBuf {
     path.with_file_name(format!("{stem}.{pass}.exr"))
 }
 
+/// Where a file's pixels sit in the frame: the display window is the
+/// whole `frame` (width, height) from (0, 0); the data window, the pixels
+/// the file holds, is `data` (the frame itself, or a region).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Window {
+    pub frame: (u32, u32),
+    pub data: Region,
+}
+
+impl Window {
+    /// The whole `width`×`height` frame.
+    pub fn full(width: u32, height: u32) -> Window {
+        Window {
+            frame: (width, height),
+            data: Region::full(width, height),
+        }
+    }
+}
+
 /// Writes the frame: beauty from `film`, the passes `layers` and the
 /// Cryptomatte of each `coverage`, with `header`'s attributes, as `opts`
 /// says, plus the PNG preview; every file appears or none does.
@@ -178,13 +208,31 @@ pub fn write_frame(
     header: &FrameHeader,
     opts: &OutputOptions,
 ) -> Result<(), Error> {
-    commit_all(stage_frame(path, film, layers, coverage, header, opts)?)
+    let window = Window::full(film.width, film.height);
+    write_window(path, window, film, layers, coverage, header, opts)
 }
 
-/// [`write_frame`] to temporary files only, for [`commit_all`] (with other
-/// outputs of the same command).
+/// [`write_frame`] for the pixels of `window.data` (`film`, the layers and
+/// the coverage are that region's) placed in the frame `window.frame`.
+pub fn write_window(
+    path: &Path,
+    window: Window,
+    film: &Film,
+    layers: &[Layer],
+    coverage: &[Coverage],
+    header: &FrameHeader,
+    opts: &OutputOptions,
+) -> Result<(), Error> {
+    commit_all(stage_frame(
+        path, window, film, layers, coverage, header, opts,
+    )?)
+}
+
+/// [`write_window`] to temporary files only, for [`commit_all`] (with
+/// other outputs of the same command).
 pub(crate) fn stage_frame(
     path: &Path,
+    window: Window,
     film: &Film,
     layers: &[Layer],
     coverage: &[Coverage],
@@ -192,11 +240,28 @@ pub(crate) fn stage_frame(
     opts: &OutputOptions,
 ) -> Result<Vec<Staged>, Error> {
     let pixels = film.pixels.len();
+    let d = window.data;
+    if (d.width(), d.height()) != (film.width, film.height)
+        || !d.within(&Region::full(window.frame.0, window.frame.1))
+    {
+        return Err(Error::Runtime(format!(
+            "cannot write a {}×{} image as the pixels {d} of a {}×{} frame",
+            film.width, film.height, window.frame.0, window.frame.1
+        )));
+    }
     check_layers(layers, coverage, pixels)?;
-    let attributes = header.attributes(film.width, film.height);
+    let attributes = header.attributes(window.frame.0, window.frame.1);
+    // a transparent film's alpha replaces the opaque A, beside R, G, B
+    let alpha = layers.iter().find(|l| l.name == "A");
+    let mut beauty = beauty_planes(film, alpha.is_none())?;
+    beauty.extend(
+        alpha
+            .map(|a| layer_planes(a, Precision::Float))
+            .unwrap_or_default(),
+    );
     let mut files: Vec<File> = vec![File {
         path: path.to_path_buf(),
-        planes: beauty_planes(film)?,
+        planes: beauty,
         attributes: attributes.clone(),
     }];
     let mut add = |name: &str, planes: Vec<Plane>, extra: Vec<(String, AttributeValue)>| {
@@ -215,6 +280,9 @@ pub(crate) fn stage_frame(
         }
     };
     for layer in layers {
+        if layer.name == "A" {
+            continue;
+        }
         add(&layer.name, layer_planes(layer, opts.precision), Vec::new());
     }
     for cov in coverage {
@@ -236,7 +304,7 @@ pub(crate) fn stage_frame(
     }
     let mut staged = Vec::with_capacity(files.len() + 1);
     for f in files {
-        staged.push(f.stage(film.width, film.height, opts.compression)?);
+        staged.push(f.stage(window, opts.compression)?);
     }
     if let Some(p) = opts.preview {
         staged.push(film.stage_png(&preview_path(path), p.tonemap, p.exposure)?);
@@ -258,9 +326,13 @@ struct File {
 }
 
 impl File {
-    fn stage(self, width: u32, height: u32, compression: ExrCompression) -> Result<Staged, Error> {
+    fn stage(self, window: Window, compression: ExrCompression) -> Result<Staged, Error> {
         // the standard attributes the exr crate keeps in fields of their own
-        let mut attributes = LayerAttributes::default();
+        let d = window.data;
+        let mut attributes = LayerAttributes {
+            layer_position: Vec2(d.x0 as i32, d.y0 as i32),
+            ..LayerAttributes::default()
+        };
         for (name, value) in self.attributes {
             match (name.as_str(), value) {
                 ("software", AttributeValue::Text(t)) => attributes.software_name = Some(t),
@@ -288,17 +360,28 @@ impl File {
             line_order: LineOrder::Increasing,
         };
         let layer = exr::image::Layer::new(
-            (width as usize, height as usize),
+            (d.width() as usize, d.height() as usize),
             attributes,
             encoding,
             AnyChannels::sort(channels),
         );
-        let image = Image::from_layer(layer);
-        Staged::write(&self.path, |tmp| {
-            image.write().non_parallel().to_unbuffered(&mut *tmp)?;
-            sort_header_in_file(tmp)
-        })
+        let mut image = Image::from_layer(layer);
+        let (w, h) = (window.frame.0 as usize, window.frame.1 as usize);
+        image.attributes.display_window = IntegerBounds::new((0, 0), (w, h));
+        stage_image(&self.path, &image)
     }
+}
+
+/// A flat single-layer EXR image with any channels, as the exr crate holds it.
+pub type AnyImage = Image<exr::image::Layer<AnyChannels<FlatSamples>>>;
+
+/// Stages `image` at `path` with deterministic bytes: blocks compressed
+/// and written in order, the header's attributes sorted by name.
+pub(crate) fn stage_image(path: &Path, image: &AnyImage) -> Result<Staged, Error> {
+    Staged::write(path, |tmp| {
+        image.write().non_parallel().to_unbuffered(&mut *tmp)?;
+        sort_header_in_file(tmp)
+    })
 }
 
 /// Why the frame's EXR could not be written to its temporary file: the
@@ -338,10 +421,10 @@ fn sort_header_in_file(f: &mut std::fs::File) -> Result<(), FrameWriteError> {
     }
 }
 
-/// Beauty: `R`, `G`, `B` from the film, `A` = 1, 32-bit float (16 bytes a
-/// pixel beside the film's 12; failing with a message, not aborting, when
-/// that cannot be allocated).
-fn beauty_planes(film: &Film) -> Result<Vec<Plane>, Error> {
+/// Beauty: `R`, `G`, `B` from the film and, when `opaque`, `A` = 1, 32-bit
+/// float (16 bytes a pixel beside the film's 12; failing with a message,
+/// not aborting, when that cannot be allocated).
+fn beauty_planes(film: &Film, opaque: bool) -> Result<Vec<Plane>, Error> {
     let n = film.pixels.len();
     let plane = |name: &str, f: fn(&crate::geometry::Vec3) -> f32| {
         let mut v = Vec::new();
@@ -353,12 +436,15 @@ fn beauty_planes(film: &Film) -> Result<Vec<Plane>, Error> {
             samples: FlatSamples::F32(v),
         })
     };
-    Ok(vec![
+    let mut planes = vec![
         plane("R", |p| p.x)?,
         plane("G", |p| p.y)?,
         plane("B", |p| p.z)?,
-        plane("A", |_| 1.0)?,
-    ])
+    ];
+    if opaque {
+        planes.push(plane("A", |_| 1.0)?);
+    }
+    Ok(planes)
 }
 
 /// A pass's channels `layer.channel`, half only for light passes at half
@@ -373,7 +459,7 @@ fn layer_planes(layer: &Layer, precision: Precision) -> Vec<Plane> {
         .map(|(c, ch)| {
             let values = layer.values.iter().skip(c).step_by(n).copied();
             Plane {
-                name: format!("{}.{ch}", layer.name),
+                name: channel_name(layer, ch),
                 samples: if half {
                     FlatSamples::F16(values.map(f16::from_f32).collect())
                 } else {
@@ -382,6 +468,17 @@ fn layer_planes(layer: &Layer, precision: Precision) -> Vec<Plane> {
             }
         })
         .collect()
+}
+
+/// The EXR channel of `layer`'s channel `ch`: `layer.ch`, or the bare
+/// name for a layer of one channel of its own name (depth: `Z`, what
+/// compositors read as depth).
+fn channel_name(layer: &Layer, ch: &str) -> String {
+    if layer.channels.len() == 1 && layer.name == ch {
+        ch.to_string()
+    } else {
+        format!("{}.{ch}", layer.name)
+    }
 }
 
 /// Layer and channel names that make well-formed, distinct channels, and
@@ -396,7 +493,9 @@ fn check_layers(layers: &[Layer], coverage: &[Coverage], pixels: usize) -> Resul
         .map(|c| cryptomatte::layer_name(&c.kind))
         .collect();
     for l in layers {
-        if !ok_name(&l.name) || ["R", "G", "B", "A"].contains(&l.name.as_str()) {
+        // `A` only as the one-channel alpha of a transparent film
+        let alpha = l.name == "A" && l.channels == ["A"];
+        if !ok_name(&l.name) || (["R", "G", "B", "A"].contains(&l.name.as_str()) && !alpha) {
             return bad(format!("\"{}\": not a layer name", l.name));
         }
         if l.channels.is_empty() || !l.channels.iter().all(|c| ok_name(c)) {
@@ -477,56 +576,6 @@ fn sort_header_attributes(bytes: &mut [u8]) -> Result<usize, FrameWriteError> {
     }
     bytes[8..at].copy_from_slice(&sorted);
     Ok(at)
-}
-
-/// The header attributes of a file, for tests and tools: (name, value).
-pub fn read_attributes(path: &Path) -> Result<Vec<(String, AttributeValue)>, Error> {
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| Error::Read {
-        path: path.to_path_buf(),
-        problem: e.to_string(),
-    })?;
-    let mut out = Vec::new();
-    for h in &meta.headers {
-        let own = &h.own_attributes;
-        if let Some(s) = &own.software_name {
-            out.push(("software".to_string(), AttributeValue::Text(s.clone())));
-        }
-        if let Some(d) = &own.capture_date {
-            out.push(("capDate".to_string(), AttributeValue::Text(d.clone())));
-        }
-        if let Some(o) = own.utc_offset {
-            out.push(("utcOffset".to_string(), AttributeValue::F32(o)));
-        }
-        for (name, m) in [
-            ("worldToCamera", own.world_to_camera),
-            ("worldToNDC", own.world_to_normalized_device),
-        ] {
-            if let Some(m) = m {
-                out.push((name.to_string(), AttributeValue::Matrix4x4(m)));
-            }
-        }
-        for (k, v) in h
-            .own_attributes
-            .other
-            .iter()
-            .chain(&h.shared_attributes.other)
-        {
-            out.push((k.to_string(), v.clone()));
-        }
-    }
-    out.sort_by(|a, b| a.0.cmp(&b.0));
-    Ok(out)
-}
-
-/// The string attribute `name` of `attributes`, if present.
-pub fn text_attribute(attributes: &[(String, AttributeValue)], name: &str) -> Option<String> {
-    attributes
-        .iter()
-        .find(|a| a.0 == name)
-        .and_then(|a| match &a.1 {
-            AttributeValue::Text(t) => String::from_utf8(t.bytes().to_vec()).ok(),
-            _ => None,
-        })
 }
 
 #[cfg(test)]

@@ -40,6 +40,9 @@ pub struct Layout {
 }
 
 const RGB: &[&str] = &["R", "G", "B"];
+/// A light group's channels: its light, and the frame's alpha (the
+/// compositing convention for `RGBA_<group>` layers; not summed).
+const RGBA: &[&str] = &["R", "G", "B", "A"];
 const XYZ: &[&str] = &["X", "Y", "Z"];
 
 /// A layer of summed channels, as a part lists it: name, channels, and
@@ -67,7 +70,7 @@ impl Layout {
             let sums = match pass {
                 Pass::Variance => channels.len() * SQUARE_WORDS,
                 p if LIGHT_PATHS.contains(&p) => channels.len(),
-                Pass::LightGroups | Pass::Albedo | Pass::Normal => channels.len(),
+                Pass::LightGroups | Pass::Albedo | Pass::Normal => 3,
                 _ => 0,
             };
             slots.push(Slot {
@@ -86,7 +89,7 @@ impl Layout {
             match pass {
                 Pass::LightGroups => {
                     for (g, group) in groups.iter().enumerate() {
-                        add(pass, g, format!("RGBA_{group}"), RGB, Light);
+                        add(pass, g, format!("RGBA_{group}"), RGBA, Light);
                     }
                 }
                 p if LIGHT_PATHS.contains(&p) => add(p, 0, name, RGB, Light),
@@ -160,7 +163,8 @@ impl Layout {
                 {
                     v.push(SumLayer {
                         name: s.name.clone(),
-                        channels: s.channels.iter().map(|c| c.to_string()).collect(),
+                        // a light group's A is the frame's, not a sum
+                        channels: RGB.iter().map(|c| c.to_string()).collect(),
                         frac_bits: FixedPoint::RADIANCE.frac_bits,
                     })
                 }

@@ -218,10 +218,18 @@ pub fn layers<'b>(
     width: u32,
     height: u32,
     n: u64,
+    alpha: bool,
     at: impl Fn(u32, u32) -> (usize, &'b [i128]),
 ) -> Result<(Vec<Layer>, Vec<Coverage>), Error> {
     let pixels = width as usize * height as usize;
     let mut layers = empty_layers(layout, pixels)?;
+    let alpha = alpha && !aov.objects.is_empty();
+    let mut a_layer = alpha.then(|| Layer {
+        name: "A".into(),
+        channels: vec!["A".into()],
+        kind: super::layers::LayerKind::Data,
+        values: Vec::with_capacity(pixels),
+    });
     let coverage_of = |p: Pass, kind: &str, names: &[String]| {
         layout.passes.contains(p).then(|| Coverage {
             kind: kind.to_string(),
@@ -237,8 +245,17 @@ pub fn layers<'b>(
             let (i, beauty) = at(x, y);
             let sums = &aov.sums[i * st..(i + 1) * st];
             let near = aov.nearest.get(i).copied().unwrap_or(Nearest::NONE);
+            let a = match &mut a_layer {
+                Some(l) => {
+                    let hits: u64 = aov.objects[i].iter().map(|&(_, c)| c as u64).sum();
+                    let a = (hits as f64 / n.max(1) as f64) as f32;
+                    l.values.push(a);
+                    a
+                }
+                None => 1.0,
+            };
             for (layer, slot) in layers.iter_mut().zip(layout.slots()) {
-                let v = slot_value(slot, sums, beauty, near, n);
+                let v = slot_value(slot, sums, beauty, near, n, a);
                 layer.values.extend_from_slice(&v[..slot.channels.len()]);
             }
             let fractions = |counts: &[(u32, u32)]| {
@@ -255,6 +272,7 @@ pub fn layers<'b>(
             }
         }
     }
+    layers.extend(a_layer);
     Ok((layers, objects.into_iter().chain(materials).collect()))
 }
 
@@ -279,14 +297,27 @@ fn empty_layers(layout: &Layout, pixels: usize) -> Result<Vec<Layer>, Error> {
     Ok(layers)
 }
 
+/// The depth `Z` of a pixel no camera ray hit: a large finite value (as
+/// Cycles writes), so filters and blurs over an edge stay finite.
+pub const DEPTH_MISS: f32 = 1e10;
+
 /// A pixel's value of the layer of `slot` (its first channels), from the
-/// pixel's pass sums, its beauty sums, its nearest hit and `n` samples.
-fn slot_value(slot: &Slot, sums: &[i128], beauty: &[i128], near: Nearest, n: u64) -> [f32; 3] {
+/// pixel's pass sums, its beauty sums, its nearest hit, `n` samples and
+/// the frame's alpha there.
+fn slot_value(
+    slot: &Slot,
+    sums: &[i128],
+    beauty: &[i128],
+    near: Nearest,
+    n: u64,
+    alpha: f32,
+) -> [f32; 4] {
     const F: FixedPoint = FixedPoint::RADIANCE;
     let o = slot.offset;
     let mean = |k: usize| F.mean(sums[o + k], n);
-    match slot.pass {
+    let [x, y, z] = match slot.pass {
         Pass::Position => near.p,
+        Pass::Depth if near.object == 0 => [DEPTH_MISS, 0.0, 0.0],
         Pass::Depth => [near.z, 0.0, 0.0],
         Pass::ObjectId => [near.object as f32, 0.0, 0.0],
         Pass::MaterialId => [near.material as f32, 0.0, 0.0],
@@ -296,7 +327,8 @@ fn slot_value(slot: &Slot, sums: &[i128], beauty: &[i128], near: Nearest, n: u64
             variance(beauty[c], &sums[w..w + SQUARE_WORDS], n)
         }),
         _ => [mean(0), mean(1), mean(2)],
-    }
+    };
+    [x, y, z, alpha]
 }
 
 #[cfg(test)]
@@ -356,11 +388,11 @@ mod tests {
         let layout = Layout::new([Pass::Albedo].into_iter().collect(), &names, &names, &names);
         let aov = AovSums::new(&layout, 0).unwrap();
         let at = |_: u32, _: u32| -> (usize, &[i128]) { unreachable!("no pixel is read") };
-        let e = layers(&layout, &aov, 1 << 30, 1 << 30, 1, at).unwrap_err();
+        let e = layers(&layout, &aov, 1 << 30, 1 << 30, 1, false, at).unwrap_err();
         let text = e.to_string();
         assert!(text.contains(&format!("{} MB", 3u64 << 42)), "{text}");
         assert!(text.contains(Pass::Albedo.name()), "{text}");
-        let e = layers(&layout, &aov, u32::MAX, u32::MAX, 1, at).unwrap_err();
+        let e = layers(&layout, &aov, u32::MAX, u32::MAX, 1, false, at).unwrap_err();
         assert!(e.to_string().contains("out of memory"), "{e}");
     }
 

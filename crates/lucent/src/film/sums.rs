@@ -162,7 +162,10 @@ impl Sums {
 
     /// The region's passes (layers in output order, and ID coverage) from
     /// their sums and the [`count`](Self::count): none without passes.
-    pub fn layers(&self) -> Result<(Vec<Layer>, Vec<Coverage>), Error> {
+    /// With `alpha` (a transparent film, whose passes keep the object
+    /// coverage), a layer `A` too: the fraction of samples whose camera
+    /// ray hit, which the light groups' `A` repeat.
+    pub fn layers(&self, alpha: bool) -> Result<(Vec<Layer>, Vec<Coverage>), Error> {
         let Some(p) = &self.passes else {
             return Ok((Vec::new(), Vec::new()));
         };
@@ -173,6 +176,7 @@ impl Sums {
             r.width(),
             r.height(),
             self.count() as u64,
+            alpha,
             |x, y| {
                 let (x, y) = (x + r.x0, y + r.y0);
                 (self.index(x, y), self.pixel(x, y))

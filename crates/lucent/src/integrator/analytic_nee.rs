@@ -126,11 +126,10 @@ pub(crate) fn found<R: Recorder>(
                 (le, weight(ctx, path.prev, |p| s.pdf(p)), Pass::Emission)
             }
             Light::Distant(d) => {
-                let Some((le, pdf)) = t_hit
-                    .is_none()
-                    .then(|| d.escaped(ray.d.normalize()))
-                    .flatten()
-                else {
+                // a transparent film leaves the sky seen directly out,
+                // suns with it
+                let seen = t_hit.is_none() && !(depth == 0 && ctx.plan.transparent);
+                let Some((le, pdf)) = seen.then(|| d.escaped(ray.d.normalize())).flatten() else {
                     continue;
                 };
                 (le, weight(ctx, path.prev, |_| pdf), Pass::Background)

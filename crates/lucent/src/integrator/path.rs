@@ -109,7 +109,8 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
             l += analytic_nee::found(ctx, &path, nearest_hit.map(|h| h.t), depth, st.rec);
         }
         let Some(hit) = nearest_hit else {
-            if ctx.plan.environment {
+            // a transparent film leaves the environment seen directly out
+            if ctx.plan.environment && !(depth == 0 && ctx.plan.transparent) {
                 l += environment(ctx, &path, depth, st.rec);
             }
             break;

@@ -148,6 +148,8 @@ pub struct OutputDef {
     pub aov_split: Option<bool>,
     /// Cryptomatte ranks per pixel.
     pub cryptomatte_ranks: Option<Spanned<u32>>,
+    /// A transparent film.
+    pub transparent: Option<bool>,
 }
 
 /// `[environment]`: a constant `radiance`, or an image `file` with its

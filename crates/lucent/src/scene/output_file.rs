@@ -15,6 +15,8 @@ pub struct OutputSettings {
     pub compression: Option<ExrCompression>,
     pub split: Option<bool>,
     pub cryptomatte_ranks: Option<usize>,
+    /// A transparent film (docs/output.md, "Transparent film").
+    pub transparent: Option<bool>,
 }
 
 impl OutputSettings {
@@ -26,6 +28,7 @@ impl OutputSettings {
             split: self.split.unwrap_or(base.split),
             cryptomatte_ranks: self.cryptomatte_ranks.unwrap_or(base.cryptomatte_ranks),
             preview: base.preview,
+            transparent: self.transparent.unwrap_or(base.transparent),
         }
     }
 }
@@ -75,6 +78,7 @@ pub(super) fn output_file(cx: &Cx, d: &OutputDef) -> Res<OutputSettings> {
         compression,
         split: d.aov_split,
         cryptomatte_ranks,
+        transparent: d.transparent,
     })
 }
 
@@ -96,7 +100,7 @@ mod tests {
     fn keys_are_read_and_bad_values_named_by_line_and_field() {
         let s = load(
             "aov_precision = \"half\"\nexr_compression = \"piz\"\naov_split = true\n\
-             cryptomatte_ranks = 4",
+             cryptomatte_ranks = 4\ntransparent = true",
         )
         .unwrap();
         assert_eq!(
@@ -106,12 +110,13 @@ mod tests {
                 compression: Some(ExrCompression::Piz),
                 split: Some(true),
                 cryptomatte_ranks: Some(4),
+                transparent: Some(true),
             }
         );
         let o = s.over(OutputOptions::default());
         assert_eq!(
-            (o.precision, o.split, o.cryptomatte_ranks),
-            (Precision::Half, true, 4)
+            (o.precision, o.split, o.cryptomatte_ranks, o.transparent),
+            (Precision::Half, true, 4, true)
         );
         assert_eq!(load("").unwrap(), OutputSettings::default());
         for (text, field, line) in [

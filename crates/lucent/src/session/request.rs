@@ -33,8 +33,11 @@ pub struct Request {
 /// Splitting a frame into parts, checkpoints and resuming (docs/farm.md).
 #[derive(Clone, Debug, Default)]
 pub struct Split {
-    /// Only these pixels.
+    /// Only these pixels, as a part.
     pub crop: Option<Region>,
+    /// Only these pixels, as a frame: a viewable EXR whose data window is
+    /// the region (docs/output.md, "Region renders").
+    pub region: Option<Region>,
     /// Only band I of N balanced horizontal bands.
     pub tile: Option<(u32, u32)>,
     /// Only these sample indices of each pixel.

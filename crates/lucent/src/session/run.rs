@@ -14,7 +14,7 @@ use crate::accel;
 use crate::error::{Error, InputError};
 use crate::farm::part;
 use crate::film::exr_attributes::FrameHeader;
-use crate::film::exr_layers::{self, OutputOptions};
+use crate::film::exr_layers::{self, OutputOptions, Window};
 use crate::film::passes::PassSet;
 use crate::film::region::Region;
 use crate::film::Sums;
@@ -86,14 +86,17 @@ fn check_counts(r: &Request) -> Result<(), Error> {
 
 /// The pixels `split` asks for, inside the `w`×`h` frame.
 fn region_of(split: &Split, w: u32, h: u32) -> Result<Region, Error> {
-    Ok(match (split.crop, split.tile) {
-        (Some(c), _) if !c.within(&Region::full(w, h)) => {
+    let rect = [("--crop", split.crop), ("--region", split.region)]
+        .into_iter()
+        .find_map(|(flag, r)| r.map(|r| (flag, r)));
+    Ok(match (rect, split.tile) {
+        (Some((flag, c)), _) if !c.within(&Region::full(w, h)) => {
             return Err(Error::Argument {
-                argument: "--crop".into(),
+                argument: flag.into(),
                 problem: format!("{c} is not inside the {w}×{h} frame"),
             })
         }
-        (Some(c), _) => c,
+        (Some((_, c)), _) => c,
         (None, Some((i, n))) => Region::band(i, n, w, h).ok_or_else(|| Error::Argument {
             argument: "--tile".into(),
             problem: format!("{i}/{n}: the {w}×{h} frame splits into at most {h} bands"),
@@ -124,6 +127,10 @@ fn load(r: &Request) -> Result<(Scene, String, String), Error> {
     let text = scene::load::read_regular_file(&r.scene, scene::load::MAX_SCENE_BYTES)
         .map_err(|e| InputError::new(&r.scene, format!("cannot read scene file: {e}")))?;
     let options = overrides::apply(&r.overrides, &mut scene.materials)?;
+    // the film is the renderer's to know (`integrator::plan::Plan`)
+    if let Some(t) = r.file.transparent {
+        scene.output.file.transparent = Some(t);
+    }
     Ok((scene, text, options))
 }
 
@@ -138,9 +145,9 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let region = region_of(&r.split, w, h)?;
     let samples = samples_of(&r.split, settings.spp)?;
-    let passes = r.aov.unwrap_or(scene.output.aovs);
-    let layout = (!passes.is_empty()).then(|| crate::integrator::aov::layout(&scene, passes));
     let mut out = output_options(r, &scene);
+    let passes = film_passes(r.aov.unwrap_or(scene.output.aovs), &out);
+    let layout = (!passes.is_empty()).then(|| crate::integrator::aov::layout(&scene, passes));
     // parts and resumes record the backend this machine resolves to
     let backend = r.backend.resolve().unwrap_or(r.backend);
     let identity = identity::identity(
@@ -227,7 +234,11 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
             date: Some(super::provenance::date_now()),
             ..frame.clone()
         };
-        write_frame(r, &done.sums, &header, &out)?;
+        let window = Window {
+            frame: (w, h),
+            data: region,
+        };
+        write_frame(r, window, &done.sums, &header, &out)?;
     }
     if this.owns(&keep) {
         checkpoint::clean(&keep);
@@ -252,6 +263,16 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
 fn output_options(r: &Request, scene: &Scene) -> OutputOptions {
     r.file
         .over(scene.output.file.over(OutputOptions::default()))
+}
+
+/// The passes a render sums: those asked for, and with a transparent film
+/// the object coverage (its counts of camera rays that hit are `A`).
+fn film_passes(asked: PassSet, out: &OutputOptions) -> PassSet {
+    let mut passes = asked;
+    if out.transparent {
+        passes.insert(crate::film::passes::Pass::CryptoObject);
+    }
+    passes
 }
 
 /// The scene file's name, for part headers.
@@ -298,14 +319,16 @@ fn keep_interrupted(
     })
 }
 
-/// Writes the finished frame's layers to the output EXR.
+/// Writes the finished frame's layers to the output EXR, its pixels at
+/// `window`.
 fn write_frame(
     r: &Request,
+    window: Window,
     sums: &Sums,
     header: &FrameHeader,
     out: &OutputOptions,
 ) -> Result<(), Error> {
-    let (layers, coverage) = sums.layers()?;
+    let (layers, coverage) = sums.layers(out.transparent)?;
     let film = sums.film()?;
-    exr_layers::write_frame(&r.output, &film, &layers, &coverage, header, out)
+    exr_layers::write_window(&r.output, window, &film, &layers, &coverage, header, out)
 }

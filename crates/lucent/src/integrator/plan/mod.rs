@@ -39,6 +39,8 @@ pub struct Plan {
     /// The scene has `[[lights]]`: light-sample them where lights are
     /// sampled, and weigh what rays find of them by MIS.
     pub analytic_lights: bool,
+    /// A transparent film: camera rays that escape add nothing.
+    pub transparent: bool,
 }
 
 impl Plan {
@@ -55,6 +57,7 @@ impl Plan {
                 .iter()
                 .any(|o| scene.materials[o.material].is_subsurface()),
             analytic_lights: !scene.lights.is_empty(),
+            transparent: scene.output.file.transparent == Some(true),
         }
     }
 }
