@@ -69,10 +69,16 @@ fn unusable_textures_exit_2_naming_file_line_field_and_reason() {
             "absent.png: cannot read it",
         ),
         (
-            scene("file = \"a.jpg\"", albedo),
-            Box::new(|d| std::fs::write(d.join("a.jpg"), b"\xff\xd8\xff").unwrap()),
+            scene("file = \"a.gif\"", albedo),
+            Box::new(|d| std::fs::write(d.join("a.gif"), b"GIF89a").unwrap()),
             "textures.t.file",
-            "unsupported texture format \"jpg\"",
+            "unsupported texture format \"gif\"",
+        ),
+        (
+            scene("file = \"cut.jpg\"", albedo),
+            Box::new(|d| std::fs::write(d.join("cut.jpg"), b"\xff\xd8\xff").unwrap()),
+            "textures.t.file",
+            "cut.jpg: cannot read it",
         ),
         (
             scene("file = \"bad.png\"", albedo),

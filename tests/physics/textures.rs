@@ -83,6 +83,34 @@ fn a_marker_texel_lands_at_the_predicted_pixel() {
     );
 }
 
+/// The mistake: a JPEG texture decoded other than as stored (channels
+/// swapped, left linear, rows flipped). A JPEG renders exactly as a PNG
+/// of the pixels the JPEG decodes to.
+#[test]
+fn a_jpeg_texture_renders_as_the_png_of_its_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let img = image::RgbImage::from_fn(8, 8, |x, y| {
+        image::Rgb([(x * 30) as u8, (y * 30) as u8, 200 - (x * y) as u8])
+    });
+    img.save(dir.path().join("t.jpg")).unwrap();
+    let decoded = image::open(dir.path().join("t.jpg")).unwrap().into_rgb8();
+    assert_ne!(decoded.get_pixel(7, 0), decoded.get_pixel(0, 7));
+    decoded.save(dir.path().join("t.png")).unwrap();
+    let frame = |file: &str| {
+        run(&load(
+            dir.path(),
+            &format!(
+                "{QUAD_VIEW}[textures.t]\nfile = \"{file}\"\n\
+                 [materials.m]\ntype = \"diffuse\"\nalbedo_texture = \"t\"\n\
+                 [[shapes]]\ntype = \"quad\"\nmaterial = \"m\"\n"
+            ),
+        ))
+    };
+    let (jpeg, png) = (frame("t.jpg"), frame("t.png"));
+    assert!(jpeg.pixels.iter().any(|p| p.max_element() > 0.1));
+    assert_eq!(jpeg.pixels, png.pixels);
+}
+
 /// A sphere on a floor under an area light: an albedo texture of one
 /// colour renders as the constant albedo it decodes to.
 #[test]

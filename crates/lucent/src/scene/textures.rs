@@ -16,9 +16,9 @@ use crate::materials::{Material, Textured};
 use crate::texture::file::{self, Format, TextureError};
 use crate::texture::{ColorSpace, Texture, TextureRef, Wrap};
 
-/// The largest PNG file read (bytes); its decoded size is bounded by
+/// The largest PNG or JPEG file read (bytes); its decoded size is bounded by
 /// [`file::MAX_TEXELS`] besides.
-const MAX_PNG_BYTES: u64 = 1 << 30;
+const MAX_IMAGE_BYTES: u64 = 1 << 30;
 
 /// A loaded texture and how its values were decoded.
 pub(super) struct Entry {
@@ -115,9 +115,10 @@ fn read(path: &Path, space: ColorSpace) -> Result<crate::environment::image::Tex
     let format = file::format_of(path).map_err(|e| e.to_string())?;
     let cannot = |e: std::io::Error| format!("cannot read it: {e}");
     match format {
-        Format::Png => {
-            let bytes = read_regular_bytes(path, MAX_PNG_BYTES).map_err(cannot)?;
-            file::read_png(&bytes, space).map_err(|e| TextureError::from(e).to_string())
+        Format::Png | Format::Jpeg => {
+            let bytes = read_regular_bytes(path, MAX_IMAGE_BYTES).map_err(cannot)?;
+            file::read_integer_image(&bytes, format, space)
+                .map_err(|e| TextureError::from(e).to_string())
         }
         Format::Float => {
             open_regular(path).map_err(cannot)?;

@@ -1,6 +1,6 @@
-//! Reading a texture image: PNG (8 or 16 bits, grey or colour, alpha
-//! ignored; decoded from sRGB or read as stored, per the texture's colour
-//! space) or a floating-point OpenEXR / Radiance `.hdr` image (linear by
+//! Reading a texture image: PNG (8 or 16 bits) or JPEG (8 bits), grey or
+//! colour, alpha ignored, decoded from sRGB or read as stored per the
+//! texture's colour space; or a floating-point OpenEXR / Radiance `.hdr` image (linear by
 //! definition: read as stored, [`crate::environment::image`]). Refused with
 //! the reason, for the scene loader to report: another format, an image
 //! larger than [`MAX_TEXELS`] (from the header, before decoding), a file
@@ -20,6 +20,7 @@ pub const MAX_TEXELS: u64 = hdr_image::MAX_TEXELS;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
     Png,
+    Jpeg,
     /// OpenEXR or Radiance `.hdr`.
     Float,
 }
@@ -28,8 +29,8 @@ pub enum Format {
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum TextureError {
     #[error(
-        "unsupported texture format \"{0}\": expected PNG (.png), OpenEXR (.exr) or Radiance \
-         (.hdr); JPEG is not built in (convert it to PNG)"
+        "unsupported texture format \"{0}\": expected PNG (.png), JPEG (.jpg, .jpeg), OpenEXR \
+         (.exr) or Radiance (.hdr)"
     )]
     Unsupported(String),
     #[error(transparent)]
@@ -45,17 +46,37 @@ pub fn format_of(path: &Path) -> Result<Format, TextureError> {
         .unwrap_or_default();
     match ext.as_str() {
         "png" => Ok(Format::Png),
+        "jpg" | "jpeg" => Ok(Format::Jpeg),
         "exr" | "hdr" => Ok(Format::Float),
         _ => Err(TextureError::Unsupported(ext)),
     }
 }
 
-/// Decodes the PNG file's `bytes` into linear texels.
-pub fn read_png(bytes: &[u8], space: ColorSpace) -> Result<Texels, ImageError> {
+/// Decodes the PNG or JPEG file's `bytes` (`format`) into linear texels.
+pub fn read_integer_image(
+    bytes: &[u8],
+    format: Format,
+    space: ColorSpace,
+) -> Result<Texels, ImageError> {
+    let unreadable = |e: &dyn std::fmt::Display| ImageError::Unreadable(e.to_string());
+    let cursor = std::io::Cursor::new(bytes);
+    match format {
+        Format::Png => decode(
+            image::codecs::png::PngDecoder::new(cursor).map_err(|e| unreadable(&e))?,
+            space,
+        ),
+        Format::Jpeg => decode(
+            image::codecs::jpeg::JpegDecoder::new(cursor).map_err(|e| unreadable(&e))?,
+            space,
+        ),
+        Format::Float => Err(ImageError::Unreadable("not an 8- or 16-bit image".into())),
+    }
+}
+
+/// The texels of `decoder`'s image, its size checked before decoding.
+fn decode(decoder: impl image::ImageDecoder, space: ColorSpace) -> Result<Texels, ImageError> {
     use image::ImageDecoder;
     let unreadable = |e: &dyn std::fmt::Display| ImageError::Unreadable(e.to_string());
-    let decoder = image::codecs::png::PngDecoder::new(std::io::Cursor::new(bytes))
-        .map_err(|e| unreadable(&e))?;
     let (width, height) = decoder.dimensions();
     if width == 0 || height == 0 {
         return Err(ImageError::Empty { width, height });
