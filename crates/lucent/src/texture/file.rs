@@ -75,7 +75,6 @@ pub fn read_integer_image(
 
 /// The texels of `decoder`'s image, its size checked before decoding.
 fn decode(decoder: impl image::ImageDecoder, space: ColorSpace) -> Result<Texels, ImageError> {
-    use image::ImageDecoder;
     let unreadable = |e: &dyn std::fmt::Display| ImageError::Unreadable(e.to_string());
     let (width, height) = decoder.dimensions();
     if width == 0 || height == 0 {
