@@ -155,7 +155,7 @@ fn killed_and_resumed(options: &[&str]) {
             "scene.toml",
             "--quiet",
             "--spp",
-            "3000",
+            "6000",
             "--threads",
             "2",
             "-o",
@@ -172,8 +172,12 @@ fn killed_and_resumed(options: &[&str]) {
             .spawn()
             .unwrap()
     };
+    let start = Instant::now();
     let (status, e) = finish(render("whole.exr", &[]), Duration::from_secs(120));
     assert_eq!(status, Some(0), "{e}");
+    // the render's own length on this machine, idle or loaded: the moments
+    // below are fractions of it, so a signal never comes after the end
+    let length = start.elapsed().as_millis() as u32;
     // every channel bit for bit (the EXR's header also records the render
     // time)
     let pixels = |p: &str| exr_channels(&d.join(p));
@@ -195,7 +199,8 @@ fn killed_and_resumed(options: &[&str]) {
         .unwrap()
         .subsec_nanos();
     for (k, signal) in [(0u32, "-TERM"), (1, "-KILL")] {
-        let wait = 300 + (nanos / 7 + k * 337) % 900;
+        // between 15 % and 60 % of the uninterrupted render's time
+        let wait = length * (15 + (nanos / 7 + k * 337) % 46) / 100;
         let child = render("cut.exr", &["--checkpoint", "0.1"]);
         std::thread::sleep(Duration::from_millis(wait as u64));
         if signal == "-KILL" {
