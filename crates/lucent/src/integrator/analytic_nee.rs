@@ -9,13 +9,12 @@
 use super::aov::{self, Event, Recorder, Source};
 use super::branch::Branch;
 use super::interaction::offset_along;
-use super::lobe::{Lobe, PrevVertex, Vertex};
+use super::lobe::{PrevVertex, Vertex};
 use super::state::PathState;
 use super::{Clock, Context, Counters, Effect};
 use crate::analytic_lights::Light;
 use crate::film::passes::Pass;
 use crate::geometry::{Ray, Vec3};
-use crate::materials::diffuse;
 use crate::sampling::{power, Draw, SampleRng};
 
 /// The probability of picking each light.
@@ -65,13 +64,7 @@ pub(crate) fn analytic_light(
         return (Vec3::ZERO, i as u32);
     }
     let wi = v.frame.to_local(s.wi);
-    let (f, pdf_lobe) = match v.lobe {
-        Lobe::Diffuse(albedo) => (
-            diffuse::eval(albedo, v.wo_local, wi),
-            diffuse::pdf(v.wo_local, wi),
-        ),
-        _ => (v.lobe.eval(v.wo_local, wi), v.lobe.pdf(v.wo_local, wi)),
-    };
+    let (f, pdf_lobe) = (v.lobe.eval(v.wo_local, wi), v.lobe.pdf(v.wo_local, wi));
     if f == Vec3::ZERO {
         return (Vec3::ZERO, i as u32);
     }

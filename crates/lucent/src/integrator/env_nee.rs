@@ -7,12 +7,11 @@
 
 use super::aov::{self, Event, Recorder, Source};
 use super::interaction::offset_along;
-use super::lobe::{Lobe, PrevVertex, Vertex};
+use super::lobe::{PrevVertex, Vertex};
 use super::state::PathState;
 use super::{Clock, Context, Counters, Effect};
 use crate::environment::EnvMap;
 use crate::geometry::{Ray, Vec3};
-use crate::materials::diffuse;
 use crate::sampling::{power, Draw, SampleRng};
 
 /// The environment image, if the scene has one.
@@ -61,13 +60,7 @@ pub(crate) fn environment_light(
         return Vec3::ZERO;
     }
     let wi = v.frame.to_local(s.wi);
-    let (f, pdf_lobe) = match v.lobe {
-        Lobe::Diffuse(albedo) => (
-            diffuse::eval(albedo, v.wo_local, wi),
-            diffuse::pdf(v.wo_local, wi),
-        ),
-        _ => (v.lobe.eval(v.wo_local, wi), v.lobe.pdf(v.wo_local, wi)),
-    };
+    let (f, pdf_lobe) = (v.lobe.eval(v.wo_local, wi), v.lobe.pdf(v.wo_local, wi));
     if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
