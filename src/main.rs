@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
+use lucent::denoise::DenoiseOptions;
 use lucent::film::exr_layers::Preview;
 use lucent::film::passes::PassSet;
 use lucent::film::ToneMap;
@@ -141,6 +142,12 @@ enum Command {
         /// (docs/performance.md, "Per-effect statistics").
         #[arg(long)]
         stats: bool,
+        /// Also write the beauty denoised by Open Image Denoise (the layer
+        /// `denoised`, which the PNG preview shows), guided by the albedo
+        /// and N passes (added if not asked for). Frames only: denoise a
+        /// split render after the merge (docs/output.md, "Denoising").
+        #[arg(long)]
+        denoise: bool,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
         #[command(flatten)]
@@ -174,6 +181,38 @@ enum Command {
         /// Without it such parts are refused.
         #[arg(long)]
         mixed_backends: bool,
+        /// Also write the merged frame's beauty denoised (the layer
+        /// `denoised`, which the PNG preview shows), from its albedo and N
+        /// passes (docs/output.md, "Denoising").
+        #[arg(long)]
+        denoise: bool,
+        /// The denoiser's threads, 1 to 1024 (default: all cores).
+        #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
+        threads: Option<usize>,
+    },
+    /// Denoise a finished frame (a render or a merge) with Open Image
+    /// Denoise from its own beauty, albedo and N layers: the frame is
+    /// written with the layer `denoised` added, and the PNG preview from
+    /// it (docs/output.md, "Denoising").
+    Denoise {
+        /// The frame.
+        frame: PathBuf,
+        /// Output OpenEXR path (default: the frame itself, replaced
+        /// atomically); the preview goes to the same path with `.png`.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// The denoiser's threads, 1 to 1024 (default: all cores).
+        #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
+        threads: Option<usize>,
+        /// Tone map of the PNG preview (the EXR is always linear).
+        #[arg(long, value_enum, default_value = "filmic")]
+        tonemap: ToneMapArg,
+        /// Exposure of the PNG preview in stops.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = exposure_stops)]
+        exposure: f32,
+        /// No summary line.
+        #[arg(short, long)]
+        quiet: bool,
     },
     /// Paste a region render (`render --region`) into a frame: only the
     /// region's pixels change, bit for bit, in every channel; the frame's
@@ -331,6 +370,7 @@ fn main() -> ExitCode {
             aov,
             explain,
             stats,
+            denoise,
             subsurface,
             file,
             split,
@@ -368,6 +408,7 @@ fn main() -> ExitCode {
                         tonemap: tonemap.into(),
                         exposure,
                     },
+                    denoise: denoise.then(|| DenoiseOptions::with_threads(threads)),
                 };
                 run_render(&r, quiet)
             })
@@ -379,14 +420,37 @@ fn main() -> ExitCode {
             exposure,
             quiet,
             mixed_backends,
+            denoise,
+            threads,
         } => {
             let preview = Preview {
                 tonemap: tonemap.into(),
                 exposure,
             };
-            session::merge_parts(&parts, &output, preview, mixed_backends).map(|m| {
+            let d = denoise.then(|| DenoiseOptions::with_threads(threads));
+            session::merge_parts(&parts, &output, preview, mixed_backends, d.as_ref()).map(|m| {
                 if !quiet {
                     tell!("{}", m.summary(&output));
+                }
+            })
+        }
+        Command::Denoise {
+            frame,
+            output,
+            threads,
+            tonemap,
+            exposure,
+            quiet,
+        } => {
+            let preview = Preview {
+                tonemap: tonemap.into(),
+                exposure,
+            };
+            let output = output.unwrap_or_else(|| frame.clone());
+            let opts = DenoiseOptions::with_threads(threads);
+            session::denoise_file(&frame, &output, preview, &opts).map(|d| {
+                if !quiet {
+                    tell!("{}", d.summary(&output));
                 }
             })
         }
