@@ -83,6 +83,7 @@ pub fn denoise_file(
     check_exr_output(output)?;
     let png = preview_path(output);
     check_not_an_input(&[&png], &[input.to_path_buf()])?;
+    crate::denoise::load::api()?;
     let mut image = super::paste::read(input)?;
     let (w, h) = (image.layer_data.size.0, image.layer_data.size.1);
     let color = planes(input, &image, ["R", "G", "B"])?;
