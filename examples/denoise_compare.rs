@@ -6,7 +6,7 @@
 //!         REF.exr THREADS FRAME.exr...
 //!
 //! Each FRAME needs the `albedo` and `N` passes. Prints, per frame, the
-//! relMSE and bias (the study's metrics) of its beauty and of its two
+//! relMSE, bias and the bias's standard error (the study's metrics) of its beauty and of its two
 //! denoised versions, and each denoise's time.
 
 use std::path::Path;
@@ -64,7 +64,7 @@ fn main() {
     let (r, w, h) = read(&args[0], ["R", "G", "B"]);
     let reference = film(r, w, h);
     let threads: usize = args[1].parse().expect("THREADS");
-    println!("frame,version,relmse,bias,denoise_seconds");
+    println!("frame,version,relmse,bias,bias_stderr,denoise_seconds");
     for path in &args[2..] {
         let (color, w, h) = read(path, ["R", "G", "B"]);
         let (albedo, _, _) = read(path, ["albedo.R", "albedo.G", "albedo.B"]);
@@ -72,7 +72,8 @@ fn main() {
         let name = Path::new(path).file_name().unwrap().to_string_lossy();
         let show = |version: &str, px: Vec<Vec3>, secs: f64| {
             let m = compare(&film(px, w, h), &reference, 1.0).expect("same size");
-            println!("{name},{version},{:.6},{:.5},{secs:.3}", m.rel_mse, m.bias);
+            let (r, b, e) = (m.rel_mse, m.bias, m.bias_stderr);
+            println!("{name},{version},{r:.6},{b:.5},{e:.5},{secs:.3}");
         };
         show("raw", color.clone(), 0.0);
         for (version, prefilter_guides) in [
