@@ -407,3 +407,34 @@ fn a_frame_with_nan_is_refused_naming_the_channel_and_pixel() {
     );
     assert!(!o.exists() && !dir.path().join("o.png").exists());
 }
+
+/// `lucent info` names the OIDN it loaded and its version, or says why
+/// there is none.
+#[test]
+fn info_names_the_denoiser_or_why_there_is_none() {
+    let info = |lib: &str| {
+        let out = lucent()
+            .env("LUCENT_OIDN", lib)
+            .arg("info")
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let text = info("/nonexistent/libOpenImageDenoise.so.2");
+    assert!(
+        text.contains("denoiser: unavailable (cannot denoise: LUCENT_OIDN=/nonexistent/"),
+        "{text}"
+    );
+    if !have_oidn() {
+        return;
+    }
+    let lib = std::env::var("LUCENT_OIDN").unwrap();
+    let text = info(&lib);
+    let line = text.lines().find(|l| l.starts_with("denoiser:")).unwrap();
+    assert!(
+        line.starts_with("denoiser: Open Image Denoise 2."),
+        "{line}"
+    );
+    assert!(line.ends_with(&format!("({lib})")), "{line}");
+}
