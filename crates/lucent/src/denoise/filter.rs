@@ -79,12 +79,17 @@ pub fn denoise(input: &DenoiseInput, opts: &DenoiseOptions) -> Result<Vec<Vec3>,
     device.run(&f, "denoising")?;
     drop(f);
     for p in &mut out {
-        *p = p
-            .to_array()
-            .map(|c| if c.is_finite() { c.max(0.0) } else { 0.0 })
-            .into();
+        *p = sanitized(*p);
     }
     Ok(out)
+}
+
+/// A pixel of OIDN's output made non-negative and finite: a negative or
+/// non-finite channel becomes 0 (light values in outputs never are).
+fn sanitized(p: Vec3) -> Vec3 {
+    p.to_array()
+        .map(|c| if c.is_finite() { c.max(0.0) } else { 0.0 })
+        .into()
 }
 
 /// Sizes that agree and finite inputs: OIDN would read out of bounds on
@@ -235,4 +240,45 @@ fn failure(what: &str, code: OIDNError, msg: &str) -> Error {
         "Open Image Denoise failed {what}: {msg} ({})",
         error_name(code)
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn negative_and_non_finite_outputs_become_zero_and_the_rest_stays() {
+        let p = sanitized(Vec3::new(-1e-3, f32::NAN, 0.25));
+        assert_eq!(p.to_array(), [0.0, 0.0, 0.25]);
+        let p = sanitized(Vec3::new(f32::INFINITY, f32::NEG_INFINITY, 7.0));
+        assert_eq!(p.to_array(), [0.0, 0.0, 7.0]);
+    }
+
+    #[test]
+    fn mismatched_sizes_and_nan_are_refused_before_oidn_is_called() {
+        let input = |color: &'static [Vec3]| DenoiseInput {
+            width: 2,
+            height: 2,
+            color,
+            albedo: &[Vec3::ONE; 4],
+            normal: &[Vec3::ONE; 4],
+        };
+        let e = check(&input(&[Vec3::ONE; 3])).unwrap_err().to_string();
+        assert!(
+            e.contains("the beauty has 3 pixels, not the 2×2 = 4"),
+            "{e}"
+        );
+        static NAN: [Vec3; 4] = [
+            Vec3::ONE,
+            Vec3::ONE,
+            Vec3::ONE,
+            Vec3::new(0.0, f32::NAN, 0.0),
+        ];
+        let e = check(&input(&NAN)).unwrap_err().to_string();
+        assert!(
+            e.contains("the beauty is not finite at pixel (1, 1)"),
+            "{e}"
+        );
+        assert!(check(&input(&[Vec3::ONE; 4])).is_ok());
+    }
 }
