@@ -22,6 +22,7 @@ use lucent::session;
 use lucent::Error;
 
 mod args;
+mod denoise;
 mod values;
 use args::{FileArgs, SplitArgs};
 use values::parse_aov;
@@ -194,26 +195,7 @@ enum Command {
     /// Denoise from its own beauty, albedo and N layers: the frame is
     /// written with the layer `denoised` added, and the PNG preview from
     /// it (docs/output.md, "Denoising").
-    Denoise {
-        /// The frame.
-        frame: PathBuf,
-        /// Output OpenEXR path (default: the frame itself, replaced
-        /// atomically); the preview goes to the same path with `.png`.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// The denoiser's threads, 1 to 1024 (default: all cores).
-        #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
-        threads: Option<usize>,
-        /// Tone map of the PNG preview (the EXR is always linear).
-        #[arg(long, value_enum, default_value = "filmic")]
-        tonemap: ToneMapArg,
-        /// Exposure of the PNG preview in stops.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = exposure_stops)]
-        exposure: f32,
-        /// No summary line.
-        #[arg(short, long)]
-        quiet: bool,
-    },
+    Denoise(denoise::DenoiseArgs),
     /// Paste a region render (`render --region`) into a frame: only the
     /// region's pixels change, bit for bit, in every channel; the frame's
     /// header and storage stay. The files must have the same display
@@ -434,26 +416,7 @@ fn main() -> ExitCode {
                 }
             })
         }
-        Command::Denoise {
-            frame,
-            output,
-            threads,
-            tonemap,
-            exposure,
-            quiet,
-        } => {
-            let preview = Preview {
-                tonemap: tonemap.into(),
-                exposure,
-            };
-            let output = output.unwrap_or_else(|| frame.clone());
-            let opts = DenoiseOptions::with_threads(threads);
-            session::denoise_file(&frame, &output, preview, &opts).map(|d| {
-                if !quiet {
-                    tell!("{}", d.summary(&output));
-                }
-            })
-        }
+        Command::Denoise(args) => denoise::run(args),
         Command::Paste {
             region,
             frame,
