@@ -19,7 +19,7 @@ use crate::error::ParamError;
 
 /// The default of [`EstimatorOptions::regularize`], chosen by time to
 /// error with its bias counted (`docs/accuracy.md`, "Real meshes").
-pub const DEFAULT_REGULARIZE: f32 = 0.0;
+pub const DEFAULT_REGULARIZE: f32 = 0.3;
 
 /// Every sampling option of a subsurface material; `Default` is the
 /// recommended setting.
