@@ -1,0 +1,95 @@
+//! Where light entering a preset's sphere at one point leaves it, by
+//! chord distance r, against what the diffusion estimator assigns
+//! (`lucent_tools::sphere_transfer`, `docs/bssrdf.md` §10, "Where the
+//! light leaves"):
+//!
+//!     cargo run --release --example sphere_transfer -- [PRESET [RADIUS_MM [WALKS]]]
+//!
+//! Defaults: marble, 10 mm, 200 000 walks per channel and body. Per
+//! channel and bin of r (mm): the walk's T(r) per mm² on the sphere and on
+//! the half-space, the model's A·R(r)·f(1/R) (0 beyond Rmax; on the
+//! half-space A·R(r)), and their ratios; then the share of the returned
+//! light that leaves beyond chord √2·R (the far hemisphere) for the walk
+//! and for the model. Deterministic for any thread count.
+
+use lucent::bssrdf::curvature_correction::CurvatureCorrection;
+use lucent::bssrdf::{profile, Fit, ProbeOptions, ProbeSampler, SubsurfaceParams};
+use lucent_tools::sphere_albedo::Body;
+use lucent_tools::sphere_transfer::transfer;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let preset = args.first().map(String::as_str).unwrap_or("marble");
+    let num = |i: usize, default: f64| -> f64 {
+        args.get(i).map_or(default, |s| {
+            s.parse().unwrap_or_else(|_| {
+                eprintln!("error: not a number: {s}");
+                std::process::exit(2)
+            })
+        })
+    };
+    let radius_mm = num(1, 10.0);
+    let walks = num(2, 200_000.0) as u64;
+    let p = SubsurfaceParams::from_preset(preset, 1.0, Fit::Searchlight).unwrap_or_else(|e| {
+        eprintln!("error: {e}");
+        std::process::exit(2)
+    });
+    let sampler = ProbeSampler::new(&p, &ProbeOptions::default()).unwrap();
+    let cc = CurvatureCorrection::new(&p, &sampler).unwrap().unwrap();
+    let f = cc.exact_factor(1.0 / radius_mm);
+    let m = p.medium.unwrap();
+    let rmax = sampler.rmax();
+    let bins = 20;
+    let edges_mm: Vec<f64> = (0..=bins)
+        .map(|i| 2.0 * radius_mm * i as f64 / bins as f64)
+        .collect();
+    // the last edge a hair beyond the diameter, so antipodal exits count
+    let mut edges_mm = edges_mm;
+    edges_mm[bins] *= 1.0 + 1e-9;
+    let far_bin = edges_mm.partition_point(|&e| e < 2f64.sqrt() * radius_mm);
+    println!("{preset}, sphere of radius {radius_mm} mm, Rmax {rmax:.2} mm, {walks} walks");
+    for c in 0..3 {
+        let st = m.sigma_s[c] * (1.0 - m.g) + m.sigma_a[c];
+        let alpha = m.sigma_s[c] * (1.0 - m.g) / st;
+        let edges: Vec<f64> = edges_mm.iter().map(|e| e * st).collect();
+        let stream = 16 * c as u64;
+        let sphere = transfer(Body::Sphere(radius_mm * st), alpha, p.eta, &edges, walks, 1, stream);
+        let slab = transfer(Body::HalfSpace, alpha, p.eta, &edges, walks, 1, stream + 1);
+        let (a, d) = (p.albedo[c], p.d[c]);
+        println!(
+            "channel {c}: A {a:.4}, d {d:.3} mm, ld {:.2} mm, f(1/R) {:.3}",
+            lucent::bssrdf::params::diffuse_mfp(m.sigma_s[c] * (1.0 - m.g), m.sigma_a[c]),
+            f[c]
+        );
+        println!("  r [mm]   T_sphere    model       ratio   T_slab      A·R(r)      ratio");
+        let mut model_far = 0.0;
+        let mut model_all = 0.0;
+        for i in 0..bins {
+            let (r0, r1) = (edges_mm[i], edges_mm[i + 1]);
+            let area = std::f64::consts::PI * (r1 * r1 - r0 * r0);
+            // the model's mean over the bin: its integral / area
+            let int = a * (profile::cdf(r1.min(rmax), d) - profile::cdf(r0.min(rmax), d));
+            let model = f[c] * int / area;
+            model_all += f[c] * int;
+            if i >= far_bin {
+                model_far += f[c] * int;
+            }
+            let per_mm2 = st * st;
+            let (ts, tp) = (sphere.density(i) * per_mm2, slab.density(i) * per_mm2);
+            println!(
+                "  {:5.1}   {ts:.3e}   {model:.3e}   {:6.3}  {tp:.3e}   {:.3e}   {:6.3}",
+                0.5 * (r0 + r1),
+                ts / model,
+                int / area,
+                tp / (int / area)
+            );
+        }
+        let walk_all = sphere.fraction(0..bins);
+        let walk_far = sphere.fraction(far_bin..bins);
+        println!(
+            "  returned: walk {walk_all:.4}, model {model_all:.4}; beyond √2·R: walk {:.2} %, model {:.2} % of it",
+            100.0 * walk_far / walk_all,
+            100.0 * model_far / model_all
+        );
+    }
+}
