@@ -3,9 +3,10 @@
 //! (`lucent_tools::sphere_transfer`, `docs/bssrdf.md` §10, "Where the
 //! light leaves"):
 //!
-//!     cargo run --release --example sphere_transfer -- [PRESET [RADIUS_MM [WALKS]]]
+//!     cargo run --release --example sphere_transfer -- [PRESET [RADIUS_MM [WALKS [RMAX_QUANTILE]]]]
 //!
-//! Defaults: marble, 10 mm, 200 000 walks per channel and body. Per
+//! Defaults: marble, 10 mm, 200 000 walks per channel and body, the
+//! renderer's Rmax quantile. Per
 //! channel and bin of r (mm): the walk's T(r) per mm² on the sphere and on
 //! the half-space, the model's A·R(r)·f(1/R) (0 beyond Rmax; on the
 //! half-space A·R(r)), and their ratios; then the share of the returned
@@ -34,7 +35,14 @@ fn main() {
         eprintln!("error: {e}");
         std::process::exit(2)
     });
-    let sampler = ProbeSampler::new(&p, &ProbeOptions::default()).unwrap();
+    let opts = ProbeOptions {
+        rmax_quantile: num(3, ProbeOptions::default().rmax_quantile),
+        ..ProbeOptions::default()
+    };
+    let sampler = ProbeSampler::new(&p, &opts).unwrap_or_else(|e| {
+        eprintln!("error: {e}");
+        std::process::exit(2)
+    });
     let cc = CurvatureCorrection::new(&p, &sampler).unwrap().unwrap();
     let f = cc.exact_factor(1.0 / radius_mm);
     let m = p.medium.unwrap();
