@@ -11,8 +11,10 @@
 # Defaults: K = 4, 256 spp each way, 1 thread, `--profile quick`; the
 # walk is most of the time (~25 s per render at 48² on one core).
 # Extra flags for the diffusion renders go in DIFF_FLAGS (e.g.
-# `--rmax-quantile 0.9999`). The sphere's disk is at (24, 24), radius
-# 20.9 px, for the scene's 48² camera.
+# `--rmax-quantile 0.9999`). REGIONS="CX CY R" says where the body is
+# (default "24 24 20.9", the sphere's disk in the scene's 48² camera;
+# "24 17 0" for scenes/keylight-bunny.toml: every lit pixel, the ears
+# above row 17).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scene=${1:-scenes/keylight-sphere.toml}
@@ -31,4 +33,5 @@ for s in $(seq 1 "$k"); do
         --seed "$s" --threads 1 -o "$out/walk$s.exr" >&2
     diff+=("$out/diff$s.exr") walk+=("$out/walk$s.exr")
 done
-target/quick/examples/keylight_regions 24 24 20.9 "${diff[@]}" -- "${walk[@]}"
+# shellcheck disable=SC2086
+target/quick/examples/keylight_regions ${REGIONS:-24 24 20.9} "${diff[@]}" -- "${walk[@]}"
