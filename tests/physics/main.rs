@@ -24,6 +24,8 @@ mod hard_cases;
 mod heavy_tails;
 mod lights;
 #[cfg(feature = "subsurface")]
+mod keylight;
+#[cfg(feature = "subsurface")]
 mod lod;
 #[cfg(feature = "subsurface")]
 mod non_negative;
