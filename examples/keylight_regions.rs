@@ -55,7 +55,10 @@ impl Body {
         let (x0, x1) = if r > 0.0 {
             (cx - r, cx + r)
         } else {
-            (xs().fold(f64::INFINITY, f64::min), xs().fold(0.0, f64::max) + 1.0)
+            (
+                xs().fold(f64::INFINITY, f64::min),
+                xs().fold(0.0, f64::max) + 1.0,
+            )
         };
         Body {
             inside,

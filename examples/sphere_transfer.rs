@@ -61,7 +61,15 @@ fn main() {
         let alpha = m.sigma_s[c] * (1.0 - m.g) / st;
         let edges: Vec<f64> = edges_mm.iter().map(|e| e * st).collect();
         let stream = 16 * c as u64;
-        let sphere = transfer(Body::Sphere(radius_mm * st), alpha, p.eta, &edges, walks, 1, stream);
+        let sphere = transfer(
+            Body::Sphere(radius_mm * st),
+            alpha,
+            p.eta,
+            &edges,
+            walks,
+            1,
+            stream,
+        );
         let slab = transfer(Body::HalfSpace, alpha, p.eta, &edges, walks, 1, stream + 1);
         let (a, d) = (p.albedo[c], p.d[c]);
         println!(

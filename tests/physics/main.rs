@@ -22,9 +22,9 @@ mod glossy;
 mod hard_cases;
 #[cfg(feature = "subsurface")]
 mod heavy_tails;
-mod lights;
 #[cfg(feature = "subsurface")]
 mod keylight;
+mod lights;
 #[cfg(feature = "subsurface")]
 mod lod;
 #[cfg(feature = "subsurface")]
