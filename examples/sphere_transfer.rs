@@ -45,67 +45,88 @@ fn main() {
     });
     let cc = CurvatureCorrection::new(&p, &sampler).unwrap().unwrap();
     let f = cc.exact_factor(1.0 / radius_mm);
-    let m = p.medium.unwrap();
-    let rmax = sampler.rmax();
     let bins = 20;
-    let edges_mm: Vec<f64> = (0..=bins)
+    let mut edges_mm: Vec<f64> = (0..=bins)
         .map(|i| 2.0 * radius_mm * i as f64 / bins as f64)
         .collect();
     // the last edge a hair beyond the diameter, so antipodal exits count
-    let mut edges_mm = edges_mm;
     edges_mm[bins] *= 1.0 + 1e-9;
-    let far_bin = edges_mm.partition_point(|&e| e < 2f64.sqrt() * radius_mm);
-    println!("{preset}, sphere of radius {radius_mm} mm, Rmax {rmax:.2} mm, {walks} walks");
-    for c in 0..3 {
-        let st = m.sigma_s[c] * (1.0 - m.g) + m.sigma_a[c];
-        let alpha = m.sigma_s[c] * (1.0 - m.g) / st;
-        let edges: Vec<f64> = edges_mm.iter().map(|e| e * st).collect();
-        let stream = 16 * c as u64;
-        let sphere = transfer(
-            Body::Sphere(radius_mm * st),
-            alpha,
-            p.eta,
-            &edges,
-            walks,
-            1,
-            stream,
-        );
-        let slab = transfer(Body::HalfSpace, alpha, p.eta, &edges, walks, 1, stream + 1);
-        let (a, d) = (p.albedo[c], p.d[c]);
-        println!(
-            "channel {c}: A {a:.4}, d {d:.3} mm, ld {:.2} mm, f(1/R) {:.3}",
-            lucent::bssrdf::params::diffuse_mfp(m.sigma_s[c] * (1.0 - m.g), m.sigma_a[c]),
-            f[c]
-        );
-        println!("  r [mm]   T_sphere    model       ratio   T_slab      A·R(r)      ratio");
-        let mut model_far = 0.0;
-        let mut model_all = 0.0;
-        for i in 0..bins {
-            let (r0, r1) = (edges_mm[i], edges_mm[i + 1]);
-            let area = std::f64::consts::PI * (r1 * r1 - r0 * r0);
-            // the model's mean over the bin: its integral / area
-            let int = a * (profile::cdf(r1.min(rmax), d) - profile::cdf(r0.min(rmax), d));
-            let model = f[c] * int / area;
-            model_all += f[c] * int;
-            if i >= far_bin {
-                model_far += f[c] * int;
-            }
-            let per_mm2 = st * st;
-            let (ts, tp) = (sphere.density(i) * per_mm2, slab.density(i) * per_mm2);
-            println!(
-                "  {:5.1}   {ts:.3e}   {model:.3e}   {:6.3}  {tp:.3e}   {:.3e}   {:6.3}",
-                0.5 * (r0 + r1),
-                ts / model,
-                int / area,
-                tp / (int / area)
-            );
+    let setup = Setup {
+        p,
+        rmax: sampler.rmax(),
+        far_bin: edges_mm.partition_point(|&e| e < 2f64.sqrt() * radius_mm),
+        edges_mm,
+        radius_mm,
+        walks,
+    };
+    println!(
+        "{preset}, sphere of radius {radius_mm} mm, Rmax {:.2} mm, {walks} walks",
+        setup.rmax
+    );
+    for (c, &fc) in f.iter().enumerate() {
+        channel(&setup, c, fc);
+    }
+}
+
+/// What every channel's comparison shares.
+struct Setup {
+    p: SubsurfaceParams,
+    rmax: f64,
+    /// The first bin beyond chord √2·R (the far hemisphere).
+    far_bin: usize,
+    edges_mm: Vec<f64>,
+    radius_mm: f64,
+    walks: u64,
+}
+
+/// Channel `c`'s table (module docs); `fc` is its f(1/R).
+fn channel(s: &Setup, c: usize, fc: f64) {
+    let (p, m) = (&s.p, s.p.medium.unwrap());
+    let ss = m.sigma_s[c] * (1.0 - m.g);
+    let st = ss + m.sigma_a[c];
+    let edges: Vec<f64> = s.edges_mm.iter().map(|e| e * st).collect();
+    let (alpha, stream) = (ss / st, 16 * c as u64);
+    let body = Body::Sphere(s.radius_mm * st);
+    let sphere = transfer(body, alpha, p.eta, &edges, s.walks, 1, stream);
+    let slab = transfer(
+        Body::HalfSpace,
+        alpha,
+        p.eta,
+        &edges,
+        s.walks,
+        1,
+        stream + 1,
+    );
+    let (a, d) = (p.albedo[c], p.d[c]);
+    let ld = lucent::bssrdf::params::diffuse_mfp(ss, m.sigma_a[c]);
+    println!("channel {c}: A {a:.4}, d {d:.3} mm, ld {ld:.2} mm, f(1/R) {fc:.3}");
+    println!("  r [mm]   T_sphere    model       ratio   T_slab      A·R(r)      ratio");
+    let bins = s.edges_mm.len() - 1;
+    let (mut model_far, mut model_all) = (0.0, 0.0);
+    for i in 0..bins {
+        let (r0, r1) = (s.edges_mm[i], s.edges_mm[i + 1]);
+        let area = std::f64::consts::PI * (r1 * r1 - r0 * r0);
+        // the profile's mean over the bin: its integral / area
+        let int = a * (profile::cdf(r1.min(s.rmax), d) - profile::cdf(r0.min(s.rmax), d));
+        let model = fc * int / area;
+        model_all += fc * int;
+        if i >= s.far_bin {
+            model_far += fc * int;
         }
-        let walk_all = sphere.fraction(0..bins);
-        let walk_far = sphere.fraction(far_bin..bins);
+        let (ts, tp) = (sphere.density(i) * st * st, slab.density(i) * st * st);
         println!(
-            "  returned: walk {walk_all:.4}, model {model_all:.4}; beyond √2·R: walk {:.2} %, model {:.2} % of it",
-            100.0 * walk_far / walk_all,
-            100.0 * model_far / model_all
+            "  {:5.1}   {ts:.3e}   {model:.3e}   {:6.3}  {tp:.3e}   {:.3e}   {:6.3}",
+            0.5 * (r0 + r1),
+            ts / model,
+            int / area,
+            tp / (int / area)
         );
     }
+    let walk_all = sphere.fraction(0..bins);
+    let walk_far = sphere.fraction(s.far_bin..bins);
+    println!(
+        "  returned: walk {walk_all:.4}, model {model_all:.4}; beyond √2·R: walk {:.2} %, model {:.2} % of it",
+        100.0 * walk_far / walk_all,
+        100.0 * model_far / model_all
+    );
 }
