@@ -5,7 +5,7 @@
 //! estimator models as A·Rd(r)·√(f(κo)f(κi)) (`docs/bssrdf.md` §10,
 //! "Where the light leaves").
 //!
-//! The walk is [`sphere_albedo::walk_to_exit`]'s (lengths in reduced mean
+//! The walk is [`crate::sphere_albedo::walk_to_exit`]'s (lengths in reduced mean
 //! free paths). On a sphere of radius R the area within chord distance r
 //! of a surface point is πr² for r ≤ 2R (Archimedes), as on the plane, so
 //! a bin [r_a, r_b) has area π(r_b² − r_a²) on both bodies.
