@@ -3,10 +3,13 @@
 //! (`lucent_tools::sphere_transfer`, `docs/bssrdf.md` §10, "Where the
 //! light leaves"):
 //!
-//!     cargo run --release --example sphere_transfer -- [PRESET [RADIUS_MM [WALKS [RMAX_QUANTILE]]]]
+//!     cargo run --release --example sphere_transfer -- [PRESET [RADIUS_MM [WALKS [RMAX_QUANTILE [ANGLE]]]]]
 //!
 //! Defaults: marble, 10 mm, 200 000 walks per channel and body, the
-//! renderer's Rmax quantile. Per
+//! renderer's Rmax quantile, diffuse entry; ANGLE (degrees from the
+//! normal) makes the light enter from one side instead, and the table's
+//! last column is the share of each bin's exits ahead of the entry point
+//! (on the side the refracted light heads to). Per
 //! channel and bin of r (mm): the walk's T(r) per mm² on the sphere and on
 //! the half-space, the model's A·R(r)·f(1/R) (0 beyond Rmax; on the
 //! half-space A·R(r)), and their ratios; then the share of the returned
@@ -15,6 +18,7 @@
 
 use lucent::bssrdf::curvature_correction::CurvatureCorrection;
 use lucent::bssrdf::{profile, Fit, ProbeOptions, ProbeSampler, SubsurfaceParams};
+use lucent_tools::halfspace::Entry;
 use lucent_tools::sphere_albedo::Body;
 use lucent_tools::sphere_transfer::transfer;
 
@@ -58,6 +62,10 @@ fn main() {
         edges_mm,
         radius_mm,
         walks,
+        entry: match args.get(4) {
+            None => Entry::Diffuse,
+            Some(_) => Entry::Oblique(num(4, 0.0).to_radians().cos() as f32),
+        },
     };
     println!(
         "{preset}, sphere of radius {radius_mm} mm, Rmax {:.2} mm, {walks} walks",
@@ -77,6 +85,7 @@ struct Setup {
     edges_mm: Vec<f64>,
     radius_mm: f64,
     walks: u64,
+    entry: Entry,
 }
 
 /// Channel `c`'s table (module docs); `fc` is its f(1/R).
@@ -87,20 +96,12 @@ fn channel(s: &Setup, c: usize, fc: f64) {
     let edges: Vec<f64> = s.edges_mm.iter().map(|e| e * st).collect();
     let (alpha, stream) = (ss / st, 16 * c as u64);
     let body = Body::Sphere(s.radius_mm * st);
-    let sphere = transfer(body, alpha, p.eta, &edges, s.walks, 1, stream);
-    let slab = transfer(
-        Body::HalfSpace,
-        alpha,
-        p.eta,
-        &edges,
-        s.walks,
-        1,
-        stream + 1,
-    );
+    let run = |body, stream| transfer(body, s.entry, alpha, p.eta, &edges, s.walks, 1, stream);
+    let (sphere, slab) = (run(body, stream), run(Body::HalfSpace, stream + 1));
     let (a, d) = (p.albedo[c], p.d[c]);
     let ld = lucent::bssrdf::params::diffuse_mfp(ss, m.sigma_a[c]);
     println!("channel {c}: A {a:.4}, d {d:.3} mm, ld {ld:.2} mm, f(1/R) {fc:.3}");
-    println!("  r [mm]   T_sphere    model       ratio   T_slab      A·R(r)      ratio");
+    println!("  r [mm]   T_sphere    model       ratio   T_slab      A·R(r)      ratio   ahead");
     let bins = s.edges_mm.len() - 1;
     let (mut model_far, mut model_all) = (0.0, 0.0);
     for i in 0..bins {
@@ -114,12 +115,14 @@ fn channel(s: &Setup, c: usize, fc: f64) {
             model_far += fc * int;
         }
         let (ts, tp) = (sphere.density(i) * st * st, slab.density(i) * st * st);
+        let ahead = sphere.ahead[i] as f64 / sphere.counts[i].max(1) as f64;
         println!(
-            "  {:5.1}   {ts:.3e}   {model:.3e}   {:6.3}  {tp:.3e}   {:.3e}   {:6.3}",
+            "  {:5.1}   {ts:.3e}   {model:.3e}   {:6.3}  {tp:.3e}   {:.3e}   {:6.3}  {:5.1} %",
             0.5 * (r0 + r1),
             ts / model,
             int / area,
-            tp / (int / area)
+            tp / (int / area),
+            100.0 * ahead
         );
     }
     let walk_all = sphere.fraction(0..bins);

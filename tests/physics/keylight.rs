@@ -18,7 +18,7 @@
 //! diffusion is −10…−13 % on the lit half and −75…−82 % on the far one
 //! (`scripts/keylight-report.sh`, 48², 4 × 256 spp; here −72…−79 %). The
 //! profile's tail is far shorter than the medium's transfer, more so on a
-//! curved body, and the entry lobe is blind to the light's direction
+//! curved body, and the exit lobe is blind to where the light came from
 //! (`docs/bssrdf.md` §10, "Where the light leaves").
 
 use std::path::Path;

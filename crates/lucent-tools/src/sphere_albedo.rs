@@ -65,14 +65,22 @@ fn outward(body: Body, p: DVec3) -> DVec3 {
 /// medium of reduced albedo `alpha` and relative index `eta`: whether it
 /// leaves again, and how many scattering events it had.
 pub fn walk(body: Body, alpha: f64, eta: f32, rng: &mut impl Draw) -> (bool, u64) {
-    let (exit, events) = walk_to_exit(body, alpha, eta, rng);
+    let (exit, events) = walk_to_exit(body, Entry::Diffuse, alpha, eta, rng);
     (exit.is_some(), events)
 }
 
-/// [`walk`] with the point where the light leaves (None if absorbed), the
-/// same random numbers: what `crate::sphere_transfer` bins by distance.
-pub fn walk_to_exit(body: Body, alpha: f64, eta: f32, rng: &mut impl Draw) -> (Option<DVec3>, u64) {
-    let mut d = enter(eta, Entry::Diffuse, rng).as_dvec3().normalize();
+/// [`walk`] with the point where the light leaves (None if absorbed) and
+/// the light entering as `entry` says (the same random numbers as [`walk`]
+/// for [`Entry::Diffuse`]): what `crate::sphere_transfer` bins by
+/// distance.
+pub fn walk_to_exit(
+    body: Body,
+    entry: Entry,
+    alpha: f64,
+    eta: f32,
+    rng: &mut impl Draw,
+) -> (Option<DVec3>, u64) {
+    let mut d = enter(eta, entry, rng).as_dvec3().normalize();
     let mut p = match body {
         Body::Sphere(r) => DVec3::new(0.0, 0.0, r),
         Body::HalfSpace => DVec3::ZERO,
