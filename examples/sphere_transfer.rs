@@ -20,7 +20,7 @@ use lucent::bssrdf::curvature_correction::CurvatureCorrection;
 use lucent::bssrdf::{profile, Fit, ProbeOptions, ProbeSampler, SubsurfaceParams};
 use lucent_tools::halfspace::Entry;
 use lucent_tools::sphere_albedo::Body;
-use lucent_tools::sphere_transfer::transfer;
+use lucent_tools::sphere_transfer::{transfer, Walks};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -96,7 +96,18 @@ fn channel(s: &Setup, c: usize, fc: f64) {
     let edges: Vec<f64> = s.edges_mm.iter().map(|e| e * st).collect();
     let (alpha, stream) = (ss / st, 16 * c as u64);
     let body = Body::Sphere(s.radius_mm * st);
-    let run = |body, stream| transfer(body, s.entry, alpha, p.eta, &edges, s.walks, 1, stream);
+    let run = |body, stream| {
+        let w = Walks {
+            body,
+            entry: s.entry,
+            alpha,
+            eta: p.eta,
+            walks: s.walks,
+            seed: 1,
+            stream,
+        };
+        transfer(&w, &edges)
+    };
     let (sphere, slab) = (run(body, stream), run(Body::HalfSpace, stream + 1));
     let (a, d) = (p.albedo[c], p.d[c]);
     let ld = lucent::bssrdf::params::diffuse_mfp(ss, m.sigma_a[c]);

@@ -41,21 +41,33 @@ impl Transfer {
     }
 }
 
-/// Runs `walks` walks entering `body` as `entry` says (reduced albedo
-/// `alpha`, index `eta`) and bins their exits by `edges`. Chunk k draws
-/// from the stream (seed, stream, k): the result does not depend on the
-/// thread count.
-#[allow(clippy::too_many_arguments)]
-pub fn transfer(
-    body: Body,
-    entry: Entry,
-    alpha: f64,
-    eta: f32,
-    edges: &[f64],
-    walks: u64,
-    seed: u64,
-    stream: u64,
-) -> Transfer {
+/// One set of walks: where and how the light enters, the medium, how
+/// many walks and their random streams.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Walks {
+    pub body: Body,
+    pub entry: Entry,
+    /// Reduced single-scattering albedo α'.
+    pub alpha: f64,
+    /// Relative index of refraction (inside / outside).
+    pub eta: f32,
+    pub walks: u64,
+    pub seed: u64,
+    pub stream: u64,
+}
+
+/// Runs `w` and bins the exits by `edges`. Chunk k draws from the stream
+/// (seed, stream, k): the result does not depend on the thread count.
+pub fn transfer(w: &Walks, edges: &[f64]) -> Transfer {
+    let &Walks {
+        body,
+        entry,
+        alpha,
+        eta,
+        walks,
+        seed,
+        stream,
+    } = w;
     use rayon::prelude::*;
     const CHUNK: u64 = 2_000;
     let entry_point = match body {
@@ -111,7 +123,16 @@ mod tests {
         let edges: Vec<f64> = (0..=20).map(|i| 2.0 * radius * i as f64 / 20.0).collect();
         let edges = [&edges[..20], &[2.0 * radius + 1e-9]].concat();
         let sphere = Body::Sphere(radius);
-        let t = transfer(sphere, Entry::Diffuse, 0.99, 1.3, &edges, 4_000, 7, 3);
+        let w = Walks {
+            body: sphere,
+            entry: Entry::Diffuse,
+            alpha: 0.99,
+            eta: 1.3,
+            walks: 4_000,
+            seed: 7,
+            stream: 3,
+        };
+        let t = transfer(&w, &edges);
         let (a, _, _) = escape(sphere, 0.99, 1.3, 4_000, 7, 3);
         assert_eq!(t.fraction(0..20), a);
         // exits cluster near the entry: the first bin's density is the highest
@@ -126,7 +147,16 @@ mod tests {
     fn light_from_one_side_leaves_ahead_of_its_entry_point() {
         let edges = [0.0, 1.0, 4.0, 1e9];
         let share = |entry| {
-            let t = transfer(Body::HalfSpace, entry, 0.99, 1.5, &edges, 40_000, 7, 5);
+            let w = Walks {
+                body: Body::HalfSpace,
+                entry,
+                alpha: 0.99,
+                eta: 1.5,
+                walks: 40_000,
+                seed: 7,
+                stream: 5,
+            };
+            let t = transfer(&w, &edges);
             let n = t.counts.iter().sum::<u64>() as f64;
             (
                 t.ahead.iter().sum::<u64>() as f64 / n,
