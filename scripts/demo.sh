@@ -7,4 +7,4 @@ cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 cargo build --release
 mkdir -p out
-./target/release/lucent render scenes/marble-bunny.toml -o out/marble-bunny.exr "$@"
+./target/release/lucent render scenes/lookdev.toml -o out/lookdev.exr "$@"

@@ -374,7 +374,8 @@ fn main() -> ExitCode {
                 stats,
             };
             if let Some(format) = explain {
-                return finish(run_explain(&scene, integrator, aov, &subsurface, format));
+                let run = |file| run_explain(&scene, integrator, aov, &subsurface, &file, format);
+                return finish(file.settings().and_then(run));
             }
             file.settings().and_then(|file| {
                 let r = session::Request {
@@ -517,10 +518,12 @@ fn run_explain(
     integrator: IntegratorKind,
     aov: Option<PassSet>,
     subsurface: &SubsurfaceArgs,
+    file: &scene::OutputSettings,
     format: ExplainArg,
 ) -> Result<(), Error> {
     let mut scene = scene::load(scene_path)?;
     session::overrides::apply(&subsurface.overrides(), &mut scene.materials)?;
+    session::apply_film(&mut scene, file);
     let passes = aov.unwrap_or(scene.output.aovs);
     let plan = session::identity::render_plan(&scene, integrator, passes);
     match format {

@@ -18,6 +18,8 @@ mod obj_mtl;
 #[cfg(feature = "subsurface")]
 mod plan;
 mod region;
+#[cfg(feature = "subsurface")]
+mod regularize;
 mod scene_errors;
 mod session;
 #[cfg(feature = "subsurface")]

@@ -79,6 +79,7 @@ fn top(direct: &str, env: &str, specular: (&str, Vec<&str>), probes: &str) -> Va
         "specular_chains": {"method": specular.0, "materials": specular.1},
         "probe_queries": {"method": probes},
         "traversal": {"method": "fast"},
+        "film": {"method": "opaque"},
         "aovs": {"method": "none", "passes": []},
     })
 }
@@ -577,6 +578,7 @@ fn explain_prints_the_plan_and_writes_nothing() {
             "specular_chains",
             "probe_queries",
             "traversal",
+            "film",
             "aovs",
             "materials"
         ]

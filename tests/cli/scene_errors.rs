@@ -426,6 +426,20 @@ fn cases() -> Vec<Case> {
             Some("materials.skin.roughness"),
         ),
         case(
+            "subsurface regularize above 1",
+            format!("{CAM}{SSS}preset = \"skin1\"\nregularize = 1.5\n"),
+            "regularize: 1.5 must be in [0, 1]",
+            Some("regularize"),
+            Some("materials.skin.regularize"),
+        ),
+        case(
+            "subsurface regularize nan",
+            format!("{CAM}{SSS}preset = \"skin1\"\nregularize = nan\n"),
+            "regularize: NaN must be in [0, 1]",
+            Some("regularize"),
+            Some("materials.skin.regularize"),
+        ),
+        case(
             "subsurface roughness not a number",
             format!("{CAM}{SSS}preset = \"skin1\"\nroughness = \"rough\"\n"),
             "invalid type: string \"rough\", expected f64",

@@ -114,3 +114,33 @@ fn transparent_parts_merge_to_the_single_render() {
     assert!(s.names().contains(&"A"));
     assert!(s.channels == m.channels, "the merged frame differs");
 }
+
+/// The film row of `lucent render --explain` for these extra arguments.
+fn film_row(dir: &Path, extra: &[&str]) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args([&["render", "s.toml", "--explain"][..], extra].concat())
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let row = text.lines().find(|l| l.trim_start().starts_with("film "));
+    row.unwrap_or_else(|| panic!("no film row in\n{text}"))
+        .to_string()
+}
+
+/// Caught: `--explain` describing the scene file's film and not the one the
+/// command line asks for (the plan loaded without the film's override), or
+/// saying nothing of the film.
+#[test]
+fn explain_names_the_film_the_render_would_use() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.toml"), SCENE).unwrap();
+    assert!(film_row(d, &[]).contains("opaque"));
+    assert!(film_row(d, &["--transparent"]).contains("transparent"));
+    let with_film = format!("{SCENE}[output]\ntransparent = true\n");
+    std::fs::write(d.join("s.toml"), with_film).unwrap();
+    assert!(film_row(d, &[]).contains("transparent"));
+    assert!(film_row(d, &["--transparent=false"]).contains("opaque"));
+}

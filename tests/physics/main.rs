@@ -22,6 +22,8 @@ mod glossy;
 mod hard_cases;
 #[cfg(feature = "subsurface")]
 mod heavy_tails;
+#[cfg(feature = "subsurface")]
+mod keylight;
 mod lights;
 #[cfg(feature = "subsurface")]
 mod lod;

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
 
-use crate::part_forgery::{edit_channel, edit_header};
+use crate::part_forgery::{edit_channel, edit_header, set_words};
 
 /// Two objects (a quad and a sphere) of two materials, 16×8 at 2 spp.
 const SCENE: &str = "[camera]\nlook_from = [0, 0, 3]\nlook_at = [0, 0, 0]\nresolution = [16, 8]\n\
@@ -234,17 +234,21 @@ type Forgery = (&'static str, &'static str, fn(&Path));
 
 /// The mistake: trusting a part's pixel values: another compression than
 /// the writer's (PXR24 mangles u32 words into −2.3e18 radiance), sums no
-/// number of samples adds up to, NaN depth, IDs past the scene's objects,
+/// number of samples adds up to, a high word stored above a missing one
+/// (read as if the missing one were zero), NaN depth, IDs past the scene's objects,
 /// coverage above one, an ID of 0 wrapping a counter. Each is refused
 /// naming the file, the channel and the pixel.
 #[test]
 fn forged_part_values_are_refused_naming_file_channel_and_pixel() {
-    let cases: [Forgery; 6] = [
+    let cases: [Forgery; 7] = [
         ("compression", "PXR24", |p| {
             edit_header(p, |h| h.set("compression", "compression", vec![5]))
         }),
         ("beauty.R", "pixel (2, 0)", |p| {
-            edit_channel(p, "beauty.R.w3", |v| v[2] = 0x4000_0000)
+            set_words(p, "beauty.R", [true; 4], |w| w[3][2] = 0x4000_0000)
+        }),
+        ("beauty.G", "beauty.G.w3 without beauty.G.w2", |p| {
+            set_words(p, "beauty.G", [true, true, false, true], |_| {})
         }),
         ("nearest.depth", "pixel (0, 1)", |p| {
             edit_channel(p, "nearest.depth", |v| v[16] = f32::NAN.to_bits())

@@ -194,3 +194,50 @@ pub fn edit_channel(path: &Path, name: &str, edit: impl FnOnce(&mut Vec<u32>)) {
     edit(v);
     image.write().to_file(path).unwrap();
 }
+
+/// Rewrites summed channel `sum` (`layer.channel`) of the part at `path`
+/// with four words a pixel, `edit` changing them; `keep` says which of the
+/// words are then stored (`w0` first), so a forger can leave a gap.
+pub fn set_words(path: &Path, sum: &str, keep: [bool; 4], edit: impl FnOnce(&mut [Vec<u32>; 4])) {
+    let mut image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .unwrap();
+    let list = &mut image.layer_data.channel_data.list;
+    let stored: Vec<Vec<u32>> = (0..4)
+        .map_while(|j| {
+            let name = format!("{sum}.w{j}");
+            let c = list.iter().find(|c| c.name == *name.as_str())?;
+            match &c.sample_data {
+                FlatSamples::U32(v) => Some(v.clone()),
+                _ => panic!("{name} is not u32"),
+            }
+        })
+        .collect();
+    assert!(!stored.is_empty(), "no channel {sum}.w0");
+    // the missing high words extend the highest stored one
+    let mut words: [Vec<u32>; 4] = std::array::from_fn(|_| Vec::new());
+    for j in 0..4 {
+        words[j] = match stored.get(j) {
+            Some(v) => v.clone(),
+            None => words[j - 1]
+                .iter()
+                .map(|&w| ((w as i32) >> 31) as u32)
+                .collect(),
+        };
+    }
+    edit(&mut words);
+    list.retain(|c| !c.name.to_string().starts_with(&format!("{sum}.w")));
+    for (j, w) in words.into_iter().enumerate().filter(|(j, _)| keep[*j]) {
+        list.push(AnyChannel::new(
+            format!("{sum}.w{j}").as_str(),
+            FlatSamples::U32(w),
+        ));
+    }
+    list.sort_by(|a, b| a.name.cmp(&b.name));
+    image.write().to_file(path).unwrap();
+}

@@ -20,12 +20,28 @@ use lucent::materials::dielectric;
 use lucent::sampling::{cosine_hemisphere, Draw};
 
 /// How light enters the half-space.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Entry {
     /// Uniform radiance outside: cosine-weighted, refracted with prob. Ft.
     Diffuse,
     /// Along the normal (μ = 1), refracted with probability Ft(1).
     Normal,
+    /// From the direction at cos θ = μ to the normal in the xz-plane on
+    /// the +x side (the refracted light heads towards −x), refracted with
+    /// probability Ft(μ): a key light (`crate::sphere_transfer`).
+    Oblique(f32),
+}
+
+impl Entry {
+    /// The random stream a run of walks entering this way draws from
+    /// (diffuse 0 and normal 1, as the albedo table was made).
+    fn stream(self) -> u64 {
+        match self {
+            Entry::Diffuse => 0,
+            Entry::Normal => 1,
+            Entry::Oblique(mu) => 2 + mu.to_bits() as u64,
+        }
+    }
 }
 
 /// The direction (z < 0) of one walk entering the medium.
@@ -35,6 +51,7 @@ pub(crate) fn enter(eta: f32, entry: Entry, rng: &mut impl Draw) -> Vec3 {
         let wo = match entry {
             Entry::Diffuse => cosine_hemisphere(rng.uniform2()),
             Entry::Normal => Vec3::new(0.0, 0.0, 1.0),
+            Entry::Oblique(mu) => Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu),
         };
         let s = dielectric::sample(eta, wo, rng.uniform());
         if s.transmitted {
@@ -233,7 +250,7 @@ pub fn run(eta: f64, g: f64, entry: Entry, albedos: &[f64], b: &Batch) -> Tally 
     let parts: Vec<Tally> = (0..chunks)
         .into_par_iter()
         .map(|k| {
-            let mut rng = Rng::new(seed, entry as u64, k);
+            let mut rng = Rng::new(seed, entry.stream(), k);
             let mut t = Tally::new(albedos, cap);
             let n = chunk.min(walks - k * chunk);
             for _ in 0..n {

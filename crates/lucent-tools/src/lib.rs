@@ -12,6 +12,9 @@
 //!   physics in a plane-parallel half-space (`docs/bssrdf.md` §9).
 //! - [`sphere_albedo`]: the curvature table's generator — the same physics
 //!   in a sphere, against the half-space (`docs/bssrdf.md` §10).
+//! - [`sphere_transfer`]: where light entering a sphere at one point
+//!   leaves it, by chord distance — the diffusion profile's ground truth
+//!   on a curved body (`docs/bssrdf.md` §10).
 //! - [`plot`]: the PNG canvas, font, palette and log axes both draw with.
 //! - [`progress`]: a render's [`lucent::progress::Progress`] drawn as a bar
 //!   on stderr (indicatif).
@@ -26,5 +29,7 @@ pub mod plot;
 pub mod progress;
 #[cfg(feature = "subsurface")]
 pub mod sphere_albedo;
+#[cfg(feature = "subsurface")]
+pub mod sphere_transfer;
 #[cfg(feature = "subsurface")]
 pub mod study;

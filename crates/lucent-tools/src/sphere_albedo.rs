@@ -65,7 +65,22 @@ fn outward(body: Body, p: DVec3) -> DVec3 {
 /// medium of reduced albedo `alpha` and relative index `eta`: whether it
 /// leaves again, and how many scattering events it had.
 pub fn walk(body: Body, alpha: f64, eta: f32, rng: &mut impl Draw) -> (bool, u64) {
-    let mut d = enter(eta, Entry::Diffuse, rng).as_dvec3().normalize();
+    let (exit, events) = walk_to_exit(body, Entry::Diffuse, alpha, eta, rng);
+    (exit.is_some(), events)
+}
+
+/// [`walk`] with the point where the light leaves (None if absorbed) and
+/// the light entering as `entry` says (the same random numbers as [`walk`]
+/// for [`Entry::Diffuse`]): what `crate::sphere_transfer` bins by
+/// distance.
+pub fn walk_to_exit(
+    body: Body,
+    entry: Entry,
+    alpha: f64,
+    eta: f32,
+    rng: &mut impl Draw,
+) -> (Option<DVec3>, u64) {
+    let mut d = enter(eta, entry, rng).as_dvec3().normalize();
     let mut p = match body {
         Body::Sphere(r) => DVec3::new(0.0, 0.0, r),
         Body::HalfSpace => DVec3::ZERO,
@@ -89,7 +104,7 @@ pub fn walk(body: Body, alpha: f64, eta: f32, rng: &mut impl Draw) -> (bool, u64
             let wo = frame.to_local(-d.as_vec3());
             let b = dielectric::sample(eta, wo, rng.uniform());
             if b.transmitted {
-                return (true, events);
+                return (Some(p), events);
             }
             d = frame.to_world(b.wi).as_dvec3().normalize();
             continue;
@@ -97,7 +112,7 @@ pub fn walk(body: Body, alpha: f64, eta: f32, rng: &mut impl Draw) -> (bool, u64
         p += t * d;
         events += 1;
         if rng.uniform_f64() >= alpha {
-            return (false, events);
+            return (None, events);
         }
         d = sample_hg(d.as_vec3(), 0.0, rng.uniform2())
             .as_dvec3()

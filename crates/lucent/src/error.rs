@@ -183,6 +183,8 @@ pub enum Param {
     RmaxQuantile,
     /// The roughness of a subsurface material's coat.
     Roughness,
+    /// The least roughness of that coat after a non-specular vertex.
+    Regularize,
 }
 
 impl Param {
@@ -205,6 +207,7 @@ impl Param {
             Param::Rmax => "rmax",
             Param::RmaxQuantile => "rmax_quantile",
             Param::Roughness => "roughness",
+            Param::Regularize => "regularize",
         }
     }
 }

@@ -25,7 +25,7 @@ use crate::film::Sums;
 use crate::stats::Counters;
 
 /// The part format this build writes and reads.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 
 /// What `lucent.format` says of a part.
 const FORMAT: &str = "lucent-part";

@@ -22,6 +22,7 @@ pub mod merge;
 pub mod part;
 mod part_file;
 mod part_values;
+mod part_words;
 pub mod scene_hash;
 
 pub use scene_hash::scene_hash;

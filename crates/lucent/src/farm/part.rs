@@ -3,9 +3,11 @@
 //!
 //! One scan-line EXR (ZIP), its data window the part's region, its display
 //! window the whole frame. Each summed channel `C` of a layer `L` (the
-//! beauty's `beauty.R` … then the passes' summed layers) is four `u32`
-//! channels `L.C.w0` … `L.C.w3`, the words of the pixel's `i128` sum, least
-//! significant first ([`to_words`]: EXR's only integer sample type is u32).
+//! beauty's `beauty.R` … then the passes' summed layers) is up to four
+//! `u32` channels `L.C.w0` … `L.C.w3`, the words of the pixel's `i128` sum,
+//! least significant first ([`to_words`]: EXR's only integer sample type
+//! is u32), the high words the channel's sums do not need left out
+//! (`farm/part_words.rs`).
 //! With P, Z or an ID pass the nearest camera hit is the u32 channels
 //! `nearest.depth`, `nearest.sample`, `nearest.px`/`py`/`pz` (f32 bits),
 //! `nearest.object`, `nearest.material`; with Cryptomatte, the sample
@@ -26,6 +28,7 @@ use super::header::bad;
 pub(crate) use super::part_file::PartFile;
 use super::part_file::NEAREST;
 use super::part_values::PixelAt;
+use super::part_words;
 use crate::error::Error;
 use crate::film::accumulate::{from_words, to_words};
 use crate::film::pass_sums::{AovSums, Nearest, Passes};
@@ -78,28 +81,67 @@ fn sum_at(sums: &mut Sums, k: usize, i: usize) -> Option<&mut i128> {
     p.sums.sums.get_mut(i * stride + k - C)
 }
 
-/// [`sum_at`], to read.
-fn sum_of(sums: &Sums, k: usize, i: usize) -> i128 {
-    const C: usize = Sums::CHANNELS;
-    match &sums.passes {
-        _ if k < C => sums.pixel_at(i)[k],
-        Some(p) => p.sums.sums[i * p.layout.stride() + k - C],
-        None => 0,
-    }
+/// Pixels a thread copies at a time.
+const CHUNK: usize = 4096;
+
+/// The summed values of the pixel of index `i`, in [`sum_names`] order.
+fn pixel_sums(sums: &Sums, i: usize) -> impl Iterator<Item = &i128> {
+    let passes = sums.passes.as_ref().map_or(&[][..], |p| {
+        let stride = p.layout.stride();
+        &p.sums.sums[i * stride..(i + 1) * stride]
+    });
+    sums.pixel_at(i).iter().chain(passes)
 }
 
-/// The words of every summed channel.
+/// The words of every summed channel, as many as its largest sum needs
+/// (`farm/part_words.rs`). The sums are read pixel by pixel, as they lie
+/// in memory, on every core: a checkpoint's copy holds up the render, an
+/// interrupted render's its exit.
 fn sum_channels(sums: &Sums, order: &[usize]) -> Vec<Channel> {
+    use rayon::prelude::*;
     let layout = sums.passes.as_ref().map(|p| &p.layout);
-    let mut out = Vec::new();
-    for (k, name) in sum_names(&layers_of(layout)).iter().enumerate() {
-        let mut words: [Vec<u32>; 4] = std::array::from_fn(|_| Vec::with_capacity(order.len()));
-        for &i in order {
-            for (w, v) in words.iter_mut().zip(to_words(sum_of(sums, k, i))) {
-                w.push(v);
+    let names = sum_names(&layers_of(layout));
+    let ones = || vec![1usize; names.len()];
+    let m = order
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut m = ones();
+            for &i in chunk {
+                for (m, v) in m.iter_mut().zip(pixel_sums(sums, i)) {
+                    *m = (*m).max(part_words::words_needed(*v));
+                }
             }
+            m
+        })
+        .reduce(ones, |a, b| {
+            a.iter().zip(b).map(|(a, b)| b.max(*a)).collect()
+        });
+    let n = order.len();
+    let mut words: Vec<Vec<u32>> = m.iter().flat_map(|&m| (0..m).map(|_| vec![0; n])).collect();
+    let mut chunks: Vec<Vec<&mut [u32]>> = (0..n.div_ceil(CHUNK)).map(|_| Vec::new()).collect();
+    for w in words.iter_mut() {
+        for (t, slice) in w.chunks_mut(CHUNK).enumerate() {
+            chunks[t].push(slice);
         }
-        for (j, w) in words.into_iter().enumerate() {
+    }
+    chunks
+        .into_par_iter()
+        .zip(order.par_chunks(CHUNK))
+        .for_each(|(mut out, pixels)| {
+            for (j, &i) in pixels.iter().enumerate() {
+                let mut at = 0;
+                for (&m, v) in m.iter().zip(pixel_sums(sums, i)) {
+                    for (o, w) in out[at..at + m].iter_mut().zip(to_words(*v)) {
+                        o[j] = w;
+                    }
+                    at += m;
+                }
+            }
+        });
+    let mut words = words.into_iter();
+    let mut out = Vec::with_capacity(words.len());
+    for (name, &m) in names.iter().zip(&m) {
+        for (j, w) in words.by_ref().take(m).enumerate() {
             out.push(Channel::new(
                 format!("{name}.w{j}").as_str(),
                 FlatSamples::U32(w),
@@ -299,20 +341,42 @@ impl Channels<'_> {
         sums: &mut Sums,
     ) -> Result<usize, Error> {
         let names = sum_names(layers);
+        let mut read = 0;
         for (k, name) in names.iter().enumerate() {
-            let mut w: [&[u32]; 4] = [&[]; 4];
-            for (j, w) in w.iter_mut().enumerate() {
-                *w = self.get(&format!("{name}.w{j}"))?;
-            }
+            let stored = self.stored_words(name)?;
+            read += stored.len();
             for (j, &i) in order.iter().enumerate() {
-                let v = from_words([w[0][j], w[1][j], w[2][j], w[3][j]]);
+                let mut words = [0u32; 4];
+                for (w, s) in words.iter_mut().zip(&stored) {
+                    *w = s[j];
+                }
+                let v = from_words(part_words::widened(&words[..stored.len()]));
                 self.at.check_sum(v, j).map_err(|e| self.located(name, e))?;
                 if let Some(s) = sum_at(sums, k, i) {
                     *s = v;
                 }
             }
         }
-        Ok(4 * names.len())
+        Ok(read)
+    }
+
+    /// The stored words of summed channel `name`: `w0`, then each higher
+    /// word up to the first missing one; a word above a missing one is
+    /// refused.
+    fn stored_words(&self, name: &str) -> Result<Vec<&[u32]>, Error> {
+        let mut stored = vec![self.get(&format!("{name}.w0"))?];
+        for j in 1..4 {
+            let word = format!("{name}.w{j}");
+            match (self.has(&word), stored.len() == j) {
+                (true, true) => stored.push(self.get(&word)?),
+                (true, false) => {
+                    let problem = format!("channel {word} without {name}.w{}", j - 1);
+                    return Err(self.located(name, problem));
+                }
+                (false, _) => {}
+            }
+        }
+        Ok(stored)
     }
 
     /// Reads the nearest hits, if the passes keep them; the channels read.

@@ -20,9 +20,11 @@ pub(crate) const RR_START: u32 = 3;
 pub(crate) const MAX_BRANCHES: usize = 4;
 
 /// A path to trace: its ray, throughput, the last non-specular vertex and
-/// its lobe pdf (for the emission MIS weight), its depth, the class of
-/// its first event (for the light-path passes), and its footprint cone
-/// (for subsurface level of detail, [`crate::materials::lod`]).
+/// its lobe pdf (for the emission MIS weight), whether it has scattered
+/// off a non-specular lobe (for the regularized coat), its depth, the
+/// class of its first event (for the light-path passes), and its
+/// footprint cone (for subsurface level of detail,
+/// [`crate::materials::lod`]).
 #[derive(Clone, Copy)]
 pub(crate) struct Branch {
     pub(crate) ray: Ray,
@@ -33,6 +35,10 @@ pub(crate) struct Branch {
     /// None after the camera or a specular bounce, where no light sample
     /// competed for this direction.
     pub(crate) prev: Option<PrevVertex>,
+    /// Some vertex before this ray scattered with a non-specular lobe: a
+    /// smooth coat met from here on reflects as the regularized one
+    /// (`docs/bssrdf.md` §6, "Regularized coat").
+    pub(crate) scattered: bool,
     pub(crate) depth: u32,
     pub(crate) event: Event,
     pub(crate) cone: Cone,
@@ -40,10 +46,12 @@ pub(crate) struct Branch {
 
 impl Branch {
     /// Goes on along `b`, which leaves the object `from` (if it cannot
-    /// meet it), with the footprint `cone`.
+    /// meet it), with the footprint `cone`; a lobe's bounce (one with a
+    /// previous vertex) marks the path as scattered.
     #[inline(always)]
     pub(crate) fn go_on(&mut self, b: Bounce, from: Option<u32>, cone: Cone) {
         (self.ray, self.beta, self.prev) = (b.ray, b.beta, b.prev);
+        self.scattered |= b.prev.is_some();
         self.from = from;
         self.cone = cone;
     }

@@ -76,6 +76,7 @@ pub(crate) fn trace<R: Recorder, T: Clock, S: SubsurfaceScatter>(
         from: None,
         beta: Vec3::ONE,
         prev: None,
+        scattered: false,
         depth: 0,
         // Set at the first hit.
         event: Event::Diffuse,
@@ -297,6 +298,7 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
                 wo,
                 depth,
                 width,
+                scattered: path.scattered,
             };
             subsurface_hit::<R, T, S>(ctx, &h, &mut path.beta, st, subsurface)
         }

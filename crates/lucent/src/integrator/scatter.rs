@@ -16,14 +16,17 @@ use crate::geometry::{Ray, Vec3};
 use crate::materials::Subsurface;
 
 /// A hit on a subsurface object at xo: its material, the interaction, ωo,
-/// the path's depth there and the width of its footprint
-/// ([`crate::materials::lod`]).
+/// the path's depth there, the width of its footprint
+/// ([`crate::materials::lod`]) and whether the path has scattered off a
+/// non-specular lobe before (the diffusion estimator's coat is then the
+/// regularized one, `docs/bssrdf.md` §6).
 pub(crate) struct SubsurfaceHit<'h, 's> {
     pub(crate) ss: &'s Subsurface,
     pub(crate) si: &'h Interaction,
     pub(crate) wo: Vec3,
     pub(crate) depth: u32,
     pub(crate) width: f32,
+    pub(crate) scattered: bool,
 }
 
 /// An estimator of light transport through subsurface objects. The bounce

@@ -42,6 +42,9 @@ pub struct Subsurface {
     probe: ProbeSampler,
     /// The rough coat, when α ≥ [`SMOOTH_ALPHA`]; None: the smooth one.
     coat: Option<RoughCoat>,
+    /// The coat after a non-specular vertex, where `regularize` asks for
+    /// one rougher than `coat` (`docs/bssrdf.md` §6, "Regularized coat").
+    regularized: Option<RoughCoat>,
     /// c = 1 − 2 FM1(1/η), Sw's normalization (for a rough coat, 1 − Ē).
     sw_c: f32,
     /// The correction, when the mode is on and the parameters record a
@@ -72,6 +75,14 @@ impl Subsurface {
                 Constraint::UnitInterval,
             ));
         }
+        let regularize = options.regularize;
+        if !(0.0..=1.0).contains(&regularize) {
+            return Err(ParamError::new(
+                Param::Regularize,
+                regularize,
+                Constraint::UnitInterval,
+            ));
+        }
         let probe = ProbeSampler::new(&params, &options.probe)?;
         let curvature = curvature_for(&params, &probe, options.curvature);
         let lod = LodRule::new(
@@ -82,6 +93,9 @@ impl Subsurface {
         );
         let alpha = alpha_from_roughness(roughness);
         let coat = (alpha >= SMOOTH_ALPHA).then(|| RoughCoat::new(alpha, params.eta));
+        let alpha_min = alpha_from_roughness(regularize);
+        let regularized = (alpha_min >= SMOOTH_ALPHA && alpha_min > alpha)
+            .then(|| RoughCoat::new(alpha_min, params.eta));
         let sw_c = match &coat {
             Some(c) => 1.0 - c.mean_albedo(),
             None => sw_normalization(params.eta),
@@ -91,6 +105,7 @@ impl Subsurface {
             options: *options,
             probe,
             coat,
+            regularized,
             sw_c,
             curvature,
             lod,
@@ -227,6 +242,18 @@ impl Subsurface {
         self.coat.as_ref()
     }
 
+    /// The coat a path meets after a non-specular vertex: the regularized
+    /// one where `regularize` asks for a rougher coat, else
+    /// [`rough_coat`](Self::rough_coat).
+    pub fn coat_after_diffuse(&self) -> Option<&RoughCoat> {
+        self.regularized.as_ref().or(self.coat.as_ref())
+    }
+
+    /// The regularized coat, where `regularize` makes one.
+    pub fn regularized_coat(&self) -> Option<&RoughCoat> {
+        self.regularized.as_ref()
+    }
+
     pub fn eta(&self) -> f32 {
         self.params.eta
     }
@@ -287,6 +314,36 @@ mod tests {
     use super::*;
     use crate::bssrdf::{Fit, ProbeAxes, RadiusSampler};
     use crate::materials::estimator_options::Assignments;
+
+    /// Caught: a regularized coat no rougher than the material's own (the
+    /// rule would then smooth a rough coat), one built with the option
+    /// off, or an option out of [0, 1] accepted.
+    #[test]
+    fn the_regularized_coat_is_the_rougher_one_and_absent_when_off() {
+        let p = SubsurfaceParams::from_preset("marble", 1.0, Fit::Searchlight).unwrap();
+        let ss = Subsurface::new(p, &ProbeOptions::default(), true, true).unwrap();
+        let with = |ss: &Subsurface, name: &str, v: f32| {
+            ss.with_options(&Assignments::default().with(name, v).over(ss.options))
+        };
+        // smooth coat: α_min = 0.3² after a non-specular vertex
+        let on = with(&ss, "regularize", 0.3).unwrap();
+        assert!(on.rough_coat().is_none());
+        assert_eq!(on.coat_after_diffuse().unwrap().ggx.alpha, 0.3 * 0.3);
+        assert_eq!(on.coat_after_diffuse().unwrap().eta, p.eta);
+        // off: the coat as given everywhere
+        let off = with(&ss, "regularize", 0.0).unwrap();
+        assert!(off.regularized_coat().is_none() && off.coat_after_diffuse().is_none());
+        // a rough coat rougher than α_min is kept; a smoother one is not
+        let rough = with(&on, "roughness", 0.6).unwrap();
+        assert!(rough.regularized_coat().is_none());
+        assert_eq!(rough.coat_after_diffuse(), rough.rough_coat());
+        let fine = with(&on, "roughness", 0.1).unwrap();
+        assert_eq!(fine.coat_after_diffuse().unwrap().ggx.alpha, 0.3 * 0.3);
+        for bad in [-0.1, 1.5, f32::NAN] {
+            let e = with(&ss, "regularize", bad).unwrap_err();
+            assert_eq!(e.param, Param::Regularize, "{bad}");
+        }
+    }
 
     #[test]
     fn overrides_replace_only_what_they_name() {

@@ -301,6 +301,8 @@ pub struct MaterialDef {
     // subsurface: variance reduction at the camera vertex
     pub control_variate: Option<Spanned<bool>>,
     pub probe_pair: Option<Spanned<bool>>,
+    // subsurface: the coat's least roughness after a non-specular vertex
+    pub regularize: Option<Spanned<f64>>,
     // conductor: a named metal, or its complex index n + ik per channel
     // (`roughness` above serves the conductor, plastic and dielectric too)
     pub metal: Option<Spanned<String>>,
@@ -366,6 +368,7 @@ impl MaterialDef {
             self.control_variate.as_ref().map(|x| x.span()),
         );
         add("probe_pair", self.probe_pair.as_ref().map(|x| x.span()));
+        add("regularize", self.regularize.as_ref().map(|x| x.span()));
         v
     }
 }

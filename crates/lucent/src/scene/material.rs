@@ -212,6 +212,7 @@ fn key_of(p: Param, m: &Spanned<MaterialDef>) -> Option<(&'static str, std::ops:
         Param::RadiusSampler | Param::TableSize => "radius",
         Param::RmaxQuantile => "rmax_quantile",
         Param::Roughness => "roughness",
+        Param::Regularize => "regularize",
         Param::D | Param::Rmax | Param::UnitsPerMm => return None,
     };
     let present = m.get_ref().present_keys();
@@ -400,6 +401,7 @@ fn option_value(d: &MaterialDef, key: &str) -> Option<(String, std::ops::Range<u
         "lod_threshold" => f(&d.lod_threshold),
         "control_variate" => b(&d.control_variate),
         "probe_pair" => b(&d.probe_pair),
+        "regularize" => f(&d.regularize),
         _ => None,
     }
 }

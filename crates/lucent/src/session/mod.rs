@@ -26,4 +26,4 @@ pub use overrides::Overrides;
 pub use paste::{paste, Pasted};
 pub use provenance::{build_id, embree4_warning};
 pub use request::{Request, Split};
-pub use run::{run, stop_if_interrupted, Outcome};
+pub use run::{apply_film, run, stop_if_interrupted, Outcome};

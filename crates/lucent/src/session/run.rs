@@ -127,11 +127,16 @@ fn load(r: &Request) -> Result<(Scene, String, String), Error> {
     let text = scene::load::read_regular_file(&r.scene, scene::load::MAX_SCENE_BYTES)
         .map_err(|e| InputError::new(&r.scene, format!("cannot read scene file: {e}")))?;
     let options = overrides::apply(&r.overrides, &mut scene.materials)?;
-    // the film is the renderer's to know (`integrator::plan::Plan`)
-    if let Some(t) = r.file.transparent {
+    apply_film(&mut scene, &r.file);
+    Ok((scene, text, options))
+}
+
+/// The command line's film settings in `scene`: the film is the
+/// renderer's to know (`integrator::plan::Plan`), and the plan's.
+pub fn apply_film(scene: &mut Scene, file: &crate::scene::OutputSettings) {
+    if let Some(t) = file.transparent {
         scene.output.file.transparent = Some(t);
     }
-    Ok((scene, text, options))
 }
 
 /// Renders `r` and writes its frame or part; a signal keeps the finished

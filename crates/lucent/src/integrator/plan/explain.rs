@@ -85,6 +85,10 @@ pub struct Explanation {
     /// ([`crate::accel::Traversal`]); absent in plans written before it.
     #[serde(default)]
     pub traversal: Choice,
+    /// What alpha holds and whether camera rays see the environment;
+    /// absent in plans written before it.
+    #[serde(default)]
+    pub film: Choice,
     pub aovs: Aovs,
     pub materials: Vec<MaterialPlan>,
 }
@@ -103,6 +107,7 @@ impl Explanation {
             specular_chains: specular_chains(rows.specular_materials, &rows.specular_why),
             probe_queries: probe_queries(opts, &rows.probes_needed),
             traversal: traversal(scene, opts),
+            film: film(&flags),
             aovs: aovs(opts),
             materials: rows.materials,
         }
@@ -201,6 +206,23 @@ fn environment(scene: &Scene, flags: &Plan) -> Choice {
             ),
         ),
         _ => choice("none", "no environment (or black): escaping paths end"),
+    }
+}
+
+/// The film: opaque, or transparent with alpha the coverage of camera
+/// rays (docs/output.md, "Transparent film").
+fn film(flags: &Plan) -> Choice {
+    match flags.transparent {
+        true => choice(
+            "transparent",
+            "alpha = the fraction of each pixel's camera rays that hit something; the \
+             environment and distant lights seen directly are left out, so the beauty \
+             composites with \"over\"",
+        ),
+        false => choice(
+            "opaque",
+            "alpha 1: the environment seen directly is part of the beauty",
+        ),
     }
 }
 

@@ -370,18 +370,27 @@ fn diffusion_coat(ss: &Subsurface) -> Choice {
     } else {
         "one chosen by Fr".to_string()
     };
+    let after = match ss.regularized_coat() {
+        Some(c) if ss.specular() => format!(
+            "; after a non-specular vertex GGX α = {} (regularize {}), light-sampled at xo",
+            c.ggx.alpha,
+            ss.options().regularize
+        ),
+        _ => String::new(),
+    };
     match (ss.rough_coat(), ss.specular()) {
         (None, true) => choice(
             "smooth",
             format!(
-                "roughness {}: a mirror reflecting Fr, {split}",
+                "roughness {}: a mirror reflecting Fr, {split}{after}",
                 ss.roughness()
             ),
         ),
         (Some(c), true) => choice(
             "rough",
             format!(
-                "roughness {}: GGX α = {}, light-sampled at xo, chosen with probability E(μo)",
+                "roughness {}: GGX α = {}, light-sampled at xo, chosen with probability \
+                 E(μo){after}",
                 ss.roughness(),
                 c.ggx.alpha
             ),

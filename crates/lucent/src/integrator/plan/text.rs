@@ -43,6 +43,7 @@ pub fn render(p: &Explanation) -> String {
         &p.probe_queries.reason,
     );
     row(r, "traversal", &p.traversal.method, &p.traversal.reason);
+    row(r, "film", &p.film.method, &p.film.reason);
     let aov_reason = if p.aovs.passes.is_empty() {
         p.aovs.reason.clone()
     } else {

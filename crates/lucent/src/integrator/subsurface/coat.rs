@@ -24,7 +24,10 @@ const _: () = assert!(COAT_SPLIT_DEPTH as usize <= MAX_BRANCHES);
 /// A subsurface hit at xo under the diffusion model: the coat at xo, then
 /// the probe(s) for the entry point xi, where the path continues with the
 /// entry lobe. Without `specular` the reflection is dropped and the medium
-/// weighted by 1 − Fr or 1 − E.
+/// weighted by 1 − Fr or 1 − E. After a non-specular vertex the coat is
+/// the regularized one where the material has it (`docs/bssrdf.md` §6,
+/// "Regularized coat"): its reflection is light-sampled, so the caustics a
+/// mirror would make are found by next-event estimation with MIS.
 #[inline(never)]
 pub(super) fn scatter<'s, R: Recorder>(
     ctx: &Context,
@@ -32,7 +35,12 @@ pub(super) fn scatter<'s, R: Recorder>(
     beta: &mut Vec3,
     st: &mut PathState<R>,
 ) -> Scatter<'s> {
-    match hit.ss.rough_coat() {
+    let coat = if hit.scattered {
+        hit.ss.coat_after_diffuse()
+    } else {
+        hit.ss.rough_coat()
+    };
+    match coat {
         None => smooth(ctx, hit, beta, st),
         Some(rc) => rough(ctx, rc, hit, beta, st),
     }

@@ -47,7 +47,7 @@ pub(crate) fn resolve<'v, 's, R: Recorder, T: Clock>(
         // Both: this path enters the medium, the reflection waits on the
         // stack (one branch per split depth).
         (Some(v), Some(r)) => {
-            push_reflection(ctx, r, at, coat_event, st, stack);
+            push_reflection(ctx, r, at, path, coat_event, st, stack);
             (Some(v), None)
         }
         (Some(v), None) => (Some(v), None),
@@ -64,12 +64,14 @@ pub(crate) fn resolve<'v, 's, R: Recorder, T: Clock>(
     }
 }
 
-/// The coat's reflection `r`, pushed on the stack if it survives roulette.
+/// The coat's reflection `r` off `path`, pushed on the stack if it
+/// survives roulette.
 #[inline(always)]
 fn push_reflection<R: Recorder>(
     ctx: &Context,
     r: Bounce,
     at: &At,
+    path: &Branch,
     event: Event,
     st: &mut PathState<R>,
     stack: &mut Branches,
@@ -81,6 +83,7 @@ fn push_reflection<R: Recorder>(
             from: ctx.leaving_towards(at.si, r.ray.d),
             beta: b,
             prev: r.prev,
+            scattered: path.scattered || r.prev.is_some(),
             depth: at.depth + 1,
             event,
             cone: at.cone_specular,
