@@ -8,7 +8,10 @@
 # and an Embree 4 for the tests of the `embree4` backend (Debian 12 has
 # none: the 4.4.0 library and the TBB it needs, from the `embreex` wheel on
 # PyPI, unpacked into .cache/embree4/, which scripts/test.sh points
-# LUCENT_EMBREE4 at). Safe to run any number of times.
+# LUCENT_EMBREE4 at), and Open Image Denoise 2.5.1 for the denoise tests
+# (Debian 12 has none: the official release libraries from the `pyoidn`
+# wheel on PyPI, unpacked into .cache/oidn/lib/, which scripts/test.sh
+# points LUCENT_OIDN at). Safe to run any number of times.
 set -euo pipefail
 
 need=()
@@ -63,4 +66,37 @@ if [ ! -e "$e4/libembree4.so.4" ]; then
   rm -rf "$e4"
   mv "$e4.part" "$e4"
   echo "Embree 4.4.0 unpacked into $e4" >&2
+fi
+
+# Open Image Denoise 2.5.1 from the pyoidn 2.5.1.0 wheel (py3-none: one
+# wheel for every interpreter): the official release's libOpenImageDenoise,
+# its core, its CPU device module and the TBB that module links. They keep
+# their directory name lib/: each has RPATH $ORIGIN/../lib, and OIDN loads
+# its device modules from its own directory. The GPU device modules are
+# left out (OIDN skips a module it does not find).
+oidn=.cache/oidn
+if [ ! -e "$oidn/lib/libOpenImageDenoise.so.2" ]; then
+  command -v python3 >/dev/null 2>&1 || {
+    echo "error: python3 (with pip) is needed to fetch Open Image Denoise for the tests" >&2
+    exit 1
+  }
+  tmp2=$(mktemp -d)
+  trap 'rm -rf "${tmp:-}" "$tmp2"' EXIT
+  python3 -m pip download --quiet --no-deps --only-binary=:all: \
+    --python-version 3.11 --platform manylinux2014_x86_64 \
+    -d "$tmp2" pyoidn==2.5.1.0
+  mkdir -p "$oidn.part/lib"
+  python3 - "$tmp2"/pyoidn-2.5.1.0-*.whl "$oidn.part/lib" <<'PY'
+import sys, zipfile
+wheel, dest = sys.argv[1], sys.argv[2]
+names = ["libOpenImageDenoise.so.2", "libOpenImageDenoise_core.so.2.5.1",
+         "libOpenImageDenoise_device_cpu.so.2.5.1", "libtbb.so.12"]
+with zipfile.ZipFile(wheel) as z:
+    for n in names:
+        with z.open("pyoidn/oidn/lib/" + n) as src, open(dest + "/" + n, "wb") as dst:
+            dst.write(src.read())
+PY
+  rm -rf "$oidn"
+  mv "$oidn.part" "$oidn"
+  echo "Open Image Denoise 2.5.1 unpacked into $oidn/lib" >&2
 fi

@@ -15,6 +15,10 @@ scripts/install-deps.sh
 # unpacked (Debian 12 has no Embree 4), and must not skip for want of it.
 export LUCENT_EMBREE4="$PWD/.cache/embree4/libembree4.so.4"
 export LUCENT_REQUIRE_EMBREE4=1
+# The denoise tests run against the Open Image Denoise 2.5.1 it unpacked,
+# and must not skip for want of it either.
+export LUCENT_OIDN="$PWD/.cache/oidn/lib/libOpenImageDenoise.so.2"
+export LUCENT_REQUIRE_OIDN=1
 
 cargo fmt --all -- --check
 # rust-version covers every locked dependency; clippy's incompatible_msrv

@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
+use lucent::denoise::DenoiseOptions;
 use lucent::film::exr_layers::Preview;
 use lucent::film::passes::PassSet;
 use lucent::film::ToneMap;
@@ -21,6 +22,7 @@ use lucent::session;
 use lucent::Error;
 
 mod args;
+mod denoise;
 mod values;
 use args::{FileArgs, SplitArgs};
 use values::parse_aov;
@@ -141,6 +143,12 @@ enum Command {
         /// (docs/performance.md, "Per-effect statistics").
         #[arg(long)]
         stats: bool,
+        /// Also write the beauty denoised by Open Image Denoise (the layer
+        /// `denoised`, which the PNG preview shows), guided by the albedo
+        /// and N passes (added if not asked for). Frames only: denoise a
+        /// split render after the merge (docs/output.md, "Denoising").
+        #[arg(long)]
+        denoise: bool,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
         #[command(flatten)]
@@ -174,7 +182,20 @@ enum Command {
         /// Without it such parts are refused.
         #[arg(long)]
         mixed_backends: bool,
+        /// Also write the merged frame's beauty denoised (the layer
+        /// `denoised`, which the PNG preview shows), from its albedo and N
+        /// passes (docs/output.md, "Denoising").
+        #[arg(long)]
+        denoise: bool,
+        /// The denoiser's threads, 1 to 1024 (default: all cores).
+        #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
+        threads: Option<usize>,
     },
+    /// Denoise a finished frame (a render or a merge) with Open Image
+    /// Denoise from its own beauty, albedo and N layers: the frame is
+    /// written with the layer `denoised` added, and the PNG preview from
+    /// it (docs/output.md, "Denoising").
+    Denoise(denoise::DenoiseArgs),
     /// Paste a region render (`render --region`) into a frame: only the
     /// region's pixels change, bit for bit, in every channel; the frame's
     /// header and storage stay. The files must have the same display
@@ -331,6 +352,7 @@ fn main() -> ExitCode {
             aov,
             explain,
             stats,
+            denoise,
             subsurface,
             file,
             split,
@@ -369,6 +391,7 @@ fn main() -> ExitCode {
                         tonemap: tonemap.into(),
                         exposure,
                     },
+                    denoise: denoise.then(|| DenoiseOptions::with_threads(threads)),
                 };
                 run_render(&r, quiet)
             })
@@ -380,17 +403,21 @@ fn main() -> ExitCode {
             exposure,
             quiet,
             mixed_backends,
+            denoise,
+            threads,
         } => {
             let preview = Preview {
                 tonemap: tonemap.into(),
                 exposure,
             };
-            session::merge_parts(&parts, &output, preview, mixed_backends).map(|m| {
+            let d = denoise.then(|| DenoiseOptions::with_threads(threads));
+            session::merge_parts(&parts, &output, preview, mixed_backends, d.as_ref()).map(|m| {
                 if !quiet {
                     tell!("{}", m.summary(&output));
                 }
             })
         }
+        Command::Denoise(args) => denoise::run(args),
         Command::Paste {
             region,
             frame,

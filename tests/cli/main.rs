@@ -10,6 +10,7 @@ mod common;
 mod aov;
 mod bench_cli;
 mod cli;
+mod denoise;
 mod environment_image;
 mod exr_oiio;
 mod farm;

@@ -37,6 +37,7 @@ fn request(output: PathBuf, samples: std::ops::Range<u32>, resume: Option<&Path>
             tonemap: ToneMap::Filmic,
             exposure: 0.0,
         },
+        denoise: None,
     }
 }
 

@@ -12,6 +12,7 @@ pub mod accel;
 pub mod analytic_lights;
 #[cfg(feature = "subsurface")]
 pub mod bssrdf;
+pub mod denoise;
 pub mod environment;
 pub mod error;
 pub mod farm;

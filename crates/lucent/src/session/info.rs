@@ -1,10 +1,11 @@
 //! What this build of lucent can do (`lucent info`): its ray-query
-//! backends, the default one, and whether it has subsurface scattering.
+//! backends, the default one, the denoiser found (if any) and whether it
+//! has subsurface scattering.
 
 use crate::accel::{self, Backend};
 
 /// A few lines: the version, the backends available (and why an Embree is
-/// missing), the default backend and the subsurface feature.
+/// missing), the default backend, the denoiser and the subsurface feature.
 pub fn build_info() -> String {
     let names: Vec<&str> = Backend::all_available().iter().map(|b| b.name()).collect();
     let mut s = format!(
@@ -24,6 +25,8 @@ pub fn build_info() -> String {
             s.push_str(&format!(" ({})", b.name()));
         }
     }
+    s.push('\n');
+    s.push_str(&crate::denoise::load::report());
     s.push_str(if cfg!(feature = "subsurface") {
         "\nsubsurface: yes"
     } else {

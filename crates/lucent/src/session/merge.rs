@@ -1,14 +1,17 @@
 //! A frame merged from its parts (`lucent merge`, docs/farm.md) and
-//! written as one EXR with its preview.
+//! written as one EXR with its preview, denoised when asked.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use super::denoise::stage_denoised;
 use super::output::{check_exr_output, check_not_an_input};
+use crate::denoise::DenoiseOptions;
 use crate::error::Error;
 use crate::farm::merge::merge;
+use crate::film::commit_all;
 use crate::film::exr_attributes::FrameHeader;
-use crate::film::exr_layers::{self, OutputOptions, Preview};
+use crate::film::exr_layers::{self, OutputOptions, Preview, Window};
 
 /// What a merge made: the frame's size and samples, and how long it took.
 #[derive(Clone, Debug)]
@@ -24,14 +27,19 @@ pub struct MergedFrame {
 
 /// Merges `parts` into the frame `output` (EXR, with the preview
 /// `preview`); `mixed_backends` lets parts rendered on different
-/// ray-query backends merge (the frame names each).
+/// ray-query backends merge (the frame names each); `denoise` adds the
+/// denoised beauty, run so.
 pub fn merge_parts(
     parts: &[PathBuf],
     output: &Path,
     preview: Preview,
     mixed_backends: bool,
+    denoise: Option<&DenoiseOptions>,
 ) -> Result<MergedFrame, Error> {
     check_exr_output(output)?;
+    if denoise.is_some() {
+        crate::denoise::load::api()?;
+    }
     let preview_path = crate::film::preview_path(output);
     check_not_an_input(&[output, &preview_path], parts)?;
     let start = Instant::now();
@@ -48,7 +56,14 @@ pub fn merge_parts(
         ..m.output
     };
     crate::memory::enter(crate::memory::Phase::Writing);
-    exr_layers::write_frame(output, &m.film, &m.layers, &m.coverage, &header, &out)?;
+    match denoise {
+        None => exr_layers::write_frame(output, &m.film, &m.layers, &m.coverage, &header, &out)?,
+        Some(d) => {
+            let window = Window::full(m.film.width, m.film.height);
+            let (f, l, c) = (&m.film, &m.layers, &m.coverage);
+            commit_all(stage_denoised(output, window, f, l, c, &header, &out, d)?)?
+        }
+    }
     Ok(MergedFrame {
         parts: parts.len(),
         width: m.film.width,

@@ -92,7 +92,7 @@ fn bad(path: &Path, field: Option<&str>, problem: impl Into<String>) -> Error {
 
 /// Reads the single-layer flat EXR at `path`, checked as untrusted input
 /// before its pixels are sized.
-fn read(path: &Path) -> Result<AnyImage, Error> {
+pub(crate) fn read(path: &Path) -> Result<AnyImage, Error> {
     let (mut file, len) =
         open_regular(path).map_err(|e| bad(path, None, format!("cannot read it: {e}")))?;
     let meta = MetaData::read_from_buffered(BufReader::new(&file), true)
@@ -101,7 +101,7 @@ fn read(path: &Path) -> Result<AnyImage, Error> {
         return Err(bad(
             path,
             None,
-            "more than one EXR part (paste one file at a time)",
+            "more than one EXR part (a single-part file is needed)",
         ));
     };
     if h.deep {

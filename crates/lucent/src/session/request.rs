@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use super::Overrides;
 use crate::accel::Backend;
+use crate::denoise::DenoiseOptions;
 use crate::film::exr_layers::Preview;
 use crate::film::passes::PassSet;
 use crate::film::region::Region;
@@ -28,6 +29,8 @@ pub struct Request {
     pub file: OutputSettings,
     pub split: Split,
     pub preview: Preview,
+    /// Also write the beauty denoised (`--denoise`), run so.
+    pub denoise: Option<DenoiseOptions>,
 }
 
 /// Splitting a frame into parts, checkpoints and resuming (docs/farm.md).

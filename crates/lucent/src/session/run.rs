@@ -144,6 +144,7 @@ pub fn apply_film(scene: &mut Scene, file: &crate::scene::OutputSettings) {
 pub fn run(r: &Request) -> Result<Outcome, Error> {
     check_exr_output(&r.output)?;
     check_counts(r)?;
+    check_denoise(r)?;
     memory::enter(Phase::LoadingScene);
     let (scene, text, options) = load(r)?;
     let settings = Settings::resolved(&scene, &r.opts);
@@ -151,7 +152,11 @@ pub fn run(r: &Request) -> Result<Outcome, Error> {
     let region = region_of(&r.split, w, h)?;
     let samples = samples_of(&r.split, settings.spp)?;
     let mut out = output_options(r, &scene);
-    let passes = film_passes(r.aov.unwrap_or(scene.output.aovs), &out);
+    let passes = film_passes(
+        r.aov.unwrap_or(scene.output.aovs),
+        &out,
+        r.denoise.is_some(),
+    );
     let layout = (!passes.is_empty()).then(|| crate::integrator::aov::layout(&scene, passes));
     // parts and resumes record the backend this machine resolves to
     let backend = r.backend.resolve().unwrap_or(r.backend);
@@ -270,14 +275,37 @@ fn output_options(r: &Request, scene: &Scene) -> OutputOptions {
         .over(scene.output.file.over(OutputOptions::default()))
 }
 
-/// The passes a render sums: those asked for, and with a transparent film
-/// the object coverage (its counts of camera rays that hit are `A`).
-fn film_passes(asked: PassSet, out: &OutputOptions) -> PassSet {
+/// The passes a render sums: those asked for, with a transparent film the
+/// object coverage (its counts of camera rays that hit are `A`), and when
+/// it is denoised the guides (albedo and normal).
+fn film_passes(asked: PassSet, out: &OutputOptions, denoised: bool) -> PassSet {
+    use crate::film::passes::Pass;
     let mut passes = asked;
     if out.transparent {
-        passes.insert(crate::film::passes::Pass::CryptoObject);
+        passes.insert(Pass::CryptoObject);
+    }
+    if denoised {
+        passes.insert(Pass::Albedo);
+        passes.insert(Pass::Normal);
     }
     passes
+}
+
+/// `--denoise` only on a frame (a part is denoised after the merge), and
+/// with the denoiser loaded before the render rather than after it.
+fn check_denoise(r: &Request) -> Result<(), Error> {
+    if r.denoise.is_none() {
+        return Ok(());
+    }
+    if r.split.is_part() {
+        return Err(Error::Argument {
+            argument: "--denoise".into(),
+            problem: "a part is not denoised: denoise the merged frame once \
+                      (lucent merge --denoise, or lucent denoise)"
+                .into(),
+        });
+    }
+    crate::denoise::load::api().map(|_| ())
 }
 
 /// The scene file's name, for part headers.
@@ -335,5 +363,10 @@ fn write_frame(
 ) -> Result<(), Error> {
     let (layers, coverage) = sums.layers(out.transparent)?;
     let film = sums.film()?;
-    exr_layers::write_window(&r.output, window, &film, &layers, &coverage, header, out)
+    match &r.denoise {
+        None => exr_layers::write_window(&r.output, window, &film, &layers, &coverage, header, out),
+        Some(d) => crate::film::commit_all(super::denoise::stage_denoised(
+            &r.output, window, &film, &layers, &coverage, header, out, d,
+        )?),
+    }
 }
