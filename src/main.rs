@@ -16,6 +16,7 @@ use lucent::integrator::{effects, plan, IntegratorKind};
 #[cfg(feature = "subsurface")]
 use lucent::materials::{EstimatorOptions, OPTIONS};
 use lucent::render::RenderOptions;
+use lucent::sampling::SamplerKind;
 use lucent::scene;
 use lucent::session;
 use lucent::Error;
@@ -99,6 +100,11 @@ enum Command {
         /// Random seed (default: the scene's `render.seed`).
         #[arg(long)]
         seed: Option<u64>,
+        /// Sampler: sobol (Owen-scrambled Sobol' points) | random
+        /// (pseudo-random stream) (default: the scene's `render.sampler`,
+        /// else sobol).
+        #[arg(long, value_parser = parse_sampler)]
+        sampler: Option<SamplerKind>,
         /// Ray-query backend: embree (the best available: embree4, else
         /// embree3), embree3, embree4 or bvh (default: embree if any is
         /// available, else bvh).
@@ -323,6 +329,7 @@ fn main() -> ExitCode {
             spp,
             threads,
             seed,
+            sampler,
             accel,
             tonemap,
             exposure,
@@ -346,6 +353,7 @@ fn main() -> ExitCode {
             let opts = RenderOptions {
                 spp,
                 seed,
+                sampler,
                 threads,
                 progress: (!quiet).then(lucent_tools::progress::Bar::sink),
                 integrator,
@@ -518,6 +526,12 @@ fn exposure_stops(s: &str) -> Result<f32, String> {
         ));
     }
     Ok(v)
+}
+
+/// Parses `--sampler` by the names of [`SamplerKind`].
+fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
+    SamplerKind::parse(s)
+        .ok_or_else(|| format!("expected {}, found \"{s}\"", SamplerKind::expected()))
 }
 
 /// `s` with every control character (from a file name, an OBJ line or a

@@ -2,8 +2,11 @@
 //! plus the multiple-importance-sampling heuristics (Veach 1997, ch. 9).
 
 pub mod rng;
+pub mod sampler;
+pub mod sobol;
 
 pub use rng::{Draw, Rng, SampleRng};
+pub use sampler::SamplerKind;
 
 use crate::geometry::Vec3;
 use std::f32::consts::PI;

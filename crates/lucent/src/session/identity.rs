@@ -45,9 +45,10 @@ pub fn identity(
         seed: settings.seed,
         spp: settings.spp,
         options: format!(
-            "accel={} integrator={} {options}",
+            "accel={} integrator={} sampler={} {options}",
             backend.name(),
-            integrator_name(settings.integrator)
+            integrator_name(settings.integrator),
+            settings.sampler.name()
         )
         .trim_end()
         .into(),
@@ -72,7 +73,7 @@ pub fn render_plan(
 }
 
 /// What the EXR header records about this render (docs/output.md): the
-/// scene file (`scene_text`) and its SHA-256, samples, seed, depth,
+/// scene file (`scene_text`) and its SHA-256, samples, seed, sampler, depth,
 /// backend that ran (`accel_name`, a resolved `backend`) and its version,
 /// integrator, every subsurface material's sampling options (named by the
 /// objects that use it), the plan with its `passes`, this host, the build
@@ -101,6 +102,7 @@ pub(crate) fn frame_header(
         backend: Some(accel_name.into()),
         backend_version: Some(backend_version(backend)?),
         integrator: Some(integrator_name(settings.integrator).into()),
+        sampler: Some(settings.sampler.name().into()),
         sampling: sampling(scene),
         plan: Some(render_plan(scene, settings.integrator, passes).to_json()),
         render_seconds: None,
