@@ -360,7 +360,13 @@ fn main() -> ExitCode {
                 stats,
             };
             if let Some(format) = explain {
-                return finish(run_explain(&scene, integrator, aov, &subsurface, format));
+                return finish(run_explain(
+                    &scene,
+                    (integrator, sampler),
+                    aov,
+                    &subsurface,
+                    format,
+                ));
             }
             file.settings().and_then(|file| {
                 let r = session::Request {
@@ -495,7 +501,7 @@ fn run_render(r: &session::Request, quiet: bool) -> Result<(), Error> {
 /// render, no file written): the scene's errors are those of a render.
 fn run_explain(
     scene_path: &Path,
-    integrator: IntegratorKind,
+    (integrator, sampler): (IntegratorKind, Option<SamplerKind>),
     aov: Option<PassSet>,
     subsurface: &SubsurfaceArgs,
     format: ExplainArg,
@@ -503,7 +509,8 @@ fn run_explain(
     let mut scene = scene::load(scene_path)?;
     session::overrides::apply(&subsurface.overrides(), &mut scene.materials)?;
     let passes = aov.unwrap_or(scene.output.aovs);
-    let plan = session::identity::render_plan(&scene, integrator, passes);
+    let sampler = sampler.unwrap_or(scene.settings.sampler);
+    let plan = session::identity::render_plan(&scene, integrator, sampler, passes);
     match format {
         ExplainArg::Text => {
             let _ = write!(std::io::stdout(), "{}", plan::text::render(&plan));

@@ -13,6 +13,7 @@ use crate::film::pass_layout::Layout;
 use crate::film::passes::PassSet;
 use crate::integrator::{plan, IntegratorKind};
 use crate::render::Settings;
+use crate::sampling::SamplerKind;
 use crate::scene::Scene;
 
 /// The integrator's name on the command line and in headers.
@@ -56,10 +57,12 @@ pub fn identity(
     }
 }
 
-/// The plan a render of `scene` with `integrator` and `passes` follows.
+/// The plan a render of `scene` with `integrator`, `sampler` and `passes`
+/// follows.
 pub fn render_plan(
     scene: &Scene,
     integrator: IntegratorKind,
+    sampler: SamplerKind,
     passes: PassSet,
 ) -> plan::Explanation {
     plan::Explanation::new(
@@ -67,6 +70,7 @@ pub fn render_plan(
         &plan::PlanOptions {
             integrator,
             passes,
+            sampler,
             ..plan::PlanOptions::default()
         },
     )
@@ -104,7 +108,7 @@ pub(crate) fn frame_header(
         integrator: Some(integrator_name(settings.integrator).into()),
         sampler: Some(settings.sampler.name().into()),
         sampling: sampling(scene),
-        plan: Some(render_plan(scene, settings.integrator, passes).to_json()),
+        plan: Some(render_plan(scene, settings.integrator, settings.sampler, passes).to_json()),
         render_seconds: None,
         date: None,
         hosts: vec![provenance::host_name()],

@@ -85,6 +85,10 @@ pub struct Explanation {
     /// ([`crate::accel::Traversal`]); absent in plans written before it.
     #[serde(default)]
     pub traversal: Choice,
+    /// Where the samples' numbers come from
+    /// ([`crate::sampling::SamplerKind`]); absent in plans written before it.
+    #[serde(default)]
+    pub sampler: Choice,
     pub aovs: Aovs,
     pub materials: Vec<MaterialPlan>,
 }
@@ -103,6 +107,7 @@ impl Explanation {
             specular_chains: specular_chains(rows.specular_materials, &rows.specular_why),
             probe_queries: probe_queries(opts, &rows.probes_needed),
             traversal: traversal(scene, opts),
+            sampler: choice(opts.sampler.name(), opts.sampler.describe()),
             aovs: aovs(opts),
             materials: rows.materials,
         }

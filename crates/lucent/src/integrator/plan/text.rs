@@ -43,6 +43,9 @@ pub fn render(p: &Explanation) -> String {
         &p.probe_queries.reason,
     );
     row(r, "traversal", &p.traversal.method, &p.traversal.reason);
+    if !p.sampler.method.is_empty() {
+        row(r, "sampler", &p.sampler.method, &p.sampler.reason);
+    }
     let aov_reason = if p.aovs.passes.is_empty() {
         p.aovs.reason.clone()
     } else {
