@@ -12,6 +12,7 @@
 //! (seed, pixel, sample) where it has them ([`super::sampler`]).
 
 use super::sampler::{Cursor, Point, SamplerKind};
+use super::sobol;
 
 #[derive(Clone, Debug)]
 pub struct Rng {
@@ -196,13 +197,19 @@ impl SampleRng {
         }
     }
 
-    /// A 2D point in [0, 1)², its first coordinate with 53 bits: one slot
-    /// of the sequence, or two 53-bit draws of the stream.
+    /// Four numbers in [0, 1), the first with 53 bits: one slot's 4D
+    /// point of the sequence (stratified together), or four 53-bit draws
+    /// of the stream.
     #[inline]
-    pub fn point_f64(&mut self) -> [f64; 2] {
-        match self.slot() {
-            Some(p) => [p.x_f64_53(), p.f64s()[1]],
-            None => [self.stream().uniform_f64(), self.stream().uniform_f64()],
+    pub fn point4_f64(&mut self) -> [f64; 4] {
+        match self.sequence.as_mut().and_then(|c| c.take4()) {
+            Some((p, first)) => [
+                first.x_f64_53(),
+                sobol::to_f64(p[1]),
+                sobol::to_f64(p[2]),
+                sobol::to_f64(p[3]),
+            ],
+            None => std::array::from_fn(|_| self.stream().uniform_f64()),
         }
     }
 

@@ -10,7 +10,7 @@
 //! a coat split off come from the sample's pseudo-random stream.
 
 use super::rng::Rng;
-use super::sobol::{self, PointSeeds};
+use super::sobol::{self, Point4Seeds, PointSeeds};
 
 /// Where a render's random numbers come from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -74,6 +74,8 @@ pub const SEQUENCE_DEPTHS: u32 = 4;
 pub(crate) struct Cursor {
     pixel_key: u64,
     index: u32,
+    /// `index`'s bits reversed, for every slot's point.
+    reversed: u32,
     next: u32,
     end: u32,
     /// Set once the sample follows a path split off: no slot after that.
@@ -87,6 +89,7 @@ impl Cursor {
         Cursor {
             pixel_key,
             index,
+            reversed: index.reverse_bits(),
             next: 0,
             end: CAMERA_SLOTS,
             left: false,
@@ -111,20 +114,45 @@ impl Cursor {
         self.end = 0;
     }
 
-    /// The next slot's point, if the block has one.
+    /// The next slot, if the block has one.
     #[inline]
-    pub(crate) fn take(&mut self) -> Option<Point> {
+    fn next_slot(&mut self) -> Option<u32> {
         if self.next >= self.end {
             return None;
         }
-        let slot = self.next;
         self.next += 1;
+        Some(self.next - 1)
+    }
+
+    /// The next slot's 4D point (the first four Sobol' dimensions), if
+    /// the block has one.
+    #[inline]
+    pub(crate) fn take4(&mut self) -> Option<([u32; 4], Point)> {
+        let slot = self.next_slot()?;
         let h = Rng::slot_key(self.pixel_key, slot);
         let h2 = Rng::slot_key(h, 0);
-        let xy = sobol::point(self.index, PointSeeds::from_hashes(h, h2));
+        let h3 = Rng::slot_key(h, 2);
+        let seeds = Point4Seeds {
+            shuffle: h as u32,
+            dims: [(h >> 32) as u32, h2 as u32, (h2 >> 32) as u32, h3 as u32],
+        };
+        let p = sobol::point4(self.index, seeds);
+        let first = Point {
+            xy: [p[0], p[1]],
+            tail: h3 ^ self.index as u64,
+        };
+        Some((p, first))
+    }
+
+    /// The next slot's point, if the block has one.
+    #[inline]
+    pub(crate) fn take(&mut self) -> Option<Point> {
+        let slot = self.next_slot()?;
+        let h = Rng::slot_key(self.pixel_key, slot);
+        let xy = sobol::point_of_reversed(self.reversed, PointSeeds::from_hash(h));
         Some(Point {
             xy,
-            tail: h2 ^ self.index as u64,
+            tail: h ^ self.index as u64,
         })
     }
 }

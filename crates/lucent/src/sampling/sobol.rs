@@ -5,7 +5,11 @@
 //! renderer draws has its own seed: its own scramble of both coordinates
 //! and its own shuffle of the sample index, so points of different seeds
 //! are independent while the first 2^m indices of one seed stay a
-//! (0,m,2)-net.
+//! (0,m,2)-net. A subsurface probe's four numbers take the first four
+//! dimensions of one index, so its discrete choices and its radius and
+//! angle are stratified together (the first three dimensions are a
+//! (1,3)-sequence, the four a (3,4)-sequence; Joe & Kuo 2008's direction
+//! numbers).
 
 /// Direction numbers of the second Sobol' dimension (primitive polynomial
 /// x + 1): column k of its generator matrix is row k of Pascal's triangle
@@ -20,6 +24,68 @@ const SECOND: [u32; 32] = {
     }
     v
 };
+
+/// Direction numbers of a Sobol' dimension of primitive polynomial degree
+/// `s` with coefficients `a` (Joe & Kuo's encoding, highest inner
+/// coefficient first) and initial numbers `m`.
+const fn directions(s: usize, a: u32, m: [u32; 3]) -> [u32; 32] {
+    let mut v = [0u32; 32];
+    let mut k = 0;
+    while k < 32 {
+        v[k] = if k < s {
+            m[k] << (31 - k)
+        } else {
+            let mut x = v[k - s] ^ (v[k - s] >> s);
+            let mut j = 1;
+            while j < s {
+                if (a >> (s - 1 - j)) & 1 == 1 {
+                    x ^= v[k - j];
+                }
+                j += 1;
+            }
+            x
+        };
+        k += 1;
+    }
+    v
+}
+
+/// The third and fourth Sobol' dimensions: x² + x + 1 with m = 1, 3, and
+/// x³ + x + 1 with m = 1, 3, 1.
+const THIRD: [u32; 32] = directions(2, 1, [1, 3, 0]);
+const FOURTH: [u32; 32] = directions(3, 1, [1, 3, 1]);
+
+/// A dimension's generator matrix by bytes of the index: four lookups.
+const fn byte_tables(dirs: &[u32; 32]) -> [[u32; 256]; 4] {
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut v = 0;
+        while v < 256 {
+            let mut x = 0u32;
+            let mut j = 0;
+            while j < 8 {
+                if v >> j & 1 == 1 {
+                    x ^= dirs[8 * b + j];
+                }
+                j += 1;
+            }
+            t[b][v] = x;
+            v += 1;
+        }
+        b += 1;
+    }
+    t
+}
+
+static THIRD_BYTES: [[u32; 256]; 4] = byte_tables(&THIRD);
+static FOURTH_BYTES: [[u32; 256]; 4] = byte_tables(&FOURTH);
+
+#[inline]
+fn by_bytes(t: &[[u32; 256]; 4], i: u32) -> u32 {
+    let [b0, b1, b2, b3] = i.to_le_bytes();
+    t[0][b0 as usize] ^ t[1][b1 as usize] ^ t[2][b2 as usize] ^ t[3][b3 as usize]
+}
 
 /// The first Sobol' dimension (van der Corput in base 2) of `index`, as a
 /// 32-bit fraction.
@@ -37,6 +103,42 @@ pub fn second(mut index: u32) -> u32 {
         index &= index - 1;
     }
     x
+}
+
+/// The second dimension bit-reversed, by bytes of the bit-reversed index:
+/// `REVERSED_SECOND[b][v]` is the XOR of `SECOND[31 − j].reverse_bits()`
+/// over the bits j of `v << 8b`, so four lookups give
+/// `second(i).reverse_bits()` from `i.reverse_bits()`.
+static REVERSED_SECOND: [[u32; 256]; 4] = {
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut v = 0;
+        while v < 256 {
+            let mut x = 0u32;
+            let mut j = 0;
+            while j < 8 {
+                if v >> j & 1 == 1 {
+                    x ^= SECOND[31 - (8 * b + j)].reverse_bits();
+                }
+                j += 1;
+            }
+            t[b][v] = x;
+            v += 1;
+        }
+        b += 1;
+    }
+    t
+};
+
+/// `second(i).reverse_bits()` from `reversed = i.reverse_bits()`.
+#[inline]
+fn second_reversed(reversed: u32) -> u32 {
+    let [b0, b1, b2, b3] = reversed.to_le_bytes();
+    REVERSED_SECOND[0][b0 as usize]
+        ^ REVERSED_SECOND[1][b1 as usize]
+        ^ REVERSED_SECOND[2][b2 as usize]
+        ^ REVERSED_SECOND[3][b3 as usize]
 }
 
 /// A bijection of 32-bit words whose output bit k is input bit k flipped
@@ -87,25 +189,66 @@ pub struct PointSeeds {
 }
 
 impl PointSeeds {
-    /// Three seeds from the 64-bit hash `h` and a second hash `h2`.
+    /// Three seeds from the 64-bit hash `h`: its two halves and the high
+    /// half of an odd multiple.
     #[inline]
-    pub fn from_hashes(h: u64, h2: u64) -> Self {
+    pub fn from_hash(h: u64) -> Self {
         PointSeeds {
             shuffle: h as u32,
             x: (h >> 32) as u32,
-            y: h2 as u32,
+            y: (h.wrapping_mul(0xd6e8_feb8_6659_fd93) >> 32) as u32,
         }
     }
 }
 
 /// Sample `index` of the Owen-scrambled Sobol' (0,2)-sequence with `seeds`,
-/// as two 32-bit fractions.
+/// as two 32-bit fractions: `owen_scramble` of both dimensions of
+/// `shuffle(index)`, with the bit reversals that cancel left out.
 #[inline]
 pub fn point(index: u32, seeds: PointSeeds) -> [u32; 2] {
+    point_of_reversed(index.reverse_bits(), seeds)
+}
+
+/// [`point`] of the index whose bits reversed are `reversed` (a sample
+/// reverses its index once for all its points).
+#[inline]
+pub fn point_of_reversed(reversed: u32, seeds: PointSeeds) -> [u32; 2] {
+    // the shuffled index reversed: its first dimension
+    let first_dim = lower_triangular_hash(reversed, seeds.shuffle);
+    let i = first_dim.reverse_bits();
+    [
+        lower_triangular_hash(i, seeds.x).reverse_bits(),
+        lower_triangular_hash(second_reversed(first_dim), seeds.y).reverse_bits(),
+    ]
+}
+
+/// The seeds of one 4D point: the index shuffle and each dimension's
+/// scramble.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Point4Seeds {
+    pub shuffle: u32,
+    pub dims: [u32; 4],
+}
+
+/// Sample `index` of the first four Owen-scrambled Sobol' dimensions
+/// with `seeds`, as 32-bit fractions (its first two are [`point`]'s).
+#[inline]
+pub fn point4(index: u32, seeds: Point4Seeds) -> [u32; 4] {
+    let [x, y] = point(
+        index,
+        PointSeeds {
+            shuffle: seeds.shuffle,
+            x: seeds.dims[0],
+            y: seeds.dims[1],
+        },
+    );
     let i = shuffle(index, seeds.shuffle);
-    // owen_scramble(first(i)) without reversing i twice
-    let x = lower_triangular_hash(i, seeds.x).reverse_bits();
-    [x, owen_scramble(second(i), seeds.y)]
+    [
+        x,
+        y,
+        owen_scramble(by_bytes(&THIRD_BYTES, i), seeds.dims[2]),
+        owen_scramble(by_bytes(&FOURTH_BYTES, i), seeds.dims[3]),
+    ]
 }
 
 /// A 32-bit fraction as an f32 in [0, 1): its top 24 bits.
@@ -153,6 +296,12 @@ mod tests {
             let p: Vec<[u32; 2]> = (0..1u32 << m).map(|i| [first(i), second(i)]).collect();
             assert!(is_net(&p, m), "m = {m}");
         }
+        // the byte tables give the same second dimension
+        let mut r = crate::sampling::Rng::from_key(1);
+        for _ in 0..1000 {
+            let i = r.next_u32();
+            assert_eq!(second_reversed(i.reverse_bits()), second(i).reverse_bits());
+        }
         // the matrix is Pascal's triangle mod 2: pinned columns
         assert_eq!(
             &SECOND[..5],
@@ -166,6 +315,72 @@ mod tests {
         );
     }
 
+    /// Whether the 2^m points are a (t,m,3)-net in their first three
+    /// coordinates: every elementary box of volume 2^(t−m) holds 2^t.
+    fn is_net3(points: &[[u32; 4]], m: u32, t: u32) -> bool {
+        let k = m - t;
+        (0..=k).all(|a| {
+            (0..=k - a).all(|b| {
+                let c = k - a - b;
+                let mut count = vec![0u32; 1 << k];
+                for p in points {
+                    let cut = |v: u32, bits: u32| if bits == 0 { 0 } else { v >> (32 - bits) };
+                    let cell = (cut(p[0], a) << (b + c)) | (cut(p[1], b) << c) | cut(p[2], c);
+                    count[cell as usize] += 1;
+                }
+                count.iter().all(|&n| n == 1 << t)
+            })
+        })
+    }
+
+    /// The first three dimensions are a (1,m,3)-net for every m, scrambled
+    /// or not, and the fourth is stratified in 1D; catches a wrong
+    /// recurrence or initial numbers of the third dimension and a fourth
+    /// that repeats another.
+    #[test]
+    fn four_dimensional_points_are_nets() {
+        let seeds = Point4Seeds {
+            shuffle: 0x5151_2323,
+            dims: [1, 0x8000_0001, 0xdead_beef, 0x0bad_f00d],
+        };
+        let zero = Point4Seeds {
+            shuffle: 0,
+            dims: [0; 4],
+        };
+        for m in 1..=10 {
+            for s in [seeds, zero] {
+                let p: Vec<[u32; 4]> = (0..1u32 << m).map(|i| point4(i, s)).collect();
+                assert!(is_net3(&p, m, 1), "m = {m}");
+                let mut w: Vec<u32> = p.iter().map(|q| q[3] >> (32 - m)).collect();
+                w.sort_unstable();
+                assert_eq!(w, (0..1u32 << m).collect::<Vec<_>>());
+                assert!(m < 3 || p.iter().any(|q| q[3] != q[2]));
+            }
+        }
+        assert_eq!(&THIRD[..3], &[0x8000_0000, 0xc000_0000, 0x6000_0000]);
+        assert_eq!(&FOURTH[..3], &[0x8000_0000, 0xc000_0000, 0x2000_0000]);
+    }
+
+    /// `point` is the scramble of both dimensions of the shuffled index.
+    #[test]
+    fn point_is_the_scrambled_shuffled_sobol_point() {
+        let seeds = PointSeeds {
+            shuffle: 0x1234_5678,
+            x: 0x9abc_def0,
+            y: 0x0fed_cba9,
+        };
+        for index in [0, 1, 2, 3, 77, 1 << 20, u32::MAX] {
+            let i = shuffle(index, seeds.shuffle);
+            assert_eq!(
+                point(index, seeds),
+                [
+                    owen_scramble(first(i), seeds.x),
+                    owen_scramble(second(i), seeds.y)
+                ]
+            );
+        }
+    }
+
     /// Catches a scramble that is not nested (a hash of all bits, or of
     /// the digits in the wrong order) and an index shuffle that leaves
     /// the first 2^m indices' block: both break the net.
@@ -173,7 +388,7 @@ mod tests {
     fn scrambled_and_shuffled_points_stay_nets() {
         for k in 0..200u64 {
             let h = crate::sampling::Rng::from_key(k).next_u64();
-            let seeds = PointSeeds::from_hashes(h, h.rotate_left(17) ^ k);
+            let seeds = PointSeeds::from_hash(h);
             for m in [1, 4, 7, 10] {
                 let p: Vec<[u32; 2]> = (0..1u32 << m).map(|i| point(i, seeds)).collect();
                 assert!(is_net(&p, m), "seed {k}, m = {m}");
@@ -198,7 +413,7 @@ mod tests {
         let mut bins = [[0u32; 64]; 2];
         let mut r = crate::sampling::Rng::from_key(5);
         for _ in 0..n {
-            let seeds = PointSeeds::from_hashes(r.next_u64(), r.next_u64());
+            let seeds = PointSeeds::from_hash(r.next_u64());
             let p = point(3, seeds);
             for c in 0..2 {
                 bins[c][(p[c] >> 26) as usize] += 1;
@@ -241,8 +456,8 @@ mod tests {
         let mut r = crate::sampling::Rng::from_key(9);
         let mut worst = 0.0f64;
         for _ in 0..50 {
-            let a = PointSeeds::from_hashes(r.next_u64(), r.next_u64());
-            let b = PointSeeds::from_hashes(r.next_u64(), r.next_u64());
+            let a = PointSeeds::from_hash(r.next_u64());
+            let b = PointSeeds::from_hash(r.next_u64());
             let both = (0..1u32 << m)
                 .filter(|&i| point(i, a)[0] < 1 << 31 && point(i, b)[0] < 1 << 31)
                 .count();

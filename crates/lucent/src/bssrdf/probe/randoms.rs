@@ -34,15 +34,14 @@ impl ProbeRandoms {
     }
 
     /// A path's probe: [`from_rng`](Self::from_rng) with the `random`
-    /// sampler; with a sequence, the radius and angle from one 2D point
-    /// (the disk's point stratified), the axis and channel choices from
-    /// another, the hit choice from a third.
+    /// sampler; with a sequence, the radius, angle, channel and axis from
+    /// one 4D point (the disk's point stratified within each channel's
+    /// share), the hit choice from another slot.
     pub fn from_sample(rng: &mut SampleRng) -> Self {
         if !rng.stratifies() {
             return Self::from_rng(rng);
         }
-        let [radius, angle] = rng.point_f64();
-        let [axis, channel] = rng.uniform2_f64_32();
+        let [radius, angle, channel, axis] = rng.point4_f64();
         let hit = rng.uniform2_f64_32()[0];
         ProbeRandoms {
             axis,
