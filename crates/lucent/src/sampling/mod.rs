@@ -1,6 +1,7 @@
 //! Random numbers and the warps that turn them into directions and points,
 //! plus the multiple-importance-sampling heuristics (Veach 1997, ch. 9).
 
+mod mix;
 pub mod rng;
 pub mod sampler;
 pub mod sobol;

@@ -11,6 +11,7 @@
 //! `sobol` sampler points of a low-discrepancy sequence indexed by the same
 //! (seed, pixel, sample) where it has them ([`super::sampler`]).
 
+use super::mix::mix64;
 use super::sampler::{Cursor, Point, SamplerKind};
 use super::sobol;
 
@@ -18,13 +19,6 @@ use super::sobol;
 pub struct Rng {
     key: u64,
     counter: u64,
-}
-
-#[inline]
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 impl Rng {
@@ -54,13 +48,6 @@ impl Rng {
             key: mix64(pixel_key ^ sample.wrapping_mul(0xd1b5_4a32_d192_ed03)),
             counter: 0,
         }
-    }
-
-    /// The key of slot `slot` of a sample's sequence ([`super::sampler`])
-    /// under `key`.
-    #[inline]
-    pub fn slot_key(key: u64, slot: u32) -> u64 {
-        mix64(key ^ (slot as u64 + 1).wrapping_mul(0xa076_1d64_78bd_642f))
     }
 
     /// A stream keyed by an arbitrary value (tests, studies, benches).

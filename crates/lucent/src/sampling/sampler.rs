@@ -9,7 +9,7 @@
 //! draws past a bounce's block, past the first bounces, and of paths that
 //! a coat split off come from the sample's pseudo-random stream.
 
-use super::rng::Rng;
+use super::mix::slot_key;
 use super::sobol::{self, Point4Seeds, PointSeeds};
 
 /// Where a render's random numbers come from.
@@ -129,9 +129,9 @@ impl Cursor {
     #[inline]
     pub(crate) fn take4(&mut self) -> Option<([u32; 4], Point)> {
         let slot = self.next_slot()?;
-        let h = Rng::slot_key(self.pixel_key, slot);
-        let h2 = Rng::slot_key(h, 0);
-        let h3 = Rng::slot_key(h, 2);
+        let h = slot_key(self.pixel_key, slot);
+        let h2 = slot_key(h, 0);
+        let h3 = slot_key(h, 2);
         let seeds = Point4Seeds {
             shuffle: h as u32,
             dims: [(h >> 32) as u32, h2 as u32, (h2 >> 32) as u32, h3 as u32],
@@ -148,7 +148,7 @@ impl Cursor {
     #[inline]
     pub(crate) fn take(&mut self) -> Option<Point> {
         let slot = self.next_slot()?;
-        let h = Rng::slot_key(self.pixel_key, slot);
+        let h = slot_key(self.pixel_key, slot);
         let xy = sobol::point_of_reversed(self.reversed, PointSeeds::from_hash(h));
         Some(Point {
             xy,
@@ -179,7 +179,7 @@ impl Point {
     /// The first coordinate with 53 bits: 21 hashed ones below its 32.
     #[inline]
     pub(crate) fn x_f64_53(self) -> f64 {
-        sobol::to_f64_53(self.xy[0], Rng::slot_key(self.tail, 1) >> 43)
+        sobol::to_f64_53(self.xy[0], slot_key(self.tail, 1) >> 43)
     }
 }
 

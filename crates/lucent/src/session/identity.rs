@@ -70,7 +70,7 @@ pub fn render_plan(
         &plan::PlanOptions {
             integrator,
             passes,
-            sampler,
+            sampler: Some(sampler),
             ..plan::PlanOptions::default()
         },
     )

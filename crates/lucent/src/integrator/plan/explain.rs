@@ -107,7 +107,7 @@ impl Explanation {
             specular_chains: specular_chains(rows.specular_materials, &rows.specular_why),
             probe_queries: probe_queries(opts, &rows.probes_needed),
             traversal: traversal(scene, opts),
-            sampler: choice(opts.sampler.name(), opts.sampler.describe()),
+            sampler: sampler(scene, opts),
             aovs: aovs(opts),
             materials: rows.materials,
         }
@@ -274,6 +274,12 @@ fn probe_queries(opts: &PlanOptions, probes_needed: &[String]) -> Choice {
             ),
         )
     }
+}
+
+/// Where the samples' numbers come from.
+fn sampler(scene: &Scene, opts: &PlanOptions) -> Choice {
+    let k = opts.sampler.unwrap_or(scene.settings.sampler);
+    choice(k.name(), k.describe())
 }
 
 /// How Embree treats rays through shared edges.

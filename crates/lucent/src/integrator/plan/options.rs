@@ -19,8 +19,8 @@ pub struct PlanOptions {
     /// `control_variate`, add the plane control variate
     /// (`crate::integrator::Context::cv_depth`).
     pub cv_depth: u32,
-    /// The sampler the render uses (`--sampler`, else the scene's).
-    pub sampler: SamplerKind,
+    /// The sampler the render uses (`--sampler`); None: the scene's.
+    pub sampler: Option<SamplerKind>,
 }
 
 impl Default for PlanOptions {
@@ -33,7 +33,7 @@ impl Default for PlanOptions {
             cv_depth: crate::integrator::control_variate::CV_DEPTH,
             #[cfg(not(feature = "subsurface"))]
             cv_depth: 0,
-            sampler: SamplerKind::default(),
+            sampler: None,
         }
     }
 }
