@@ -170,10 +170,8 @@ pub fn owen_scramble(x: u32, seed: u32) -> u32 {
 /// The shuffled index: a nested uniform scramble of `index` read as a
 /// fraction, so each low bit is flipped by a hash of the bits above it and
 /// every aligned block of 2^m indices goes to an aligned block of 2^m (the
-/// first 2^m samples stay a net). Flipping low bits by the high ones, not
-/// the other way, is what decorrelates the points of different seeds: a
-/// shuffle nested the other way is a scramble of the first coordinate, and
-/// two points' first coordinates would share their strata.
+/// first 2^m samples stay a net). It also decorrelates the points of
+/// different seeds: their first coordinates do not share strata.
 #[inline]
 pub fn shuffle(index: u32, seed: u32) -> u32 {
     owen_scramble(index, seed)
@@ -449,7 +447,7 @@ mod tests {
     /// The first coordinates of two points of different seeds share no
     /// strata: over the first 2^m indices, the points with both first
     /// coordinates below ½ are about a quarter, not 0 or a half (a shuffle
-    /// nested from the low bits gives 0 or a half).
+    /// nested from the low bits fails).
     #[test]
     fn points_of_different_seeds_are_decorrelated() {
         let m = 10;
