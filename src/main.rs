@@ -17,6 +17,7 @@ use lucent::integrator::{effects, plan, IntegratorKind};
 #[cfg(feature = "subsurface")]
 use lucent::materials::{EstimatorOptions, OPTIONS};
 use lucent::render::RenderOptions;
+use lucent::sampling::SamplerKind;
 use lucent::scene;
 use lucent::session;
 use lucent::Error;
@@ -101,6 +102,11 @@ enum Command {
         /// Random seed (default: the scene's `render.seed`).
         #[arg(long)]
         seed: Option<u64>,
+        /// Sampler: sobol (Owen-scrambled Sobol' points) | random
+        /// (pseudo-random stream) (default: the scene's `render.sampler`,
+        /// else sobol).
+        #[arg(long, value_parser = parse_sampler)]
+        sampler: Option<SamplerKind>,
         /// Ray-query backend: embree (the best available: embree4, else
         /// embree3), embree3, embree4 or bvh (default: embree if any is
         /// available, else bvh).
@@ -344,6 +350,7 @@ fn main() -> ExitCode {
             spp,
             threads,
             seed,
+            sampler,
             accel,
             tonemap,
             exposure,
@@ -368,13 +375,16 @@ fn main() -> ExitCode {
             let opts = RenderOptions {
                 spp,
                 seed,
+                sampler,
                 threads,
                 progress: (!quiet).then(lucent_tools::progress::Bar::sink),
                 integrator,
                 stats,
             };
             if let Some(format) = explain {
-                let run = |file| run_explain(&scene, integrator, aov, &subsurface, &file, format);
+                let run = |file| {
+                    run_explain(&scene, (integrator, sampler), aov, &subsurface, &file, format)
+                };
                 return finish(file.settings().and_then(run));
             }
             file.settings().and_then(|file| {
@@ -515,7 +525,7 @@ fn run_render(r: &session::Request, quiet: bool) -> Result<(), Error> {
 /// render, no file written): the scene's errors are those of a render.
 fn run_explain(
     scene_path: &Path,
-    integrator: IntegratorKind,
+    (integrator, sampler): (IntegratorKind, Option<SamplerKind>),
     aov: Option<PassSet>,
     subsurface: &SubsurfaceArgs,
     file: &scene::OutputSettings,
@@ -525,7 +535,8 @@ fn run_explain(
     session::overrides::apply(&subsurface.overrides(), &mut scene.materials)?;
     session::apply_film(&mut scene, file);
     let passes = aov.unwrap_or(scene.output.aovs);
-    let plan = session::identity::render_plan(&scene, integrator, passes);
+    let sampler = sampler.unwrap_or(scene.settings.sampler);
+    let plan = session::identity::render_plan(&scene, integrator, sampler, passes);
     match format {
         ExplainArg::Text => {
             let _ = write!(std::io::stdout(), "{}", plan::text::render(&plan));
@@ -548,6 +559,12 @@ fn exposure_stops(s: &str) -> Result<f32, String> {
         ));
     }
     Ok(v)
+}
+
+/// Parses `--sampler` by the names of [`SamplerKind`].
+fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
+    SamplerKind::parse(s)
+        .ok_or_else(|| format!("expected {}, found \"{s}\"", SamplerKind::expected()))
 }
 
 /// `s` with every control character (from a file name, an OBJ line or a

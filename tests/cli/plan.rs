@@ -80,6 +80,7 @@ fn top(direct: &str, env: &str, specular: (&str, Vec<&str>), probes: &str) -> Va
         "probe_queries": {"method": probes},
         "traversal": {"method": "fast"},
         "film": {"method": "opaque"},
+        "sampler": {"method": "sobol"},
         "aovs": {"method": "none", "passes": []},
     })
 }
@@ -474,6 +475,21 @@ fn a_plan_with_subsurface_makes_probe_queries_and_the_walk_none() {
     assert!(w.effect_rays[Effect::Walk as usize] > 0, "{w:?}");
 }
 
+/// Catches a plan that names the default sampler whatever the scene or
+/// the options say.
+#[test]
+fn the_plan_names_the_scenes_sampler_unless_the_options_name_one() {
+    // CAMERA ends in [render]
+    let sampled = load(&format!("sampler = \"random\"\n{LAMP}"));
+    let plan = plan_of(&sampled, IntegratorKind::Path, PassSet::EMPTY);
+    assert_eq!(plan.sampler.method, "random");
+    let asked = PlanOptions {
+        sampler: Some(lucent::sampling::SamplerKind::Sobol),
+        ..PlanOptions::default()
+    };
+    assert_eq!(Explanation::new(&sampled, &asked).sampler.method, "sobol");
+}
+
 #[test]
 fn the_plan_traverses_fast_unless_the_scene_asks_or_the_walk_needs_watertight() {
     let method = |s: &Scene, i| plan_of(s, i, PassSet::EMPTY).traversal.method;
@@ -579,6 +595,7 @@ fn explain_prints_the_plan_and_writes_nothing() {
             "probe_queries",
             "traversal",
             "film",
+            "sampler",
             "aovs",
             "materials"
         ]

@@ -237,6 +237,7 @@ fn cases() -> Vec<Case> {
         case("spp zero", format!("{CAM}[render]\nspp = 0\n"), "at least 1 sample", Some("spp"), Some("render.spp")),
         case("max_depth zero", format!("{CAM}[render]\nmax_depth = 0\n"), "a path depth of 1 to 1024", Some("max_depth"), Some("render.max_depth")),
         case("traversal unknown", format!("{CAM}[render]\ntraversal = \"robust\"\n"), "expected \"fast\" or \"watertight\", found \"robust\"", Some("traversal"), Some("render.traversal")),
+        case("sampler unknown", format!("{CAM}[render]\nsampler = \"halton\"\n"), "expected \"sobol\" or \"random\", found \"halton\"", Some("sampler"), Some("render.sampler")),
         case("traversal not a string", format!("{CAM}[render]\ntraversal = true\n"), "expected a string", Some("traversal"), Some("render.traversal")),
         case("seed negative", format!("{CAM}[render]\nseed = -3\n"), "expected u64", Some("seed"), Some("render.seed")),
         case("units_per_mm zero", format!("units_per_mm = 0\n{CAM}"), "expected a number > 0", Some("units_per_mm"), Some("units_per_mm")),

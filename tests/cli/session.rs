@@ -103,6 +103,6 @@ fn a_part_names_its_options_as_the_scene_format_does() {
     let (h, _) = part::read(&out).unwrap();
     assert_eq!(
         h.identity.options,
-        "accel=bvh integrator=path axes=mis3 probe_pair=true"
+        "accel=bvh integrator=path sampler=sobol axes=mis3 probe_pair=true"
     );
 }

@@ -245,9 +245,20 @@ fn marble_tile_default_sees_across_its_edges() {
     // curvature alone the default sent 99 % of its probes along N: relMSE
     // 1.58 and 18 fireflies over this ladder against mis3's 0.09. The edge
     // rule and the weighted pick bring it to 0.028 (mis3 0.037). Normal-
-    // only probes never reach across an edge: quiet but too dark.
+    // only probes never reach across an edge: quiet but too dark. These
+    // figures are of the pseudo-random sampler, pinned here: with the
+    // Sobol' sampler mis3's error falls more than the default's, and at 16
+    // spp the two are alike (docs/journal.md, 2026-12-07).
     let dir = tempfile::tempdir().unwrap();
-    let mut s = quick("marble-tile.toml", dir.path());
+    let text = std::fs::read_to_string(scene("marble-tile.toml")).unwrap();
+    let pinned = dir.path().join("marble-tile-random.toml");
+    std::fs::write(
+        &pinned,
+        text.replacen("[render]\n", "[render]\nsampler = \"random\"\n", 1),
+    )
+    .unwrap();
+    let mut s = Settings::new(&pinned, dir.path().join("study"), true);
+    s.threads = Some(2);
     s.only = vec![Axis::Axes];
     let out = study::run(&s).unwrap();
     let at16 = |name: &str| row(&out.rows, name, 16).clone();

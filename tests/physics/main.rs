@@ -36,6 +36,8 @@ mod probe_pair;
 #[cfg(feature = "subsurface")]
 mod randomwalk;
 #[cfg(feature = "subsurface")]
+mod sampler;
+#[cfg(feature = "subsurface")]
 mod slab;
 #[cfg(feature = "subsurface")]
 mod specular_coat;

@@ -45,7 +45,7 @@ use crate::integrator::path::Scratch;
 use crate::integrator::{Clock, Context, Counters, IntegratorKind, NoClock, Stopwatch};
 use crate::interrupt;
 use crate::progress::{Progress, ProgressSink};
-use crate::sampling::{Draw, Rng, SampleRng};
+use crate::sampling::{Draw, Rng, SampleRng, SamplerKind};
 use crate::scene::Scene;
 
 pub use crate::film::sums::TILE;
@@ -60,6 +60,8 @@ pub struct RenderOptions {
     pub spp: Option<u32>,
     /// Seed (overrides the scene's when Some).
     pub seed: Option<u64>,
+    /// Sampler (overrides the scene's `[render] sampler` when Some).
+    pub sampler: Option<SamplerKind>,
     /// Worker threads, 1 to [`MAX_THREADS`]; None: rayon's default (all
     /// cores).
     pub threads: Option<usize>,
@@ -78,6 +80,7 @@ impl Default for RenderOptions {
         RenderOptions {
             spp: None,
             seed: None,
+            sampler: None,
             threads: None,
             progress: None,
             integrator: IntegratorKind::Path,
@@ -188,16 +191,18 @@ pub struct Settings {
     pub seed: u64,
     pub max_depth: u32,
     pub integrator: IntegratorKind,
+    pub sampler: SamplerKind,
 }
 
 impl Settings {
-    /// `opts`' spp and seed where given, else the scene's.
+    /// `opts`' spp, seed and sampler where given, else the scene's.
     pub fn resolved(scene: &Scene, opts: &RenderOptions) -> Settings {
         Settings {
             spp: opts.spp.unwrap_or(scene.settings.spp),
             seed: opts.seed.unwrap_or(scene.settings.seed),
             max_depth: scene.settings.max_depth,
             integrator: opts.integrator,
+            sampler: opts.sampler.unwrap_or(scene.settings.sampler),
         }
     }
 }
@@ -266,6 +271,7 @@ pub fn render_job(
             ctx: &ctx,
             integrator: settings.integrator,
             seed: settings.seed,
+            sampler: settings.sampler,
             samples: s.clone(),
             pool: &pool,
             bar,
@@ -401,6 +407,7 @@ struct Pass<'a> {
     ctx: &'a Context<'a>,
     integrator: IntegratorKind,
     seed: u64,
+    sampler: SamplerKind,
     samples: Range<u32>,
     pool: &'a rayon::ThreadPool,
     bar: Option<&'a dyn Progress>,
@@ -419,7 +426,7 @@ impl Pass<'_> {
                 .into_par_iter()
                 .map(|((t, prev, out), passes)| {
                     let (ctx, i, s) = (self.ctx, self.integrator, self.samples.clone());
-                    let key = Rng::seed_key(self.seed);
+                    let key = (self.sampler, Rng::seed_key(self.seed));
                     // the timed instance only with --stats (integrator::effects)
                     let c = if self.stats {
                         render_tile::<_, Stopwatch>(ctx, i, key, t, s, prev, out, passes)
@@ -437,7 +444,7 @@ impl Pass<'_> {
 }
 
 // Kept out of line so profiles (scripts/profile.sh) can name the tile loop.
-/// Adds the samples `samples` (streams keyed by `seed_key`,
+/// Adds the samples `samples` (drawn with `sampler`, keyed by `seed_key`,
 /// [`Rng::seed_key`]) of every pixel of `tile` to its sums `prev`
 /// (the tile's pixels row by row), writing the result to `out`, and to the
 /// sums of its `passes` (with [`NoAov`]: none, and this instance is the
@@ -448,7 +455,7 @@ impl Pass<'_> {
 fn render_tile<P: PixelPasses, T: Clock>(
     ctx: &Context,
     integrator: IntegratorKind,
-    seed_key: u64,
+    (sampler, seed_key): (SamplerKind, u64),
     tile: &Region,
     samples: Range<u32>,
     prev: &[i128],
@@ -474,9 +481,8 @@ fn render_tile<P: PixelPasses, T: Clock>(
             let mut sum: [i128; C] = prev[i * C..(i + 1) * C].try_into().unwrap();
             passes.begin_pixel(i);
             for s in samples.clone() {
-                // = SampleRng::new(seed, pixel, s), hashing the seed and
-                // pixel once
-                let mut rng = SampleRng::for_sample(pixel_key, s as u64);
+                // keyed by (seed, pixel, s), hashing the seed and pixel once
+                let mut rng = SampleRng::with_sampler(sampler, pixel_key, s);
                 let [jx, jy] = rng.uniform2_packed();
                 let (fx, fy) = (x as f32 + jx, y as f32 + jy);
                 let ray = match scene.camera.lens() {

@@ -75,6 +75,7 @@ fn render_opts(
     RenderOptions {
         spp: Some(spp),
         seed: Some(seed),
+        sampler: None,
         threads: s.threads,
         progress: progress.then(crate::progress::Bar::sink),
         integrator,

@@ -1,6 +1,6 @@
 //! What a frame's EXR header says about the render that made it: the
 //! renderer, its version and build, the scene file and its content hash,
-//! the resolution, samples, seed, backend, integrator, every sampling
+//! the resolution, samples, seed, backend, integrator, sampler, every sampling
 //! option, the render plan (JSON, `crate::integrator::plan`), the hosts,
 //! the date (`capDate`, `utcOffset`), the camera (`worldToCamera`,
 //! `worldToNDC`, the OpenEXR standard attributes) and the render time, as
@@ -41,6 +41,8 @@ pub struct FrameHeader {
     pub backend_version: Option<String>,
     /// The estimator (`path`, `randomwalk`).
     pub integrator: Option<String>,
+    /// The sampler (`sobol`, `random`).
+    pub sampler: Option<String>,
     /// Sampling options by material: (material name, `key=value …`).
     pub sampling: Vec<(String, String)>,
     /// The render plan as one line of JSON
@@ -111,6 +113,7 @@ impl FrameHeader {
             ("lucent/backend", s(&self.backend)),
             ("lucent/backendVersion", s(&self.backend_version)),
             ("lucent/integrator", s(&self.integrator)),
+            ("lucent/sampler", s(&self.sampler)),
             ("lucent/plan", s(&self.plan)),
             ("lucent/build", s(&self.build)),
             ("capDate", s(&self.date)),

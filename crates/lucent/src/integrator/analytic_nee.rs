@@ -55,7 +55,7 @@ pub(crate) fn analytic_light(
     counters: &mut Counters,
 ) -> (Vec3, u32) {
     let lights = &ctx.scene.lights;
-    let [u_pick, u0, u1] = rng.uniform3();
+    let (u_pick, [u0, u1]) = rng.choice_and_point();
     let i = ((u_pick * lights.len() as f32) as usize).min(lights.len() - 1);
     let Some(s) = lights[i].sample(v.p, [u0, u1]) else {
         return (Vec3::ZERO, i as u32);

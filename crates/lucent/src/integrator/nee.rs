@@ -93,7 +93,7 @@ pub(crate) fn emission_weight(
 /// without lights or on a degenerate emitter.
 #[inline(always)]
 pub(crate) fn draw_light(ctx: &Context, rng: &mut SampleRng) -> Option<LightSample> {
-    let [u_pick, u0, u1] = rng.uniform3();
+    let (u_pick, [u0, u1]) = rng.choice_and_point();
     ctx.lights.sample(u_pick, [u0, u1])
 }
 

@@ -83,7 +83,11 @@ pub(crate) fn trace<R: Recorder, T: Clock, S: SubsurfaceScatter>(
         cone: Cone::camera(&ctx.camera_spread, camera_ray.d),
     });
     let mut l = Vec3::ZERO;
-    while let Some(start) = first.take().or_else(|| stack.pop()) {
+    // a path split off draws from the stream: its depths' slots are taken
+    while let Some(start) = first.take().or_else(|| {
+        st.rng.leave_sequence();
+        stack.pop()
+    }) {
         l += follow::<R, T, S>(ctx, start, st, subsurface, &mut stack);
     }
     l
@@ -105,6 +109,7 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
     let mut path = start;
     let max_depth = ctx.scene.settings.max_depth;
     for depth in start.depth..=max_depth {
+        st.rng.start_bounce(depth);
         let nearest_hit = nearest::<R, T>(ctx, &path, depth, st);
         if ctx.plan.analytic_lights {
             l += analytic_nee::found(ctx, &path, nearest_hit.map(|h| h.t), depth, st.rec);

@@ -1,9 +1,13 @@
 //! Random numbers and the warps that turn them into directions and points,
 //! plus the multiple-importance-sampling heuristics (Veach 1997, ch. 9).
 
+mod mix;
 pub mod rng;
+pub mod sampler;
+pub mod sobol;
 
 pub use rng::{Draw, Rng, SampleRng};
+pub use sampler::SamplerKind;
 
 use crate::geometry::Vec3;
 use std::f32::consts::PI;

@@ -7,19 +7,18 @@
 //! with the counter folded in between), in the spirit of counter-based
 //! generators (Salmon et al. 2011, "Parallel random numbers: as easy as 1, 2, 3").
 //! The renderer's samples use [`SampleRng`], the same key with one mix per
-//! draw, because the hashing showed in the render's profile.
+//! draw, because the hashing showed in the render's profile, or with the
+//! `sobol` sampler points of a low-discrepancy sequence indexed by the same
+//! (seed, pixel, sample) where it has them ([`super::sampler`]).
+
+use super::mix::mix64;
+use super::sampler::{Cursor, Point, SamplerKind};
+use super::sobol;
 
 #[derive(Clone, Debug)]
 pub struct Rng {
     key: u64,
     counter: u64,
-}
-
-#[inline]
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 impl Rng {
@@ -127,6 +126,9 @@ impl Draw for Rng {
 #[derive(Clone, Debug)]
 pub struct SampleRng {
     state: u64,
+    /// The sample's slots of the low-discrepancy sequence (None: the
+    /// `random` sampler, every draw from the stream).
+    sequence: Option<Cursor>,
 }
 
 impl SampleRng {
@@ -140,15 +142,152 @@ impl SampleRng {
     pub fn for_sample(pixel_key: u64, sample: u64) -> Self {
         SampleRng {
             state: Rng::for_sample(pixel_key, sample).key,
+            sequence: None,
         }
+    }
+
+    /// Sample `sample` of the pixel keyed `pixel_key` with `sampler`: with
+    /// `Random` exactly [`for_sample`](Self::for_sample); with `Sobol`
+    /// its draws take the sequence's slots ([`super::sampler`]) where it
+    /// has them and the same stream otherwise.
+    #[inline]
+    pub fn with_sampler(sampler: SamplerKind, pixel_key: u64, sample: u32) -> Self {
+        let mut r = SampleRng::for_sample(pixel_key, sample as u64);
+        if sampler == SamplerKind::Sobol {
+            r.sequence = Some(Cursor::new(pixel_key, sample));
+        }
+        r
+    }
+
+    /// Whether draws come from the low-discrepancy sequence (where it has
+    /// slots), so callers may lay out a 2D point's coordinates together.
+    #[inline]
+    pub fn stratifies(&self) -> bool {
+        self.sequence.is_some()
+    }
+
+    /// The path reached bounce `depth`: the next draws take that bounce's
+    /// block of slots.
+    #[inline]
+    pub fn start_bounce(&mut self, depth: u32) {
+        if let Some(c) = &mut self.sequence {
+            c.start_bounce(depth);
+        }
+    }
+
+    /// The sample follows a path split off another: its draws from here
+    /// on are from the stream (the slots of its depths are taken).
+    #[inline]
+    pub fn leave_sequence(&mut self) {
+        if let Some(c) = &mut self.sequence {
+            c.leave();
+        }
+    }
+
+    /// Four numbers in [0, 1), the first with 53 bits: one slot's 4D
+    /// point of the sequence (stratified together), or four 53-bit draws
+    /// of the stream.
+    #[inline]
+    pub fn point4_f64(&mut self) -> [f64; 4] {
+        match self.sequence.as_mut().and_then(|c| c.take4()) {
+            Some((p, first)) => [
+                first.x_f64_53(),
+                sobol::to_f64(p[1]),
+                sobol::to_f64(p[2]),
+                sobol::to_f64(p[3]),
+            ],
+            None => std::array::from_fn(|_| self.stream().uniform_f64()),
+        }
+    }
+
+    #[inline]
+    fn slot(&mut self) -> Option<Point> {
+        self.sequence.as_mut()?.take()
+    }
+
+    #[inline]
+    fn stream(&mut self) -> Stream<'_> {
+        Stream(&mut self.state)
     }
 }
 
+/// The pseudo-random stream of a [`SampleRng`] (its draws as they are
+/// without the sequence).
+struct Stream<'a>(&'a mut u64);
+
+impl Draw for Stream<'_> {
+    #[inline]
+    fn next_u64(&mut self) -> u64 {
+        *self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        mix64(*self.0)
+    }
+}
+
+/// Each draw of one or two numbers takes one slot; three numbers take
+/// two (a 2D point and one more, in the order the method names).
 impl Draw for SampleRng {
     #[inline]
     fn next_u64(&mut self) -> u64 {
-        self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        mix64(self.state)
+        self.stream().next_u64()
+    }
+
+    #[inline]
+    fn uniform(&mut self) -> f32 {
+        match self.slot() {
+            Some(p) => p.f32s()[0],
+            None => self.stream().uniform(),
+        }
+    }
+
+    #[inline]
+    fn uniform_f64(&mut self) -> f64 {
+        match self.slot() {
+            Some(p) => p.x_f64_53(),
+            None => self.stream().uniform_f64(),
+        }
+    }
+
+    #[inline]
+    fn uniform2(&mut self) -> [f32; 2] {
+        match self.slot() {
+            Some(p) => p.f32s(),
+            None => self.stream().uniform2(),
+        }
+    }
+
+    #[inline]
+    fn uniform2_packed(&mut self) -> [f32; 2] {
+        match self.slot() {
+            Some(p) => p.f32s(),
+            None => self.stream().uniform2_packed(),
+        }
+    }
+
+    #[inline]
+    fn uniform3(&mut self) -> [f32; 3] {
+        match self.slot() {
+            Some(p) => {
+                let [a, b] = p.f32s();
+                [a, b, self.uniform()]
+            }
+            None => self.stream().uniform3(),
+        }
+    }
+
+    #[inline]
+    fn choice_and_point(&mut self) -> (f32, [f32; 2]) {
+        match self.slot() {
+            Some(p) => (p.f32s()[0], self.uniform2()),
+            None => self.stream().choice_and_point(),
+        }
+    }
+
+    #[inline]
+    fn uniform2_f64_32(&mut self) -> [f64; 2] {
+        match self.slot() {
+            Some(p) => p.f64s(),
+            None => self.stream().uniform2_f64_32(),
+        }
     }
 }
 
@@ -203,6 +342,15 @@ pub trait Draw {
             ((x >> 16) & 0xff_ffff) as f32 * k,
             self.uniform(),
         ]
+    }
+
+    /// A number for a discrete choice and a 2D point: the three numbers of
+    /// [`uniform3`](Self::uniform3) in that order (a sequence's sampler
+    /// gives the choice and the point a slot each).
+    #[inline]
+    fn choice_and_point(&mut self) -> (f32, [f32; 2]) {
+        let [c, a, b] = self.uniform3();
+        (c, [a, b])
     }
 
     /// Two uniforms in [0, 1) as f64 with 32 random bits each from one draw.

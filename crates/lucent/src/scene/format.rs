@@ -131,6 +131,8 @@ pub struct RenderDef {
     pub seed: Option<u64>,
     /// `"fast"` or `"watertight"` (`crate::accel::Traversal`).
     pub traversal: Option<Spanned<String>>,
+    /// `"sobol"` or `"random"` (`crate::sampling::SamplerKind`).
+    pub sampler: Option<Spanned<String>>,
 }
 
 /// `[output]`: the passes and how the frame is stored; every key is

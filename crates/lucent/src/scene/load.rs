@@ -30,6 +30,7 @@ use crate::accel::Traversal;
 use crate::error::InputError;
 use crate::geometry::Vec3;
 use crate::materials::Material;
+use crate::sampling::SamplerKind;
 
 /// OBJ loading, also used on its own (the benchmark's meshes).
 pub use super::obj::load_obj;
@@ -332,6 +333,16 @@ fn settings(cx: &Cx, r: &RenderDef) -> Res<RenderSettings> {
             )
         })?;
     }
+    if let Some(k) = &r.sampler {
+        let name = k.get_ref().as_str();
+        s.sampler = SamplerKind::parse(name).ok_or_else(|| {
+            cx.err(
+                k.span(),
+                "render.sampler",
+                format!("expected {}, found \"{name}\"", SamplerKind::expected()),
+            )
+        })?;
+    }
     Ok(s)
 }
 
@@ -406,6 +417,15 @@ mod tests {
     }
 
     #[test]
+    fn sampler_is_sobol_unless_the_scene_asks_for_random() {
+        assert_eq!(scene("").settings.sampler, SamplerKind::Sobol);
+        for k in SamplerKind::ALL {
+            let s = scene(&format!("[render]\nsampler = \"{}\"\n", k.name()));
+            assert_eq!(s.settings.sampler, k);
+        }
+    }
+
+    #[test]
     fn defaults_fill_everything_optional() {
         let s = scene("");
         assert_eq!(s.settings, RenderSettings::default());
@@ -436,6 +456,7 @@ mod tests {
                 max_depth: 3,
                 seed: 99,
                 traversal: Traversal::Fast,
+                sampler: SamplerKind::Sobol,
             }
         );
         // Field by field: the derived members (tan of the fov) can differ in

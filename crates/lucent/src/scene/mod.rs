@@ -63,7 +63,8 @@ pub(crate) fn show_point(p: [f32; 3]) -> String {
     format!("[{}, {}, {}]", one(p[0]), one(p[1]), one(p[2]))
 }
 
-/// Sample count, path depth, seed, and how rays treat shared edges.
+/// Sample count, path depth, seed, how rays treat shared edges, and the
+/// sampler.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     pub spp: u32,
@@ -73,6 +74,9 @@ pub struct RenderSettings {
     /// ([`crate::accel::Traversal`]; the random walk is watertight
     /// whatever this says). `Fast` unless the scene says `"watertight"`.
     pub traversal: crate::accel::Traversal,
+    /// `[render] sampler`: where the samples' random numbers come from
+    /// ([`crate::sampling::SamplerKind`], its default unless given).
+    pub sampler: crate::sampling::SamplerKind,
 }
 
 impl Default for RenderSettings {
@@ -82,6 +86,7 @@ impl Default for RenderSettings {
             max_depth: 8,
             seed: 0,
             traversal: crate::accel::Traversal::Fast,
+            sampler: crate::sampling::SamplerKind::Sobol,
         }
     }
 }

@@ -13,6 +13,7 @@ use crate::film::pass_layout::Layout;
 use crate::film::passes::PassSet;
 use crate::integrator::{plan, IntegratorKind};
 use crate::render::Settings;
+use crate::sampling::SamplerKind;
 use crate::scene::Scene;
 
 /// The integrator's name on the command line and in headers.
@@ -45,9 +46,10 @@ pub fn identity(
         seed: settings.seed,
         spp: settings.spp,
         options: format!(
-            "accel={} integrator={} {options}",
+            "accel={} integrator={} sampler={} {options}",
             backend.name(),
-            integrator_name(settings.integrator)
+            integrator_name(settings.integrator),
+            settings.sampler.name()
         )
         .trim_end()
         .into(),
@@ -55,10 +57,12 @@ pub fn identity(
     }
 }
 
-/// The plan a render of `scene` with `integrator` and `passes` follows.
+/// The plan a render of `scene` with `integrator`, `sampler` and `passes`
+/// follows.
 pub fn render_plan(
     scene: &Scene,
     integrator: IntegratorKind,
+    sampler: SamplerKind,
     passes: PassSet,
 ) -> plan::Explanation {
     plan::Explanation::new(
@@ -66,13 +70,14 @@ pub fn render_plan(
         &plan::PlanOptions {
             integrator,
             passes,
+            sampler: Some(sampler),
             ..plan::PlanOptions::default()
         },
     )
 }
 
 /// What the EXR header records about this render (docs/output.md): the
-/// scene file (`scene_text`) and its SHA-256, samples, seed, depth,
+/// scene file (`scene_text`) and its SHA-256, samples, seed, sampler, depth,
 /// backend that ran (`accel_name`, a resolved `backend`) and its version,
 /// integrator, every subsurface material's sampling options (named by the
 /// objects that use it), the plan with its `passes`, this host, the build
@@ -101,8 +106,9 @@ pub(crate) fn frame_header(
         backend: Some(accel_name.into()),
         backend_version: Some(backend_version(backend)?),
         integrator: Some(integrator_name(settings.integrator).into()),
+        sampler: Some(settings.sampler.name().into()),
         sampling: sampling(scene),
-        plan: Some(render_plan(scene, settings.integrator, passes).to_json()),
+        plan: Some(render_plan(scene, settings.integrator, settings.sampler, passes).to_json()),
         render_seconds: None,
         date: None,
         hosts: vec![provenance::host_name()],

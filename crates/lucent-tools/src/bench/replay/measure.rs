@@ -50,6 +50,7 @@ pub(super) fn measure(
     let opts = RenderOptions {
         spp: Some(s.spp),
         seed: None,
+        sampler: None,
         threads: Some(threads),
         progress: None,
         integrator: IntegratorKind::Path,

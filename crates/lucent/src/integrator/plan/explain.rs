@@ -89,6 +89,10 @@ pub struct Explanation {
     /// absent in plans written before it.
     #[serde(default)]
     pub film: Choice,
+    /// Where the samples' numbers come from
+    /// ([`crate::sampling::SamplerKind`]); absent in plans written before it.
+    #[serde(default)]
+    pub sampler: Choice,
     pub aovs: Aovs,
     pub materials: Vec<MaterialPlan>,
 }
@@ -108,6 +112,7 @@ impl Explanation {
             probe_queries: probe_queries(opts, &rows.probes_needed),
             traversal: traversal(scene, opts),
             film: film(&flags),
+            sampler: sampler(scene, opts),
             aovs: aovs(opts),
             materials: rows.materials,
         }
@@ -291,6 +296,12 @@ fn probe_queries(opts: &PlanOptions, probes_needed: &[String]) -> Choice {
             ),
         )
     }
+}
+
+/// Where the samples' numbers come from.
+fn sampler(scene: &Scene, opts: &PlanOptions) -> Choice {
+    let k = opts.sampler.unwrap_or(scene.settings.sampler);
+    choice(k.name(), k.describe())
 }
 
 /// How Embree treats rays through shared edges.

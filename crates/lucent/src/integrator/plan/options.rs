@@ -3,6 +3,7 @@
 use crate::film::passes::PassSet;
 use crate::integrator::path::PAIR_DEPTH;
 use crate::integrator::IntegratorKind;
+use crate::sampling::SamplerKind;
 
 /// What besides the scene decides the plan.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,6 +19,8 @@ pub struct PlanOptions {
     /// `control_variate`, add the plane control variate
     /// (`crate::integrator::Context::cv_depth`).
     pub cv_depth: u32,
+    /// The sampler the render uses (`--sampler`); None: the scene's.
+    pub sampler: Option<SamplerKind>,
 }
 
 impl Default for PlanOptions {
@@ -30,6 +33,7 @@ impl Default for PlanOptions {
             cv_depth: crate::integrator::control_variate::CV_DEPTH,
             #[cfg(not(feature = "subsurface"))]
             cv_depth: 0,
+            sampler: None,
         }
     }
 }

@@ -44,6 +44,9 @@ pub fn render(p: &Explanation) -> String {
     );
     row(r, "traversal", &p.traversal.method, &p.traversal.reason);
     row(r, "film", &p.film.method, &p.film.reason);
+    if !p.sampler.method.is_empty() {
+        row(r, "sampler", &p.sampler.method, &p.sampler.reason);
+    }
     let aov_reason = if p.aovs.passes.is_empty() {
         p.aovs.reason.clone()
     } else {

@@ -106,7 +106,7 @@ pub(super) fn entries<'s, R: Recorder>(
         && control_variate::applies(ctx.cv_depth, ctx.plan.area_lights, hit.depth);
     // The control variate's light samples, drawn before the probe's randoms.
     let lights = cv.then(|| [draw_light(ctx, st.rng), None]);
-    let u = ProbeRandoms::from_rng(st.rng);
+    let u = ProbeRandoms::from_sample(st.rng);
     // The curvature correction's exit half, once for both probes of a pair.
     let exit = ss.curvature_correction().map(|cc| {
         (
