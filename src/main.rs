@@ -383,7 +383,14 @@ fn main() -> ExitCode {
             };
             if let Some(format) = explain {
                 let run = |file| {
-                    run_explain(&scene, (integrator, sampler), aov, &subsurface, &file, format)
+                    run_explain(
+                        &scene,
+                        (integrator, sampler),
+                        aov,
+                        &subsurface,
+                        &file,
+                        format,
+                    )
                 };
                 return finish(file.settings().and_then(run));
             }
