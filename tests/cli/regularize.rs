@@ -1,10 +1,10 @@
-//! `regularize = 0` restores the pixels of the renderer before the option
-//! existed, bit for bit: `tests/fixtures/smooth-bunny-region.exr` is a
-//! region of scenes/smooth-bunny.toml rendered by main at 6d847a1 (the
-//! commands below, `--accel bvh`; that renderer's only sampler, the
-//! pseudo-random stream `--sampler random` keeps bit for bit), where the
-//! default regularized coat changes most pixels (docs/bssrdf.md §6,
-//! "Regularized coat").
+//! `regularize = 0` keeps the smooth coat a mirror at every vertex, bit
+//! for bit: `tests/fixtures/smooth-bunny-region.exr` is a region of
+//! scenes/smooth-bunny.toml rendered with the mirror coat everywhere and
+//! the pseudo-random stream (the commands below, `--accel bvh`, `--sampler
+//! random`), where the default regularized coat changes most pixels
+//! (docs/bssrdf.md §6, "Regularized coat"); the journal (2026-12-07, "The
+//! regularized coat") says which build made it.
 //!
 //! Caught: the coat regularized with the option off, or the path's
 //! random numbers drawn differently for it. A change that is meant to

@@ -98,8 +98,8 @@ fn render_with(scene: &Scene, sampler: SamplerKind, threads: usize, spp: u32) ->
 
 /// The `random` sampler's pixels are the pseudo-random stream's: pinned
 /// bits of a subsurface scene with a floor, a light and an environment
-/// (checked equal to the renderer before the sequence, whose only
-/// sampler this was). Catches any change to the stream's draws: their
+/// (the journal, 2026-12-07, "Low-discrepancy sampling: …", says how they
+/// were checked). Catches any change to the stream's draws: their
 /// order, the probe's or the light's layout, the camera's.
 #[test]
 fn random_sampler_pixels_are_the_streams() {
