@@ -43,8 +43,7 @@ pub fn install() -> std::io::Result<()> {
                     .compare_exchange(0, sig, Ordering::SeqCst, Ordering::SeqCst)
                     .is_err()
                 {
-                    remove_temporaries();
-                    std::process::exit(exit_code(sig));
+                    remove_temporaries_and_exit(exit_code(sig));
                 }
             }
         })?;
@@ -96,6 +95,20 @@ pub fn register_temporary(path: &Path) {
     }
 }
 
+/// Creates the temporary file `path` with `create` and registers it, both
+/// under the registry's lock: an exit at a second signal, which holds the
+/// lock from its removals to the end, either removes the file or comes
+/// before it exists.
+pub(crate) fn create_temporary<T, E>(
+    path: &Path,
+    create: impl FnOnce() -> Result<T, E>,
+) -> Result<T, E> {
+    let mut t = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
+    let file = create()?;
+    t.push(path.to_path_buf());
+    Ok(file)
+}
+
 /// The temporary file was renamed into place or removed: forget it.
 pub(crate) fn unregister_temporary(path: &Path) {
     if let Ok(mut t) = TEMPORARIES.lock() {
@@ -105,13 +118,15 @@ pub(crate) fn unregister_temporary(path: &Path) {
     }
 }
 
-/// Removes every registered temporary file.
-fn remove_temporaries() {
-    if let Ok(t) = TEMPORARIES.lock() {
-        for p in t.iter() {
-            let _ = std::fs::remove_file(p);
-        }
+/// Removes every registered temporary file and exits with `code`, holding
+/// the registry's lock to the end so no temporary is created after the
+/// removals.
+fn remove_temporaries_and_exit(code: i32) -> ! {
+    let t = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
+    for p in t.iter() {
+        let _ = std::fs::remove_file(p);
     }
+    std::process::exit(code)
 }
 
 /// Removes every registered temporary file, unless the registry is in use

@@ -257,27 +257,28 @@ impl Staged {
         // what a killed process left of this output (SIGKILL, `stale`)
         stale::clean(path);
         let tmp = temp_path(path);
-        let mut file = fs::OpenOptions::new()
-            .write(true)
-            .read(true)
-            .create_new(true)
-            .open(&tmp)
-            .map_err(|e| Error::Write {
-                path: path.to_path_buf(),
-                problem: match e.kind() {
-                    std::io::ErrorKind::AlreadyExists => format!(
-                        "its temporary file {} is in the way (lucent did not create it: \
+        let create = || {
+            fs::OpenOptions::new()
+                .write(true)
+                .read(true)
+                .create_new(true)
+                .open(&tmp)
+        };
+        let mut file = interrupt::create_temporary(&tmp, create).map_err(|e| Error::Write {
+            path: path.to_path_buf(),
+            problem: match e.kind() {
+                std::io::ErrorKind::AlreadyExists => format!(
+                    "its temporary file {} is in the way (lucent did not create it: \
                          move it away)",
-                        tmp.display()
-                    ),
-                    _ => format!("cannot create its temporary file {}: {e}", tmp.display()),
-                },
-            })?;
+                    tmp.display()
+                ),
+                _ => format!("cannot create its temporary file {}: {e}", tmp.display()),
+            },
+        })?;
         let staged = Staged {
             tmp,
             path: path.to_path_buf(),
         };
-        interrupt::register_temporary(&staged.tmp);
         // on failure, dropping `staged` removes the temporary file
         write(&mut file).map_err(|problem| Error::Write {
             path: path.to_path_buf(),
