@@ -13,6 +13,7 @@ pub mod analytic_lights;
 #[cfg(feature = "subsurface")]
 pub mod bssrdf;
 pub mod denoise;
+mod dynlib;
 pub mod environment;
 pub mod error;
 pub mod farm;

@@ -126,39 +126,19 @@ pub fn report() -> String {
 }
 
 fn load() -> Result<Api, LoadError> {
-    let (lib, path) = match std::env::var_os(ENV_VAR).filter(|v| !v.is_empty()) {
-        Some(p) => {
-            let shown = p.to_string_lossy().into_owned();
-            // SAFETY: loading runs the library's initializers; OIDN's are
-            // sound. A path to some other library is the user's explicit
-            // choice, refused below before any OIDN call unless it has
-            // OIDN's functions and reports version 2.
-            let lib =
-                unsafe { libloading::Library::new(&p) }.map_err(|e| LoadError::CannotLoad {
-                    path: shown.clone(),
-                    problem: e.to_string(),
-                })?;
-            (lib, shown)
-        }
-        None => {
-            let mut errs = Vec::new();
-            let mut found = None;
-            for name in LIB_NAMES {
-                // SAFETY: as above; these are OIDN 2's own names.
-                match unsafe { libloading::Library::new(name) } {
-                    Ok(l) => {
-                        found = Some((l, name.to_string()));
-                        break;
-                    }
-                    Err(e) => errs.push(e.to_string()),
-                }
-            }
-            found.ok_or_else(|| LoadError::NotFound {
-                tried: errs.join("; "),
-            })?
-        }
-    };
+    let (lib, path) = crate::dynlib::open(ENV_VAR, &LIB_NAMES)?;
     bind(lib, path)
+}
+
+impl From<crate::dynlib::OpenError> for LoadError {
+    fn from(e: crate::dynlib::OpenError) -> Self {
+        match e {
+            crate::dynlib::OpenError::CannotLoad { path, problem } => {
+                LoadError::CannotLoad { path, problem }
+            }
+            crate::dynlib::OpenError::NotFound { tried } => LoadError::NotFound { tried },
+        }
+    }
 }
 
 /// Looks every function up, then asks a CPU device for the version.
