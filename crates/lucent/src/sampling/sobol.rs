@@ -105,40 +105,25 @@ pub fn second(mut index: u32) -> u32 {
     x
 }
 
-/// The second dimension bit-reversed, by bytes of the bit-reversed index:
-/// `REVERSED_SECOND[b][v]` is the XOR of `SECOND[31 − j].reverse_bits()`
-/// over the bits j of `v << 8b`, so four lookups give
-/// `second(i).reverse_bits()` from `i.reverse_bits()`.
-static REVERSED_SECOND: [[u32; 256]; 4] = {
-    let mut t = [[0u32; 256]; 4];
-    let mut b = 0;
-    while b < 4 {
-        let mut v = 0;
-        while v < 256 {
-            let mut x = 0u32;
-            let mut j = 0;
-            while j < 8 {
-                if v >> j & 1 == 1 {
-                    x ^= SECOND[31 - (8 * b + j)].reverse_bits();
-                }
-                j += 1;
-            }
-            t[b][v] = x;
-            v += 1;
-        }
-        b += 1;
+/// Direction numbers that act on the bit-reversed index and give the
+/// bit-reversed fraction: column k is `dirs[31 − k].reverse_bits()`.
+const fn reversed_directions(dirs: &[u32; 32]) -> [u32; 32] {
+    let mut r = [0u32; 32];
+    let mut k = 0;
+    while k < 32 {
+        r[k] = dirs[31 - k].reverse_bits();
+        k += 1;
     }
-    t
-};
+    r
+}
+
+/// The second dimension bit-reversed, by bytes of the bit-reversed index.
+static REVERSED_SECOND: [[u32; 256]; 4] = byte_tables(&reversed_directions(&SECOND));
 
 /// `second(i).reverse_bits()` from `reversed = i.reverse_bits()`.
 #[inline]
 fn second_reversed(reversed: u32) -> u32 {
-    let [b0, b1, b2, b3] = reversed.to_le_bytes();
-    REVERSED_SECOND[0][b0 as usize]
-        ^ REVERSED_SECOND[1][b1 as usize]
-        ^ REVERSED_SECOND[2][b2 as usize]
-        ^ REVERSED_SECOND[3][b3 as usize]
+    by_bytes(&REVERSED_SECOND, reversed)
 }
 
 /// A bijection of 32-bit words whose output bit k is input bit k flipped
