@@ -14,8 +14,9 @@ fn node(k: usize) -> f32 {
     s * s
 }
 
-/// E(μ) at the nodes and Ē of the interpolated table.
-#[derive(Clone, Debug, PartialEq)]
+/// E(μ) at the nodes and Ē of the interpolated table. The default is the
+/// empty table, which [`AlbedoTable::at`] must not be asked.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct AlbedoTable {
     values: Vec<f32>,
     mean: f32,

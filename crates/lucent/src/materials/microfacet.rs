@@ -12,26 +12,19 @@
 //!
 //! This file depends only on geometry, sampling and Fresnel: no ray queries.
 
+use super::albedo_table::AlbedoTable;
 use crate::fresnel;
 use crate::geometry::Vec3;
 use crate::sampling::concentric_disk;
 use std::f32::consts::PI;
+use std::sync::{Arc, Mutex};
 
 /// Below this α the interface is treated as smooth (pbrt-v4's threshold).
 pub const SMOOTH_ALPHA: f32 = 1e-3;
 
-/// Intervals of the E(μ) table. Nodes are μ = (k / ALBEDO_NODES)²,
-/// dense at grazing angles, where Fresnel reflectance changes fastest.
-pub(crate) const ALBEDO_NODES: usize = 64;
-
-/// Midpoint-rule points per side of the sampling square for each node.
+/// Midpoint-rule points per side of the sampling square for each node of
+/// the albedo table.
 const QUADRATURE_SIDE: usize = 64;
-
-/// The table's k-th cosine, (k / ALBEDO_NODES)².
-fn node(k: usize) -> f32 {
-    let s = k as f32 / ALBEDO_NODES as f32;
-    s * s
-}
 
 /// α from the scene's roughness ∈ [0, 1]: α = roughness².
 pub(crate) fn alpha_from_roughness(roughness: f32) -> f32 {
@@ -120,11 +113,9 @@ pub(crate) fn reflect(wo: Vec3, m: Vec3) -> Vec3 {
 pub struct RoughCoat {
     pub ggx: Ggx,
     pub eta: f32,
-    /// E(μ) at μ = (k / ALBEDO_NODES)².
-    albedo: Vec<f32>,
-    /// 2 ∫₀¹ E(μ) μ dμ of the interpolated table: the coat's albedo under
-    /// uniform light.
-    mean: f32,
+    /// E(μ) and its cosine-weighted mean Ē, the coat's albedo under
+    /// uniform light; shared by every coat of the same α and η.
+    albedo: Arc<AlbedoTable>,
 }
 
 impl PartialEq for RoughCoat {
@@ -137,31 +128,17 @@ impl RoughCoat {
     /// The coat of width `alpha` (≥ [`SMOOTH_ALPHA`]) and index `eta`, with
     /// its albedo table.
     pub fn new(alpha: f32, eta: f32) -> Self {
-        let mut c = RoughCoat {
+        // Sampling the coat, which the quadrature does, never reads the
+        // table: an empty one stands in while it is built.
+        let bare = RoughCoat {
             ggx: Ggx { alpha },
             eta,
-            albedo: Vec::new(),
-            mean: 0.0,
+            albedo: Arc::default(),
         };
-        c.albedo = (0..=ALBEDO_NODES)
-            .map(|k| {
-                // μ = 0 itself is a limit; the table's first node sits just
-                // above it.
-                let mu = node(k).max(1e-4);
-                c.albedo_quadrature(mu, QUADRATURE_SIDE) as f32
-            })
-            .collect();
-        // 2 ∫ E μ dμ of the piecewise-linear table, exactly: on [a, b] of
-        // width h with E linear from ea to eb, ∫ E μ = h (ea (2a + b) + eb (a + 2b)) / 6.
-        let mut mean = 0.0;
-        for k in 0..ALBEDO_NODES {
-            let (a, b) = (node(k) as f64, node(k + 1) as f64);
-            let h = b - a;
-            let (ea, eb) = (c.albedo[k] as f64, c.albedo[k + 1] as f64);
-            mean += h * (ea * (2.0 * a + b) + eb * (a + 2.0 * b)) / 6.0;
-        }
-        c.mean = (2.0 * mean) as f32;
-        c
+        let albedo = shared_table((alpha.to_bits(), eta.to_bits()), || {
+            AlbedoTable::new(|mu| bare.albedo_quadrature(mu, QUADRATURE_SIDE))
+        });
+        RoughCoat { albedo, ..bare }
     }
 
     /// E(μo) by an n × n midpoint rule over the sampling square.
@@ -182,16 +159,12 @@ impl RoughCoat {
     /// E(μ), linearly interpolated in μ between the table's nodes (μ
     /// clamped to [0, 1]).
     pub fn albedo(&self, mu: f32) -> f32 {
-        let mu = mu.clamp(0.0, 1.0);
-        let k = ((mu.sqrt() * ALBEDO_NODES as f32) as usize).min(ALBEDO_NODES - 1);
-        let (a, b) = (node(k), node(k + 1));
-        let t = ((mu - a) / (b - a)).clamp(0.0, 1.0);
-        self.albedo[k] * (1.0 - t) + self.albedo[k + 1] * t
+        self.albedo.at(mu)
     }
 
     /// 2 ∫₀¹ E(μ) μ dμ: the fraction of uniform incident light reflected.
     pub(crate) fn mean_albedo(&self) -> f32 {
-        self.mean
+        self.albedo.mean()
     }
 
     /// f(ωo, ωi) per steradian; 0 unless both are above the surface.
@@ -231,6 +204,26 @@ impl RoughCoat {
         let w = fresnel::dielectric(cos_om, self.eta) * self.ggx.g2(wo, wi) / g1;
         Some((wi, w, pdf))
     }
+}
+
+/// The bits of a coat's α and η.
+type CoatKey = (u32, u32);
+
+/// The albedo table of the coat whose α and η have the bits `key`, built
+/// the first time a process asks for it: a table costs a quarter of a
+/// million samples of the coat, and materials of one coat, a material's
+/// regularized coat and a material rebuilt with other estimator options
+/// all ask for the same.
+fn shared_table(key: CoatKey, build: impl FnOnce() -> AlbedoTable) -> Arc<AlbedoTable> {
+    static TABLES: Mutex<Vec<(CoatKey, Arc<AlbedoTable>)>> = Mutex::new(Vec::new());
+    // A panic elsewhere while the lock was held leaves only whole entries.
+    let mut tables = TABLES.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, t)) = tables.iter().find(|(k, _)| *k == key) {
+        return Arc::clone(t);
+    }
+    let table = Arc::new(build());
+    tables.push((key, Arc::clone(&table)));
+    table
 }
 
 /// The unit half vector of a reflection, ωh = (ωo + ωi)/|ωo + ωi|; None
@@ -498,5 +491,22 @@ mod tests {
                 assert!((coat.albedo(0.5) as f64 - fr).abs() < 2e-3);
             }
         }
+    }
+
+    #[test]
+    fn coats_share_a_table_only_when_alpha_and_eta_agree() {
+        // a table keyed by α alone would give the η = 1.5 coat the η = 1.3
+        // coat's albedo
+        let a = RoughCoat::new(0.09, 1.3);
+        let b = RoughCoat::new(0.09, 1.3);
+        let c = RoughCoat::new(0.09, 1.5);
+        let d = RoughCoat::new(0.16, 1.3);
+        assert!(Arc::ptr_eq(&a.albedo, &b.albedo));
+        assert!(!Arc::ptr_eq(&a.albedo, &c.albedo) && !Arc::ptr_eq(&a.albedo, &d.albedo));
+        assert!(
+            c.mean_albedo() > a.mean_albedo(),
+            "a higher index reflects more"
+        );
+        assert_eq!(c.albedo(0.5), RoughCoat::new(0.09, 1.5).albedo(0.5));
     }
 }
