@@ -97,7 +97,7 @@ fn diffusion(coat: &str, exit: &str, active: &[&str], inactive: &[&str]) -> Valu
     json!({
         "subsurface": [{"method": "level-of-detail"}, {
             "method": "diffusion", "axes": "curvature", "channel": "mis",
-            "radius": "analytic", "pair_depth": 0, "control_variate_depth": 1,
+            "radius": "analytic", "pair_depth": 0, "control_variate_depth": 0,
             "curvature_correction": true
         }],
         "coat": {"method": coat},
@@ -236,8 +236,8 @@ fn ketchup_blue_is_off_with_the_presets_given_albedo_and_on_with_the_table() {
 fn the_variance_reduction_is_planned_as_the_material_asks_and_the_lights_allow() {
     // The control variate models next-event estimation of area lights:
     // under the environment alone there is nothing for it to model, and
-    // the plan says so; with a lamp it is on at the camera vertex, unless
-    // the material turns it off; the pair only where the material asks.
+    // the plan says so; with a lamp it is on at the camera vertex where
+    // the material turns it on; the pair only where the material asks.
     let diffusion_of = |s: &Scene| -> Value {
         let v = serde_json::to_value(plan_of(s, IntegratorKind::Path, PassSet::EMPTY)).unwrap();
         let m = v["materials"]
@@ -256,13 +256,15 @@ fn the_variance_reduction_is_planned_as_the_material_asks_and_the_lights_allow()
             .clone()
     };
     let env = load(&format!(
-        "[environment]\nradiance = [0.5, 0.5, 0.5]\n{KETCHUP}{BALL_SAUCE}"
+        "[environment]\nradiance = [0.5, 0.5, 0.5]\n{KETCHUP}control_variate = true\n{BALL_SAUCE}"
     ));
     let d = diffusion_of(&env);
     assert_eq!(d["control_variate_depth"], 0, "{d}");
     let why = d["reason"].as_str().unwrap();
     assert!(why.contains("no area light"), "{why}");
-    let lit = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
+    let lit = load(&format!(
+        "{LAMP}{KETCHUP}control_variate = true\n{BALL_SAUCE}"
+    ));
     let d = diffusion_of(&lit);
     assert_eq!(d["control_variate_depth"], 1, "{d}");
     let why = d["reason"].as_str().unwrap();
@@ -285,9 +287,7 @@ fn the_variance_reduction_is_planned_as_the_material_asks_and_the_lights_allow()
             && why.contains("no control variate (control_variate = false)"),
         "{why}"
     );
-    let neither = load(&format!(
-        "{LAMP}{KETCHUP}control_variate = false\n{BALL_SAUCE}"
-    ));
+    let neither = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
     let d = diffusion_of(&neither);
     assert_eq!(
         (&d["pair_depth"], &d["control_variate_depth"]),

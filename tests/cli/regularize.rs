@@ -1,8 +1,8 @@
 //! `regularize = 0` keeps the smooth coat a mirror at every vertex, bit
 //! for bit: `tests/fixtures/smooth-bunny-region.exr` is a region of
 //! scenes/smooth-bunny.toml rendered with the mirror coat everywhere and
-//! the pseudo-random stream (the commands below, `--accel bvh`, `--sampler
-//! random`), where the default regularized coat changes most pixels
+//! the pseudo-random stream and the plane control variate (the commands
+//! below, `--accel bvh`, `--sampler random`, `--control-variate true`), where the default regularized coat changes most pixels
 //! (docs/bssrdf.md §6, "Regularized coat"); the journal (2026-12-07, "The
 //! regularized coat") says which build made it.
 //!
@@ -42,6 +42,8 @@ fn render(extra: &[&str]) -> Exr {
             "bvh",
             "--sampler",
             "random",
+            "--control-variate",
+            "true",
             "-q",
         ])
         .arg("-o")

@@ -1,8 +1,9 @@
 //! The two variance reductions of the probe estimator at the camera vertex
 //! on a smooth translucent sphere lit from the side, where the light at the
 //! entry point changes across the profile: the antithetic probe pair
-//! (`integrator::path`, `PAIR_DEPTH`) and the plane control variate (the
-//! default, `integrator::control_variate`). Each must (a) leave the mean
+//! (`integrator::path`, `PAIR_DEPTH`) and the plane control variate
+//! (`control_variate = true`, `integrator::control_variate`). Each must
+//! (a) leave the mean
 //! where one plain probe puts it — both are unbiased estimators of the same
 //! integral — and (b) cut the per-sample variance of the lit body to well
 //! below one probe's (docs/accuracy.md). Hand-made breaks that (b) catches:
@@ -161,11 +162,11 @@ fn the_control_variate_keeps_the_mean_and_cuts_the_lit_bodys_variance() {
         .unwrap();
     assert_eq!(
         (ss.control_variate(), ss.probe_pair()),
-        (true, false),
-        "one probe with the control variate is the default"
+        (false, false),
+        "one plain probe is the default"
     );
-    let one = scene("control_variate = false");
-    let ratio = lit_body_variance_ratio(&default, &one, "control variate");
+    let cv = scene("control_variate = true");
+    let ratio = lit_body_variance_ratio(&cv, &default, "control variate");
     assert!(
         ratio < 0.7,
         "the control variate's variance is {ratio:.3} of one probe's"
@@ -184,7 +185,7 @@ fn the_control_variate_leaves_the_pair_as_it_is() {
         [(20u32, 14u32), (24, 18)].map(|(x, y)| pixel_stats(&ctx, x, y, 64))
     };
     assert_eq!(
-        samples("probe_pair = true"),
+        samples("control_variate = true\nprobe_pair = true"),
         samples("control_variate = false\nprobe_pair = true")
     );
 }
@@ -277,7 +278,7 @@ fn the_control_variate_is_drawn_only_at_the_camera_vertex_under_an_area_light() 
         }
         pixels.map(|(x, y)| pixel_stats(&ctx, x, y, 64))
     };
-    let lit_on = scene("");
+    let lit_on = scene("control_variate = true");
     let lit_off = scene("control_variate = false");
     assert_ne!(
         samples(&lit_on, None),
@@ -295,7 +296,10 @@ fn the_control_variate_is_drawn_only_at_the_camera_vertex_under_an_area_light() 
             .replace("emission = [50.0, 50.0, 50.0]\n", "");
         lucent::scene::load_str(&text, Path::new("no_area_light.toml")).unwrap()
     };
-    let (dark_on, dark_off) = (dark(""), dark("control_variate = false"));
+    let (dark_on, dark_off) = (
+        dark("control_variate = true"),
+        dark("control_variate = false"),
+    );
     assert!(
         !Context::new(
             &dark_on,

@@ -62,7 +62,7 @@ impl Default for EstimatorOptions {
             curvature: CurvatureMode::Auto,
             lod: LodMode::Auto,
             lod_threshold: DEFAULT_THRESHOLD,
-            control_variate: true,
+            control_variate: false,
             probe_pair: false,
             regularize: DEFAULT_REGULARIZE,
         }
