@@ -436,8 +436,8 @@ fn cli_bad_input_exits_2() {
 
 #[test]
 fn the_variance_axis_varies_the_camera_vertex_estimator_and_keeps_the_rest() {
-    // The baseline keeps the scene's variance reduction (by default the
-    // control variate alone); the full study adds each other choice, and
+    // The baseline keeps the scene's variance reduction (by default none:
+    // one plain probe); the full study adds each other choice, and
     // every such row differs from the baseline in those two settings only.
     let variance_rows = |extra: &str| {
         let text = std::fs::read_to_string(scene("smooth-sphere.toml"))
@@ -479,7 +479,10 @@ fn the_variance_axis_varies_the_camera_vertex_estimator_and_keeps_the_rest() {
         }
         names
     };
-    assert_eq!(variance_rows(""), ["none", "pair", "pair+control-variate"]);
+    assert_eq!(
+        variance_rows(""),
+        ["control-variate", "pair", "pair+control-variate"]
+    );
     assert_eq!(
         variance_rows("probe_pair = true\ncontrol_variate = false\n"),
         ["none", "control-variate", "pair+control-variate"]

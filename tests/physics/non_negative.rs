@@ -96,7 +96,10 @@ fn no_light_pass_of_a_shipped_subsurface_scene_goes_below_zero() {
         let runs = [(1, ""), (4, ""), (16, ""), (4, CV), (16, CV)];
         for (spp, options) in runs {
             for n in negatives(&path, spp, options) {
-                bad.push(format!("{} {options:?} at {spp} spp: {n:?}", path.display()));
+                bad.push(format!(
+                    "{} {options:?} at {spp} spp: {n:?}",
+                    path.display()
+                ));
             }
         }
     }
