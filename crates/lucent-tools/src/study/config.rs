@@ -359,7 +359,7 @@ pub fn matrix(
         m.base.clone().with("lod", LodMode::Off.name()),
     );
     // The variance reduction at the camera vertex, each choice other than
-    // the scene's (the default: the control variate alone); the quick
+    // the scene's (the default: one plain probe); the quick
     // study keeps the pair.
     let own = scene_variance(scene);
     let variance: &[(&str, bool, bool)] = if quick {
