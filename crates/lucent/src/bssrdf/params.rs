@@ -503,6 +503,20 @@ impl SubsurfaceParams {
             .fold(0.0, f64::max)
     }
 
+    /// Scales channel c's lengths by `k[c]` (finite, > 0): d, and the
+    /// medium's mean free paths (a textured length, `docs/bssrdf.md` §13).
+    pub fn scaled_channels(&self, k: [f64; 3]) -> Self {
+        SubsurfaceParams {
+            d: std::array::from_fn(|c| self.d[c] * k[c]),
+            medium: self.medium.map(|m| Medium {
+                sigma_s: std::array::from_fn(|c| m.sigma_s[c] / k[c]),
+                sigma_a: std::array::from_fn(|c| m.sigma_a[c] / k[c]),
+                g: m.g,
+            }),
+            ..*self
+        }
+    }
+
     /// Scales all lengths (e.g. an object instanced at a different scale).
     pub fn scaled(&self, k: f64) -> Self {
         SubsurfaceParams {

@@ -1,7 +1,8 @@
 //! A hit on a textured material: its texture coordinates (the triangle's
 //! corners at the hit's barycentrics), the footprint in UV units, and the
 //! parameters the textures give there: the shading normal of a normal map,
-//! the diffuse albedo (`docs/scene-format.md`, "Textures").
+//! the albedo, a subsurface medium's length factor
+//! (`docs/scene-format.md`, "Textures").
 //!
 //! The footprint is the path's ray cone width w at the hit
 //! ([`super::footprint`]), stretched on the surface to w/|cos θ| along the
@@ -19,10 +20,11 @@ use crate::materials::Textured;
 const MIN_COS: f32 = 1e-3;
 
 /// What the textures of a hit give: its interaction (with the normal
-/// map's shading normal) and the albedo, when textured.
+/// map's shading normal), the albedo and the length factor, when textured.
 pub(crate) struct Resolved {
     pub(crate) si: Interaction,
     pub(crate) albedo: Option<Vec3>,
+    pub(crate) dmfp: Option<Vec3>,
 }
 
 /// The parameters of `t` at `si` (barycentrics `bary`), seen along `wo`
@@ -40,6 +42,7 @@ pub(crate) fn resolve(
         return Resolved {
             si: *si,
             albedo: None,
+            dmfp: None,
         };
     };
     let uv = tri.at(bary);
@@ -52,6 +55,7 @@ pub(crate) fn resolve(
     Resolved {
         si,
         albedo: t.albedo.as_ref().map(|a| a.eval(uv, w)),
+        dmfp: t.dmfp.as_ref().map(|a| a.eval(uv, w)),
     }
 }
 

@@ -20,6 +20,8 @@ pub mod rough_dielectric;
 #[cfg(feature = "subsurface")]
 pub mod subsurface;
 pub mod textured;
+#[cfg(feature = "subsurface")]
+pub mod textured_medium;
 
 use std::sync::Arc;
 
@@ -70,10 +72,10 @@ impl Material {
         }
     }
 
-    /// Whether this is a subsurface material.
+    /// Whether this is a subsurface material (textured or not).
     #[cfg(feature = "subsurface")]
     pub(crate) fn is_subsurface(&self) -> bool {
-        matches!(self, Material::Subsurface(_))
+        matches!(self.base(), Material::Subsurface(_))
     }
 
     /// Whether this is a subsurface material: never, in a build without

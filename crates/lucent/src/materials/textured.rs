@@ -1,8 +1,10 @@
 //! A material whose parameters vary over the surface: a base material,
 //! with its diffuse albedo read from a texture and/or its shading normal
-//! perturbed by a tangent-space normal map (`docs/scene-format.md`,
-//! "Textures"). Resolved at each hit into the base material's scattering
-//! with the looked-up values (`crate::integrator::path`).
+//! perturbed by a tangent-space normal map, or a subsurface base whose
+//! albedo and lengths are read from textures at the exit point
+//! (`docs/scene-format.md`, "Textures"; `docs/bssrdf.md` §13). Resolved at
+//! each hit into the base material's scattering with the looked-up values
+//! (`crate::integrator::path`).
 
 use std::sync::Arc;
 
@@ -14,20 +16,40 @@ use crate::texture::{Texture, TextureRef};
 pub struct Textured {
     /// What scatters; never itself `Textured`.
     pub base: Material,
-    /// The diffuse albedo (a `diffuse` base only), linear RGB.
+    /// The albedo, linear RGB: a `diffuse` base's, or a subsurface base's
+    /// A (then a factor on the material's `albedo`, see [`Self::medium`]).
     pub albedo: Option<TextureRef>,
     /// A tangent-space normal map: RGB in [0, 1] read as 2c − 1, z along
     /// the shading normal, x along the tangent (increasing u), y along the
     /// bitangent (increasing v).
     pub normal: Option<Arc<Texture>>,
+    /// A subsurface base's factor per channel on its lengths (`dmfp`).
+    pub dmfp: Option<TextureRef>,
+    /// How a subsurface base's parameters follow from `albedo` and `dmfp`
+    /// at a point; None for other bases.
+    #[cfg(feature = "subsurface")]
+    pub medium: Option<super::textured_medium::MediumRecipe>,
 }
 
 impl Textured {
+    /// A textured `base` with `albedo` and/or a `normal` map.
+    pub fn new(base: Material, albedo: Option<TextureRef>, normal: Option<Arc<Texture>>) -> Self {
+        Textured {
+            base,
+            albedo,
+            normal,
+            dmfp: None,
+            #[cfg(feature = "subsurface")]
+            medium: None,
+        }
+    }
+
     /// The textures it reads.
     pub fn textures(&self) -> impl Iterator<Item = &Arc<Texture>> {
         self.albedo
             .iter()
             .map(|a| &a.texture)
             .chain(self.normal.iter())
+            .chain(self.dmfp.iter().map(|a| &a.texture))
     }
 }

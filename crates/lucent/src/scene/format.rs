@@ -282,6 +282,9 @@ pub struct MaterialDef {
     pub sigma_a: Option<Spanned<Triple3>>,
     pub g: Option<Spanned<f64>>,
     pub dmfp: Option<Spanned<Triple3>>,
+    /// A texture's name: a factor per channel on a subsurface medium's
+    /// lengths (`dmfp`, or a preset's or measured medium's).
+    pub dmfp_texture: Option<Spanned<String>>,
     pub fit: Option<Spanned<String>>,
     pub albedo_source: Option<Spanned<String>>,
     // subsurface: sampling options
@@ -327,6 +330,7 @@ impl MaterialDef {
             self.albedo_texture.as_ref().map(|x| x.span()),
         );
         add("normal_map", self.normal_map.as_ref().map(|x| x.span()));
+        add("dmfp_texture", self.dmfp_texture.as_ref().map(|x| x.span()));
         add("metal", self.metal.as_ref().map(|x| x.span()));
         add("n", self.n.as_ref().map(|x| x.span()));
         add("k", self.k.as_ref().map(|x| x.span()));

@@ -326,12 +326,11 @@ fn material(
     if albedo.is_none() && normal.is_none() {
         return Ok(base);
     }
-    Ok(Material::Textured(Arc::new(Textured {
-        base,
-        albedo: albedo.map(|texture| TextureRef {
-            texture,
-            scale: Vec3::ONE,
-        }),
-        normal,
-    })))
+    let albedo = albedo.map(|texture| TextureRef {
+        texture,
+        scale: Vec3::ONE,
+    });
+    Ok(Material::Textured(Arc::new(Textured::new(
+        base, albedo, normal,
+    ))))
 }

@@ -1,6 +1,7 @@
 //! `[textures.NAME]` → the scene's texture table (each image read once,
 //! shared by every material that names it), and the materials that name
-//! textures (`albedo_texture`, `normal_map`) → [`Textured`] materials
+//! textures (`albedo_texture`, `normal_map`, a subsurface material's
+//! `dmfp_texture`) → [`Textured`] materials
 //! (`docs/scene-format.md`, "Textures").
 
 use std::collections::{BTreeMap, HashMap};
@@ -12,6 +13,8 @@ use super::format::{MaterialDef, Spanned, TextureDef};
 use super::key_path::{key_segment, quoted};
 use super::regular_file::{open_regular, read_regular_bytes};
 use crate::geometry::Vec3;
+#[cfg(feature = "subsurface")]
+use crate::materials::textured_medium::MediumRecipe;
 use crate::materials::{Material, Textured};
 use crate::texture::file::{self, Format, TextureError};
 use crate::texture::{ColorSpace, Texture, TextureRef, Wrap};
@@ -137,7 +140,10 @@ pub(super) fn textured(
     table: &Table,
 ) -> Res<Material> {
     let d = m.get_ref();
-    if d.albedo_texture.is_none() && d.normal_map.is_none() {
+    // a subsurface material's textures are read with its parameters
+    if matches!(base, Material::Textured(_))
+        || (d.albedo_texture.is_none() && d.normal_map.is_none())
+    {
         return Ok(base);
     }
     let field = format!("materials.{}", key_segment(name));
@@ -155,30 +161,74 @@ pub(super) fn textured(
         }
         None => None,
     };
-    let normal = match &d.normal_map {
+    let normal = d
+        .normal_map
+        .as_ref()
+        .map(|t| data(cx, &format!("{field}.normal_map"), t, table, "a normal map"))
+        .transpose()?;
+    Ok(Material::Textured(Arc::new(Textured::new(
+        base, albedo, normal,
+    ))))
+}
+
+/// The linear texture `t` names (at `key`), refused when declared sRGB:
+/// `what` is data.
+fn data(cx: &Cx, key: &str, t: &Spanned<String>, table: &Table, what: &str) -> Res<Arc<Texture>> {
+    let e = lookup(cx, key, t, table)?;
+    if e.space != ColorSpace::Linear {
+        return Err(cx.err(
+            t.span(),
+            key,
+            format!(
+                "texture {} is declared sRGB, but {what} is data: give it \
+                 color_space = \"linear\"",
+                quoted(t.get_ref())
+            ),
+        ));
+    }
+    Ok(e.texture.clone())
+}
+
+/// The subsurface material `base` (`field`, table `m`) with the textures
+/// its `albedo_texture` (A, a factor on `albedo`) and `dmfp_texture` (a
+/// factor on its lengths, data) name, its parameters at a point following
+/// `recipe`; `base` when it names neither.
+#[cfg(feature = "subsurface")]
+pub(super) fn subsurface(
+    cx: &Cx,
+    field: &str,
+    m: &Spanned<MaterialDef>,
+    base: Material,
+    recipe: MediumRecipe,
+    table: &Table,
+) -> Res<Material> {
+    let d = m.get_ref();
+    if d.albedo_texture.is_none() && d.dmfp_texture.is_none() {
+        return Ok(base);
+    }
+    let unit = |texture| TextureRef {
+        texture,
+        scale: Vec3::ONE,
+    };
+    let albedo = match &d.albedo_texture {
+        Some(t) => Some(unit(
+            lookup(cx, &format!("{field}.albedo_texture"), t, table)?
+                .texture
+                .clone(),
+        )),
+        None => None,
+    };
+    let dmfp = match &d.dmfp_texture {
         Some(t) => {
-            let key = format!("{field}.normal_map");
-            let e = lookup(cx, &key, t, table)?;
-            if e.space != ColorSpace::Linear {
-                return Err(cx.err(
-                    t.span(),
-                    &key,
-                    format!(
-                        "texture {} is declared sRGB, but a normal map is data: give it \
-                         color_space = \"linear\"",
-                        quoted(t.get_ref())
-                    ),
-                ));
-            }
-            Some(e.texture.clone())
+            let key = format!("{field}.dmfp_texture");
+            Some(unit(data(cx, &key, t, table, "a length factor")?))
         }
         None => None,
     };
-    Ok(Material::Textured(Arc::new(Textured {
-        base,
-        albedo,
-        normal,
-    })))
+    let mut t = Textured::new(base, albedo, None);
+    t.dmfp = dmfp;
+    t.medium = Some(recipe);
+    Ok(Material::Textured(Arc::new(t)))
 }
 
 /// The texture `t` names, or an error at `field` listing those defined.
