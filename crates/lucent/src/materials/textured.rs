@@ -29,6 +29,17 @@ pub struct Textured {
     /// at a point; None for other bases.
     #[cfg(feature = "subsurface")]
     pub medium: Option<super::textured_medium::MediumRecipe>,
+    /// Which parameter reads which texture, as the scene names them (for
+    /// the render plan).
+    pub names: Vec<TextureUse>,
+}
+
+/// A parameter read from a texture: its key (`albedo_texture`,
+/// `normal_map`, `map_Kd`, …) and the texture's name or file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TextureUse {
+    pub key: &'static str,
+    pub texture: String,
 }
 
 impl Textured {
@@ -41,7 +52,14 @@ impl Textured {
             dmfp: None,
             #[cfg(feature = "subsurface")]
             medium: None,
+            names: Vec::new(),
         }
+    }
+
+    /// The same, with the textures' `names` recorded.
+    pub fn named(mut self, names: Vec<TextureUse>) -> Self {
+        self.names = names;
+        self
     }
 
     /// The textures it reads.

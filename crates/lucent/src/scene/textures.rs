@@ -15,7 +15,7 @@ use super::regular_file::{open_regular, read_regular_bytes};
 use crate::geometry::Vec3;
 #[cfg(feature = "subsurface")]
 use crate::materials::textured_medium::MediumRecipe;
-use crate::materials::{Material, Textured};
+use crate::materials::{Material, TextureUse, Textured};
 use crate::texture::file::{self, Format, TextureError};
 use crate::texture::{ColorSpace, Texture, TextureRef, Wrap};
 
@@ -166,9 +166,13 @@ pub(super) fn textured(
         .as_ref()
         .map(|t| data(cx, &format!("{field}.normal_map"), t, table, "a normal map"))
         .transpose()?;
-    Ok(Material::Textured(Arc::new(Textured::new(
-        base, albedo, normal,
-    ))))
+    let names = uses(&[
+        ("albedo_texture", &d.albedo_texture),
+        ("normal_map", &d.normal_map),
+    ]);
+    Ok(Material::Textured(Arc::new(
+        Textured::new(base, albedo, normal).named(names),
+    )))
 }
 
 /// The linear texture `t` names (at `key`), refused when declared sRGB:
@@ -225,10 +229,26 @@ pub(super) fn subsurface(
         }
         None => None,
     };
-    let mut t = Textured::new(base, albedo, None);
+    let names = uses(&[
+        ("albedo_texture", &d.albedo_texture),
+        ("dmfp_texture", &d.dmfp_texture),
+    ]);
+    let mut t = Textured::new(base, albedo, None).named(names);
     t.dmfp = dmfp;
     t.medium = Some(recipe);
     Ok(Material::Textured(Arc::new(t)))
+}
+
+/// The texture keys given, with the names they give.
+fn uses(keys: &[(&'static str, &Option<Spanned<String>>)]) -> Vec<TextureUse> {
+    keys.iter()
+        .filter_map(|(key, v)| {
+            v.as_ref().map(|v| TextureUse {
+                key,
+                texture: v.get_ref().clone(),
+            })
+        })
+        .collect()
 }
 
 /// The texture `t` names, or an error at `field` listing those defined.

@@ -60,6 +60,10 @@ pub fn render(p: &Explanation) -> String {
             format!("objects: {}", m.objects.join(", "))
         };
         r.push_str(&format!("material {} ({}; {users})\n", m.name, m.kind));
+        if !m.textures.is_empty() {
+            let why = "read at each hit (docs/scene-format.md, \"Textured parameters\")";
+            row(r, "textures", &m.textures.join(" "), why);
+        }
         for s in &m.subsurface {
             match s {
                 SubsurfaceMethod::Diffusion {
