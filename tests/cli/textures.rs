@@ -227,6 +227,28 @@ fn subsurface_textures_are_checked_and_explained() {
         );
         assert!(!written);
     }
+    // a length factor of 10⁹ takes Rmax past the supported range
+    let long = subsurface_scene("albedo = [0.5, 0.5, 0.5]\ndmfp = [1, 1, 1]\ndmfp_texture = \"k\"")
+        .replace(
+            "file = \"a.png\"\ncolor_space",
+            "file = \"long.exr\"\ncolor_space",
+        );
+    let (code, stderr, written) = render(&long, &[], |d| {
+        png(&d.join("a.png"), 2, 2);
+        exr::prelude::write_rgb_file(d.join("long.exr"), 2, 2, |x, _| {
+            let g = if x == 1 { 1e9 } else { 1.0 };
+            (1.0, g, 1.0)
+        })
+        .unwrap()
+    });
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("field `materials.m.dmfp_texture`")
+            && stderr.contains("largest texels")
+            && stderr.contains("beyond 1e7"),
+        "{stderr}"
+    );
+    assert!(!written);
     let s = subsurface_scene("dmfp = [1, 1, 1]\nalbedo_texture = \"a\"\ndmfp_texture = \"k\"");
     let dir = tempfile::tempdir().unwrap();
     png(&dir.path().join("a.png"), 2, 2);

@@ -12,6 +12,8 @@ use super::checked::{Cx, Res};
 use super::format::{MaterialDef, Spanned, TextureDef};
 use super::key_path::{key_segment, quoted};
 use super::regular_file::{open_regular, read_regular_bytes};
+#[cfg(feature = "subsurface")]
+use super::MAX_SUBSURFACE_RADIUS;
 use crate::geometry::Vec3;
 #[cfg(feature = "subsurface")]
 use crate::materials::textured_medium::MediumRecipe;
@@ -233,10 +235,43 @@ pub(super) fn subsurface(
         ("albedo_texture", &d.albedo_texture),
         ("dmfp_texture", &d.dmfp_texture),
     ]);
+    if let (Some(k), Some(v), Material::Subsurface(ss)) = (&dmfp, &d.dmfp_texture, &base) {
+        let key = format!("{field}.dmfp_texture");
+        check_longest(cx, &key, v, ss, &recipe, k.texture.max_texel())?;
+    }
     let mut t = Textured::new(base, albedo, None).named(names);
     t.dmfp = dmfp;
     t.medium = Some(recipe);
     Ok(Material::Textured(Arc::new(t)))
+}
+
+/// Refuses a length texture whose largest texels `max` would make the
+/// probe radius of `ss` exceed [`MAX_SUBSURFACE_RADIUS`] (at the
+/// material's own albedo).
+#[cfg(feature = "subsurface")]
+fn check_longest(
+    cx: &Cx,
+    key: &str,
+    v: &Spanned<String>,
+    ss: &crate::materials::Subsurface,
+    recipe: &MediumRecipe,
+    max: Vec3,
+) -> Res<()> {
+    let params = recipe.params_at(ss.params(), None, Some(max));
+    let rmax = ss.at_point(params).map_or(0.0, |p| p.probe().rmax());
+    if rmax <= MAX_SUBSURFACE_RADIUS {
+        return Ok(());
+    }
+    Err(cx.err(
+        v.span(),
+        key,
+        format!(
+            "texture {}'s largest texels {max} make the subsurface probe radius Rmax = \
+             {rmax:e} scene units, beyond {MAX_SUBSURFACE_RADIUS:e}, the supported range \
+             (see \"Supported ranges\" in docs/scene-format.md)",
+            quoted(v.get_ref())
+        ),
+    ))
 }
 
 /// The texture keys given, with the names they give.
