@@ -132,6 +132,27 @@ fn unusable_textures_exit_2_naming_file_line_field_and_reason() {
             "materials.m.normal_map",
             "a normal map is data: give it color_space = \"linear\"",
         ),
+        (
+            scene("file = \"a.png\"", "albedo = [1, 1, 1]\nbump = \"t\""),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "materials.m.bump",
+            "a height map is data: give it color_space = \"linear\"",
+        ),
+        (
+            scene(
+                "file = \"a.png\"\ncolor_space = \"linear\"",
+                "albedo = [1, 1, 1]\nnormal_map = \"t\"\nbump = \"t\"",
+            ),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "materials.m.bump",
+            "give either `normal_map` or `bump`",
+        ),
+        (
+            scene("file = \"a.png\"", "albedo = [1, 1, 1]\nbump_scale = 0.1"),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "materials.m.bump_scale",
+            "`bump_scale` without `bump`",
+        ),
     ];
     for (scene, setup, field, fragment) in rows {
         let (code, stderr, written) = render(&scene, &[], setup);

@@ -79,9 +79,10 @@ const DMFP: [f64; 3] = [0.3, 0.4, 0.25];
 /// radius of the untextured material, the sRGB curve skipped on the
 /// albedo or applied to the lengths). A uniform albedo texture of sRGB
 /// value 150 and a uniform length texture of linear value 200 render, bit
-/// for bit, as the constant material of A·t and dmfp·k: with the
-/// diffusion estimator, and with the random walk, whose medium (σs, σa
-/// from the albedo table's inversion) must follow the texels too.
+/// for bit, as the constant material of A·t and dmfp·k with the
+/// diffusion estimator; with the random walk, whose medium (σs, σa from
+/// the albedo table's inversion) must follow the texels too, within 10⁻⁴
+/// (the textured material inverts A by a table of the inversion).
 #[test]
 fn a_uniform_texture_renders_as_the_constant_medium() {
     let dir = tempfile::tempdir().unwrap();
@@ -119,7 +120,19 @@ fn a_uniform_texture_renders_as_the_constant_medium() {
         );
         let lit = con.pixels.iter().filter(|p| p.min_element() > 0.01).count();
         assert!(lit > 128, "{integrator:?}: {lit} lit pixels");
-        assert_eq!(tex.pixels, con.pixels, "{integrator:?}");
+        if integrator == IntegratorKind::Path {
+            assert!(tex.pixels == con.pixels, "{integrator:?}: pixels differ");
+            continue;
+        }
+        // the walk's medium: α' of a textured A from the material's table
+        // of the inversion (within 2·10⁻⁵), not the bisection itself
+        let worst = tex
+            .pixels
+            .iter()
+            .zip(&con.pixels)
+            .map(|(a, b)| (*a - *b).abs().max_element() / b.max_element().max(1e-3))
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-4, "{integrator:?}: relative difference {worst}");
     }
 }
 

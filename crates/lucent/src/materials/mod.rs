@@ -34,7 +34,7 @@ pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;
 #[cfg(feature = "subsurface")]
 pub use subsurface::Subsurface;
-pub use textured::{TextureUse, Textured};
+pub use textured::{Bump, TextureUse, Textured};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {

@@ -1,6 +1,6 @@
 //! A material whose parameters vary over the surface: a base material,
 //! with its diffuse albedo read from a texture and/or its shading normal
-//! perturbed by a tangent-space normal map, or a subsurface base whose
+//! perturbed by a tangent-space normal map or a height (bump) map, or a subsurface base whose
 //! albedo and lengths are read from textures at the exit point
 //! (`docs/scene-format.md`, "Textures"; `docs/bssrdf.md` §13). Resolved at
 //! each hit into the base material's scattering with the looked-up values
@@ -23,6 +23,9 @@ pub struct Textured {
     /// the shading normal, x along the tangent (increasing u), y along the
     /// bitangent (increasing v).
     pub normal: Option<Arc<Texture>>,
+    /// A height map (the mean of its channels, times `scale` scene units)
+    /// whose slopes tilt the shading normal; never with `normal`.
+    pub bump: Option<Bump>,
     /// A subsurface base's factor per channel on its lengths (`dmfp`).
     pub dmfp: Option<TextureRef>,
     /// How a subsurface base's parameters follow from `albedo` and `dmfp`
@@ -32,6 +35,13 @@ pub struct Textured {
     /// Which parameter reads which texture, as the scene names them (for
     /// the render plan).
     pub names: Vec<TextureUse>,
+}
+
+/// A bump map: a height texture and the height of a texel of value 1.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bump {
+    pub texture: Arc<Texture>,
+    pub scale: f32,
 }
 
 /// A parameter read from a texture: its key (`albedo_texture`,
@@ -49,6 +59,7 @@ impl Textured {
             base,
             albedo,
             normal,
+            bump: None,
             dmfp: None,
             #[cfg(feature = "subsurface")]
             medium: None,
@@ -68,6 +79,7 @@ impl Textured {
             .iter()
             .map(|a| &a.texture)
             .chain(self.normal.iter())
+            .chain(self.bump.iter().map(|b| &b.texture))
             .chain(self.dmfp.iter().map(|a| &a.texture))
     }
 }

@@ -26,7 +26,7 @@ use crate::error::{Constraint, InputError, Param, ParamError};
 #[cfg(feature = "subsurface")]
 use crate::materials::estimator_options::{EstimatorOptions, OptionError, OPTIONS};
 #[cfg(feature = "subsurface")]
-use crate::materials::textured_medium::MediumRecipe;
+use crate::materials::textured_medium::{MediumRecipe, Reduced};
 use crate::materials::Material;
 #[cfg(feature = "subsurface")]
 use crate::materials::Subsurface;
@@ -80,7 +80,13 @@ pub(super) fn material(
     };
     match kind {
         MaterialKind::Diffuse => {
-            let keys = ["albedo", "albedo_texture", "normal_map"];
+            let keys = [
+                "albedo",
+                "albedo_texture",
+                "normal_map",
+                "bump",
+                "bump_scale",
+            ];
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             // With a texture the albedo is a factor on it, 1 by default.
             let albedo = match (&d.albedo, &d.albedo_texture) {
@@ -97,12 +103,27 @@ pub(super) fn material(
             glossy_material::dielectric(cx, &field, d, eta)
         }
         MaterialKind::Conductor => {
-            let keys = ["metal", "n", "k", "roughness", "normal_map"];
+            let keys = [
+                "metal",
+                "n",
+                "k",
+                "roughness",
+                "normal_map",
+                "bump",
+                "bump_scale",
+            ];
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             glossy_material::conductor(cx, &field, m)
         }
         MaterialKind::Plastic => {
-            let keys = ["albedo", "eta", "roughness", "normal_map"];
+            let keys = [
+                "albedo",
+                "eta",
+                "roughness",
+                "normal_map",
+                "bump",
+                "bump_scale",
+            ];
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             glossy_material::plastic(cx, &field, m)
         }
@@ -362,12 +383,13 @@ fn parameters(
         (None, None, Some(mfp)) if d.g.is_none() => {
             let albedo = albedo.ok_or_else(|| missing_albedo("the artist form"))?;
             let (dmfp, eta) = (mfp.map(|x| x * units), eta.unwrap_or(1.3));
+            let reduced = Reduced::new(albedo, eta, source, d.albedo_texture.is_some());
             let recipe = MediumRecipe::Artist {
                 albedo,
                 dmfp,
                 eta,
                 fit,
-                source,
+                reduced,
             };
             SubsurfaceParams::from_artist_with(albedo, dmfp, eta, fit, source)
                 .map(|p| (p, recipe))

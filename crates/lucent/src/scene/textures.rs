@@ -17,7 +17,7 @@ use super::MAX_SUBSURFACE_RADIUS;
 use crate::geometry::Vec3;
 #[cfg(feature = "subsurface")]
 use crate::materials::textured_medium::MediumRecipe;
-use crate::materials::{Material, TextureUse, Textured};
+use crate::materials::{Bump, Material, TextureUse, Textured};
 use crate::texture::file::{self, Format, TextureError};
 use crate::texture::{ColorSpace, Texture, TextureRef, Wrap};
 
@@ -143,12 +143,14 @@ pub(super) fn textured(
 ) -> Res<Material> {
     let d = m.get_ref();
     // a subsurface material's textures are read with its parameters
-    if matches!(base, Material::Textured(_))
-        || (d.albedo_texture.is_none() && d.normal_map.is_none())
-    {
+    let field = format!("materials.{}", key_segment(name));
+    if matches!(base, Material::Textured(_)) {
         return Ok(base);
     }
-    let field = format!("materials.{}", key_segment(name));
+    let bump = bump(cx, &field, d, table)?;
+    if d.albedo_texture.is_none() && d.normal_map.is_none() && bump.is_none() {
+        return Ok(base);
+    }
     let albedo = match &d.albedo_texture {
         Some(t) => {
             let e = lookup(cx, &format!("{field}.albedo_texture"), t, table)?;
@@ -171,10 +173,40 @@ pub(super) fn textured(
     let names = uses(&[
         ("albedo_texture", &d.albedo_texture),
         ("normal_map", &d.normal_map),
+        ("bump", &d.bump),
     ]);
-    Ok(Material::Textured(Arc::new(
-        Textured::new(base, albedo, normal).named(names),
-    )))
+    let mut t = Textured::new(base, albedo, normal).named(names);
+    t.bump = bump;
+    Ok(Material::Textured(Arc::new(t)))
+}
+
+/// The bump map of material `field` (table `d`): its `bump` texture
+/// (data) and `bump_scale` (finite, default 1). Refused: `bump_scale`
+/// alone, `bump` with `normal_map`.
+fn bump(cx: &Cx, field: &str, d: &MaterialDef, table: &Table) -> Res<Option<Bump>> {
+    let scale = match &d.bump_scale {
+        Some(s) => {
+            let key = format!("{field}.bump_scale");
+            if d.bump.is_none() {
+                return Err(cx.err(s.span(), &key, "`bump_scale` without `bump`"));
+            }
+            cx.scalar(s, &key)?
+        }
+        None => 1.0,
+    };
+    let Some(t) = &d.bump else {
+        return Ok(None);
+    };
+    let key = format!("{field}.bump");
+    if d.normal_map.is_some() {
+        return Err(cx.err(
+            t.span(),
+            &key,
+            "give either `normal_map` or `bump`: both set the shading normal",
+        ));
+    }
+    let texture = data(cx, &key, t, table, "a height map")?;
+    Ok(Some(Bump { texture, scale }))
 }
 
 /// The linear texture `t` names (at `key`), refused when declared sRGB:

@@ -61,8 +61,11 @@ pub fn render(p: &Explanation) -> String {
         };
         r.push_str(&format!("material {} ({}; {users})\n", m.name, m.kind));
         if !m.textures.is_empty() {
-            let why = "read at each hit (docs/scene-format.md, \"Textured parameters\")";
-            row(r, "textures", &m.textures.join(" "), why);
+            let which = format!(
+                "{} (docs/scene-format.md, \"Textured parameters\")",
+                m.textures.join(" ")
+            );
+            row(r, "textures", "read per hit", &which);
         }
         for s in &m.subsurface {
             match s {
