@@ -280,17 +280,17 @@ impl Medium {
             sigma_a: [0.0; 3],
             g: 0.0,
         };
-        for c in 0..3 {
-            if mfp[c] <= 0.0 {
+        for (c, &l) in mfp.iter().enumerate() {
+            if l <= 0.0 {
                 m.sigma_a[c] = dense;
                 continue;
             }
             let a = alpha(c);
             let st = if volume_mfp {
-                1.0 / mfp[c]
+                1.0 / l
             } else {
                 // σtr = σt' √(3(1 − α')) = 1/ℓd
-                1.0 / (mfp[c] * (3.0 * (1.0 - a)).sqrt())
+                1.0 / (l * (3.0 * (1.0 - a)).sqrt())
             };
             m.sigma_s[c] = a * st;
             m.sigma_a[c] = (1.0 - a) * st;

@@ -25,6 +25,8 @@ const MIN_COS: f32 = 1e-3;
 pub(crate) struct Resolved {
     pub(crate) si: Interaction,
     pub(crate) albedo: Option<Vec3>,
+    /// Read by subsurface materials only.
+    #[cfg_attr(not(feature = "subsurface"), allow(dead_code))]
     pub(crate) dmfp: Option<Vec3>,
 }
 
