@@ -132,6 +132,27 @@ fn unusable_textures_exit_2_naming_file_line_field_and_reason() {
             "materials.m.normal_map",
             "a normal map is data: give it color_space = \"linear\"",
         ),
+        (
+            scene("file = \"a.png\"", "albedo = [1, 1, 1]\nbump = \"t\""),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "materials.m.bump",
+            "a height map is data: give it color_space = \"linear\"",
+        ),
+        (
+            scene(
+                "file = \"a.png\"\ncolor_space = \"linear\"",
+                "albedo = [1, 1, 1]\nnormal_map = \"t\"\nbump = \"t\"",
+            ),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "materials.m.bump",
+            "give either `normal_map` or `bump`",
+        ),
+        (
+            scene("file = \"a.png\"", "albedo = [1, 1, 1]\nbump_scale = 0.1"),
+            Box::new(|d| png(&d.join("a.png"), 2, 2)),
+            "materials.m.bump_scale",
+            "`bump_scale` without `bump`",
+        ),
     ];
     for (scene, setup, field, fragment) in rows {
         let (code, stderr, written) = render(&scene, &[], setup);
@@ -177,4 +198,91 @@ fn an_obj_without_texture_coordinates_under_a_texture_exits_2() {
         .unwrap();
     });
     assert_eq!(code, Some(0), "{stderr}");
+}
+
+/// A subsurface slab with `material_keys` under the textures `a` (sRGB)
+/// and `k` (linear).
+#[cfg(feature = "subsurface")]
+fn subsurface_scene(material_keys: &str) -> String {
+    format!(
+        "{CAM}[textures.a]\nfile = \"a.png\"\n\
+         [textures.k]\nfile = \"a.png\"\ncolor_space = \"linear\"\n\
+         [materials.m]\ntype = \"subsurface\"\n{material_keys}\n\
+         [[shapes]]\ntype = \"box\"\nmaterial = \"m\"\n"
+    )
+}
+
+/// The mistakes: a subsurface texture key accepted where the parameter
+/// cannot follow it (a preset's albedo), a length factor read through
+/// the sRGB curve, an unknown texture name; and `--explain` silent about
+/// what is textured. Each refusal exits 2 naming the line and the field.
+#[cfg(feature = "subsurface")]
+#[test]
+fn subsurface_textures_are_checked_and_explained() {
+    let rows = [
+        (
+            "preset = \"marble\"\nalbedo_texture = \"a\"",
+            "materials.m.albedo_texture",
+            "a textured albedo needs the artist form",
+        ),
+        (
+            "albedo = [0.5, 0.5, 0.5]\ndmfp = [1, 1, 1]\ndmfp_texture = \"a\"",
+            "materials.m.dmfp_texture",
+            "a length factor is data: give it color_space = \"linear\"",
+        ),
+        (
+            "dmfp = [1, 1, 1]\nalbedo_texture = \"skin\"",
+            "materials.m.albedo_texture",
+            "unknown texture \"skin\" (defined: a, k)",
+        ),
+    ];
+    for (keys, field, fragment) in rows {
+        let (code, stderr, written) = render(&subsurface_scene(keys), &[], |d| {
+            png(&d.join("a.png"), 2, 2)
+        });
+        assert_eq!(code, Some(2), "{fragment:?}: {stderr}");
+        assert!(stderr.contains(fragment), "lacks {fragment:?}: {stderr}");
+        assert!(
+            stderr.contains("scene.toml:") && stderr.contains(&format!("field `{field}`")),
+            "no line or field {field}: {stderr}"
+        );
+        assert!(!written);
+    }
+    // a length factor of 10⁹ takes Rmax past the supported range
+    let long = subsurface_scene("albedo = [0.5, 0.5, 0.5]\ndmfp = [1, 1, 1]\ndmfp_texture = \"k\"")
+        .replace(
+            "file = \"a.png\"\ncolor_space",
+            "file = \"long.exr\"\ncolor_space",
+        );
+    let (code, stderr, written) = render(&long, &[], |d| {
+        png(&d.join("a.png"), 2, 2);
+        exr::prelude::write_rgb_file(d.join("long.exr"), 2, 2, |x, _| {
+            let g = if x == 1 { 1e9 } else { 1.0 };
+            (1.0, g, 1.0)
+        })
+        .unwrap()
+    });
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("field `materials.m.dmfp_texture`")
+            && stderr.contains("largest texels")
+            && stderr.contains("beyond 1e7"),
+        "{stderr}"
+    );
+    assert!(!written);
+    let s = subsurface_scene("dmfp = [1, 1, 1]\nalbedo_texture = \"a\"\ndmfp_texture = \"k\"");
+    let dir = tempfile::tempdir().unwrap();
+    png(&dir.path().join("a.png"), 2, 2);
+    std::fs::write(dir.path().join("scene.toml"), s).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["render", "--explain"])
+        .arg(dir.path().join("scene.toml"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.contains("textures") && text.contains("albedo_texture=a dmfp_texture=k"),
+        "{text}"
+    );
 }

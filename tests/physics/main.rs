@@ -41,4 +41,6 @@ mod sampler;
 mod slab;
 #[cfg(feature = "subsurface")]
 mod specular_coat;
+#[cfg(feature = "subsurface")]
+mod subsurface_textures;
 mod textures;

@@ -57,6 +57,9 @@ pub struct CurvatureCorrection {
     /// f per channel at κ·ℓd = 2^(LOG2_FIRST + j/STEPS_PER_OCTAVE),
     /// j = 0 … LUT_LEN − 1 ([`Self::exact_factor`] at the nodes).
     lut: Vec<[f32; 3]>,
+    /// Whether [`Self::factor`] is [`Self::exact_factor`] (no table: a
+    /// correction built per hit for textured parameters).
+    exact: bool,
 }
 
 /// The lookup table's first node, κ·ℓd = 2^LOG2_FIRST (a sphere of 1024
@@ -74,6 +77,29 @@ impl CurvatureCorrection {
     /// when the parameters record no medium. Err only if the embedded
     /// table does not load (a build defect; the message names the line).
     pub fn new(
+        params: &SubsurfaceParams,
+        sampler: &ProbeSampler,
+    ) -> Result<Option<Self>, &'static TableError> {
+        let Some(mut cc) = Self::new_exact(params, sampler)? else {
+            return Ok(None);
+        };
+        cc.exact = false;
+        let ld_max = cc.ld_max;
+        if ld_max > 0.0 && ld_max.is_finite() {
+            cc.lut = (0..LUT_LEN)
+                .map(|j| {
+                    let kl = (LOG2_FIRST + j as f32 / STEPS_PER_OCTAVE).exp2() as f64;
+                    cc.exact_factor(kl / ld_max).map(|f| f as f32)
+                })
+                .collect();
+        }
+        Ok(Some(cc))
+    }
+
+    /// [`Self::new`] without the lookup table, cheap to build: its
+    /// [`factor`](Self::factor) is [`exact_factor`](Self::exact_factor)
+    /// (for parameters that change from hit to hit, `docs/bssrdf.md` §13).
+    pub fn new_exact(
         params: &SubsurfaceParams,
         sampler: &ProbeSampler,
     ) -> Result<Option<Self>, &'static TableError> {
@@ -102,30 +128,26 @@ impl CurvatureCorrection {
             .flatten()
             .map(|c: &Channel| c.ld)
             .fold(0.0, f64::max);
-        let mut cc = CurvatureCorrection {
+        Ok(Some(CurvatureCorrection {
             table,
             channels,
             rmax: sampler.rmax(),
             ld_max,
             lut: Vec::new(),
-        };
-        if ld_max > 0.0 && ld_max.is_finite() {
-            cc.lut = (0..LUT_LEN)
-                .map(|j| {
-                    let kl = (LOG2_FIRST + j as f32 / STEPS_PER_OCTAVE).exp2() as f64;
-                    cc.exact_factor(kl / ld_max).map(|f| f as f32)
-                })
-                .collect();
-        }
-        Ok(Some(cc))
+            exact: true,
+        }))
     }
 
     /// f(κ) per channel from the lookup table: linear in log2 κ between
     /// nodes (relative error against [`Self::exact_factor`] below 2e-3,
     /// 1e-2 next to the clamp at [`MAX_FACTOR`]; tested), linear in κ from 1 at κ = 0 to the first node (the
     /// table's first-order tail), the last node beyond the last. Exactly
-    /// 1 for κ ≤ 0 (and NaN).
+    /// 1 for κ ≤ 0 (and NaN). [`Self::exact_factor`] in f32 for a
+    /// correction built by [`Self::new_exact`].
     pub fn factor(&self, kappa: f32) -> [f32; 3] {
+        if self.exact {
+            return self.exact_factor(kappa as f64).map(|f| f as f32);
+        }
         let kl = kappa * self.ld_max as f32;
         if kl.is_nan() || kl <= 0.0 || self.lut.is_empty() {
             return [1.0; 3];

@@ -244,13 +244,26 @@ impl Medium {
     /// The medium whose total diffuse reflectance (under `source`: the
     /// albedo table or the dipole) is `albedo` and whose diffuse mean free
     /// path (or, with `volume_mfp`, volume mean free path 1/σt') is `mfp`
-    /// (scene units), g = 0. See the module docs.
+    /// (scene units), g = 0. See the module docs. (The loader goes through
+    /// [`SubsurfaceParams::from_artist_with`], which inverts the same way.)
+    #[cfg(test)]
     pub(crate) fn from_reflectance(
         albedo: [f64; 3],
         mfp: [f64; 3],
         eta: f32,
         volume_mfp: bool,
         source: AlbedoSource,
+    ) -> Medium {
+        let alpha = |c: usize| invert_reflectance(albedo[c], eta as f64, source);
+        Self::from_reduced_albedo(alpha, mfp, volume_mfp)
+    }
+
+    /// [`Self::from_reflectance`] with the reduced albedo α' of each
+    /// channel given by `alpha` (read only for channels with ℓ > 0).
+    pub(crate) fn from_reduced_albedo(
+        alpha: impl Fn(usize) -> f64,
+        mfp: [f64; 3],
+        volume_mfp: bool,
     ) -> Medium {
         let shortest = mfp
             .iter()
@@ -267,17 +280,17 @@ impl Medium {
             sigma_a: [0.0; 3],
             g: 0.0,
         };
-        for c in 0..3 {
-            if mfp[c] <= 0.0 {
+        for (c, &l) in mfp.iter().enumerate() {
+            if l <= 0.0 {
                 m.sigma_a[c] = dense;
                 continue;
             }
-            let a = invert_reflectance(albedo[c], eta as f64, source);
+            let a = alpha(c);
             let st = if volume_mfp {
-                1.0 / mfp[c]
+                1.0 / l
             } else {
                 // σtr = σt' √(3(1 − α')) = 1/ℓd
-                1.0 / (mfp[c] * (3.0 * (1.0 - a)).sqrt())
+                1.0 / (l * (3.0 * (1.0 - a)).sqrt())
             };
             m.sigma_s[c] = a * st;
             m.sigma_a[c] = (1.0 - a) * st;
@@ -457,11 +470,25 @@ impl SubsurfaceParams {
         fit: Fit,
         source: AlbedoSource,
     ) -> Result<Self, ParamError> {
+        let alpha = |c: usize| invert_reflectance(albedo[c], eta as f64, source);
+        Self::from_artist_reduced(albedo, mfp, eta, fit, alpha)
+    }
+
+    /// [`Self::from_artist_with`] with the random-walk medium's reduced
+    /// albedo per channel given by `alpha` (the inversion of A, done by
+    /// the caller: a textured material tabulates it, `docs/bssrdf.md` §13).
+    pub(crate) fn from_artist_reduced(
+        albedo: [f64; 3],
+        mfp: [f64; 3],
+        eta: f32,
+        fit: Fit,
+        alpha: impl Fn(usize) -> f64,
+    ) -> Result<Self, ParamError> {
         check_albedo(albedo)?;
         check_finite_nonneg(Param::Mfp, mfp)?;
         check_eta(eta)?;
         let d = std::array::from_fn(|c| mfp[c] / fit.s(albedo[c]));
-        let medium = Medium::from_reflectance(albedo, mfp, eta, fit.uses_volume_mfp(), source);
+        let medium = Medium::from_reduced_albedo(alpha, mfp, fit.uses_volume_mfp());
         Self::checked(albedo, d, eta, medium)
     }
 
@@ -501,6 +528,20 @@ impl SubsurfaceParams {
             .filter(|&c| self.active(c))
             .map(|c| self.d[c])
             .fold(0.0, f64::max)
+    }
+
+    /// Scales channel c's lengths by `k[c]` (finite, > 0): d, and the
+    /// medium's mean free paths (a textured length, `docs/bssrdf.md` §13).
+    pub fn scaled_channels(&self, k: [f64; 3]) -> Self {
+        SubsurfaceParams {
+            d: std::array::from_fn(|c| self.d[c] * k[c]),
+            medium: self.medium.map(|m| Medium {
+                sigma_s: std::array::from_fn(|c| m.sigma_s[c] / k[c]),
+                sigma_a: std::array::from_fn(|c| m.sigma_a[c] / k[c]),
+                g: m.g,
+            }),
+            ..*self
+        }
     }
 
     /// Scales all lengths (e.g. an object instanced at a different scale).

@@ -216,15 +216,15 @@ impl<'a> Context<'a> {
     }
 }
 
-/// Per mesh with a subsurface material, its [`SubsurfaceCurvature`];
-/// None for the others.
+/// Per mesh with a subsurface material, its [`SubsurfaceCurvature`]
+/// (without the factors for a textured one); None for the others.
 #[cfg(feature = "subsurface")]
 fn subsurface_curvatures(scene: &Scene) -> Vec<Option<SubsurfaceCurvature>> {
     scene
         .meshes
         .iter()
         .zip(&scene.objects)
-        .map(|(m, o)| match &scene.materials[o.material] {
+        .map(|(m, o)| match scene.materials[o.material].base() {
             crate::materials::Material::Subsurface(ss) => {
                 // only the `curvature` axis rule reads sharp edges
                 let reads_edges = ss.probe().options().axes == crate::bssrdf::ProbeAxes::Curvature;
@@ -234,7 +234,12 @@ fn subsurface_curvatures(scene: &Scene) -> Vec<Option<SubsurfaceCurvature>> {
                     0.0
                 };
                 let c = MeshCurvature::new(m, reach);
-                Some(SubsurfaceCurvature::new(c, ss.curvature_correction()))
+                // a textured material's correction changes from hit to hit
+                let cc = match &scene.materials[o.material] {
+                    crate::materials::Material::Textured(_) => None,
+                    _ => ss.curvature_correction(),
+                };
+                Some(SubsurfaceCurvature::new(c, cc))
             }
             _ => None,
         })

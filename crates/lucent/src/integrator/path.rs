@@ -17,7 +17,7 @@ use super::env_nee::{escaped, record_environment};
 use super::footprint::Cone;
 use super::lobe::{Bounce, Vertex};
 use super::nee::{emission_weight, record_direct, NeeAt};
-use super::scatter::{Scatter, SubsurfaceScatter};
+use super::scatter::{PointMaterial, Scatter, SubsurfaceScatter};
 use super::state::PathState;
 use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
@@ -107,6 +107,7 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
 ) -> Vec3 {
     let mut l = Vec3::ZERO;
     let mut path = start;
+    let mut point = PointMaterial::None;
     let max_depth = ctx.scene.settings.max_depth;
     for depth in start.depth..=max_depth {
         st.rng.start_bounce(depth);
@@ -135,7 +136,8 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
             break;
         }
         let material = &ctx.scene.materials[object.material];
-        let scatter = scatter_at::<R, T, S>(ctx, material, &at, &mut path, st, subsurface);
+        let scatter =
+            scatter_at::<R, T, S>(ctx, material, &at, &mut path, st, subsurface, &mut point);
         // Borrowed, not moved out: the vertex stays where it was built.
         let (vertex, nee) = match next::<R, T>(ctx, &scatter, &at, &mut path, &mut l, st, stack) {
             Next::Vertex(v, nee) => (v, nee),
@@ -249,7 +251,8 @@ fn emitted<R: Recorder>(
 
 /// What the material at `at` scatters into (`path.beta` scaled by it);
 /// `path.from` becomes the object a continuation leaves, where known
-/// (through a dielectric; a medium's exit is not culled from).
+/// (through a dielectric; a medium's exit is not culled from). A textured
+/// subsurface material's values at the hit are kept in `point`.
 #[inline(always)]
 #[cfg_attr(
     not(feature = "subsurface"),
@@ -262,6 +265,7 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
     path: &mut Branch,
     st: &mut PathState<R>,
     subsurface: &mut S,
+    point: &'s mut PointMaterial,
 ) -> Scatter<'s> {
     match material {
         Material::Diffuse { albedo } => {
@@ -278,9 +282,15 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
                     a.unwrap_or(*albedo),
                     st.rec,
                 )),
+                #[cfg(feature = "subsurface")]
+                (Material::Subsurface(ss), _) => {
+                    let at = At { si: &r.si, ..*at };
+                    let ss = at_point(t, ss, &r, point);
+                    subsurface_at::<R, T, S>(ctx, ss, &at, path, st, subsurface)
+                }
                 (base, _) => {
                     let at = At { si: &r.si, ..*at };
-                    textured_base::<R, T, S>(ctx, base, &at, path, st, subsurface)
+                    textured_base::<R, T, S>(ctx, base, &at, path, st, subsurface, point)
                 }
             }
         }
@@ -293,20 +303,53 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
         Material::Conductor(c) => super::glossy::conductor(ctx, c, at, path, st.rec),
         Material::Plastic(p) => super::glossy::plastic(ctx, p, at, path, st.rng, st.rec),
         #[cfg(feature = "subsurface")]
-        Material::Subsurface(ss) => {
-            path.from = None;
-            let width = path.cone.width_at(at.t);
-            let (si, wo, depth) = (at.si, at.wo, at.depth);
-            let h = SubsurfaceHit {
-                ss,
-                si,
-                wo,
-                depth,
-                width,
-                scattered: path.scattered,
-            };
-            subsurface_hit::<R, T, S>(ctx, &h, &mut path.beta, st, subsurface)
-        }
+        Material::Subsurface(ss) => subsurface_at::<R, T, S>(ctx, ss, at, path, st, subsurface),
+    }
+}
+
+/// The subsurface material `ss` hit at `at`.
+#[cfg(feature = "subsurface")]
+#[inline(always)]
+fn subsurface_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
+    ctx: &'s Context,
+    ss: &'s crate::materials::Subsurface,
+    at: &At,
+    path: &mut Branch,
+    st: &mut PathState<R>,
+    subsurface: &mut S,
+) -> Scatter<'s> {
+    path.from = None;
+    let width = path.cone.width_at(at.t);
+    let (si, wo, depth) = (at.si, at.wo, at.depth);
+    let h = SubsurfaceHit {
+        ss,
+        si,
+        wo,
+        depth,
+        width,
+        scattered: path.scattered,
+    };
+    subsurface_hit::<R, T, S>(ctx, &h, &mut path.beta, st, subsurface)
+}
+
+/// The textured subsurface material `t` (base `ss`) with the parameters
+/// its textures give at the hit (`r`), kept in `point`; `ss` itself
+/// where they give no medium (`docs/bssrdf.md` §13).
+#[cfg(feature = "subsurface")]
+#[inline(never)]
+fn at_point<'s>(
+    t: &crate::materials::Textured,
+    ss: &'s crate::materials::Subsurface,
+    r: &super::texturing::Resolved,
+    point: &'s mut PointMaterial,
+) -> &'s crate::materials::Subsurface {
+    let params = match &t.medium {
+        Some(m) => m.params_at(ss.params(), r.albedo, r.dmfp),
+        None => *ss.params(),
+    };
+    match ss.at_point(params) {
+        Some(p) => point.insert(p),
+        None => ss,
     }
 }
 
@@ -320,8 +363,9 @@ fn textured_base<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
     path: &mut Branch,
     st: &mut PathState<R>,
     subsurface: &mut S,
+    point: &'s mut PointMaterial,
 ) -> Scatter<'s> {
-    scatter_at::<R, T, S>(ctx, base, at, path, st, subsurface)
+    scatter_at::<R, T, S>(ctx, base, at, path, st, subsurface, point)
 }
 
 /// The nearest hit along the path's ray, timed as the camera's (depth 0)

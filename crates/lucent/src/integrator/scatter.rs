@@ -29,6 +29,11 @@ pub(crate) struct SubsurfaceHit<'h, 's> {
     pub(crate) scattered: bool,
 }
 
+/// Where the bounce loop keeps, while a hit's scattering is in use, the
+/// subsurface material with the parameters a textured one has at that hit
+/// (`docs/bssrdf.md` §13): one per path, replaced at each such hit.
+pub(crate) type PointMaterial = Option<Subsurface>;
+
 /// An estimator of light transport through subsurface objects. The bounce
 /// loop is generic over it, so each implementation gets its own
 /// monomorphised loop.

@@ -531,11 +531,21 @@ impl Assignments {
     }
 
     /// Applies the assignments to every subsurface material of
-    /// `materials` (each over its own options).
+    /// `materials`, textured or not (each over its own options).
     pub fn apply_all(&self, materials: &mut [super::Material]) -> Result<(), ParamError> {
         for m in materials.iter_mut() {
-            if let super::Material::Subsurface(ss) = m {
-                *ss = std::sync::Arc::new(ss.with_options(&self.over(*ss.options()))?);
+            match m {
+                super::Material::Subsurface(ss) => {
+                    *ss = std::sync::Arc::new(ss.with_options(&self.over(*ss.options()))?);
+                }
+                super::Material::Textured(t) => {
+                    if let super::Material::Subsurface(ss) = &t.base {
+                        let ss = ss.with_options(&self.over(*ss.options()))?;
+                        std::sync::Arc::make_mut(t).base =
+                            super::Material::Subsurface(std::sync::Arc::new(ss));
+                    }
+                }
+                _ => {}
             }
         }
         Ok(())

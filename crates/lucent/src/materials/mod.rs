@@ -20,6 +20,8 @@ pub mod rough_dielectric;
 #[cfg(feature = "subsurface")]
 pub mod subsurface;
 pub mod textured;
+#[cfg(feature = "subsurface")]
+pub mod textured_medium;
 
 use std::sync::Arc;
 
@@ -32,7 +34,7 @@ pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;
 #[cfg(feature = "subsurface")]
 pub use subsurface::Subsurface;
-pub use textured::Textured;
+pub use textured::{Bump, TextureUse, Textured};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {
@@ -70,10 +72,10 @@ impl Material {
         }
     }
 
-    /// Whether this is a subsurface material.
+    /// Whether this is a subsurface material (textured or not).
     #[cfg(feature = "subsurface")]
     pub(crate) fn is_subsurface(&self) -> bool {
-        matches!(self, Material::Subsurface(_))
+        matches!(self.base(), Material::Subsurface(_))
     }
 
     /// Whether this is a subsurface material: never, in a build without

@@ -24,6 +24,8 @@
 //! weighted by the transmitted fraction (1 − Fr or 1 − E) and the reflected
 //! light is lost, for either roughness.
 
+use std::sync::Arc;
+
 use super::estimator_options::{CurvatureMode, EstimatorOptions, WalkBoundary, OPTIONS};
 use super::lod::{LodMode, LodRule};
 use super::microfacet::{alpha_from_roughness, RoughCoat, SMOOTH_ALPHA};
@@ -41,10 +43,11 @@ pub struct Subsurface {
     options: EstimatorOptions,
     probe: ProbeSampler,
     /// The rough coat, when α ≥ [`SMOOTH_ALPHA`]; None: the smooth one.
-    coat: Option<RoughCoat>,
+    /// Shared with the material's values at textured points ([`Self::at_point`]).
+    coat: Option<Arc<RoughCoat>>,
     /// The coat after a non-specular vertex, where `regularize` asks for
     /// one rougher than `coat` (`docs/bssrdf.md` §6, "Regularized coat").
-    regularized: Option<RoughCoat>,
+    regularized: Option<Arc<RoughCoat>>,
     /// c = 1 − 2 FM1(1/η), Sw's normalization (for a rough coat, 1 − Ē).
     sw_c: f32,
     /// The correction, when the mode is on and the parameters record a
@@ -92,10 +95,10 @@ impl Subsurface {
             probe.planar_reflectance(),
         );
         let alpha = alpha_from_roughness(roughness);
-        let coat = (alpha >= SMOOTH_ALPHA).then(|| RoughCoat::new(alpha, params.eta));
+        let coat = (alpha >= SMOOTH_ALPHA).then(|| Arc::new(RoughCoat::new(alpha, params.eta)));
         let alpha_min = alpha_from_roughness(regularize);
         let regularized = (alpha_min >= SMOOTH_ALPHA && alpha_min > alpha)
-            .then(|| RoughCoat::new(alpha_min, params.eta));
+            .then(|| Arc::new(RoughCoat::new(alpha_min, params.eta)));
         let sw_c = match &coat {
             Some(c) => 1.0 - c.mean_albedo(),
             None => sw_normalization(params.eta),
@@ -132,6 +135,37 @@ impl Subsurface {
     /// The same medium sampled with `options`.
     pub fn with_options(&self, options: &EstimatorOptions) -> Result<Self, ParamError> {
         Self::from_options(self.params, options)
+    }
+
+    /// The material with the medium `params` at one point of a textured
+    /// surface (`docs/bssrdf.md` §13): the probe sampler, its Rmax, the
+    /// level-of-detail rule and the curvature correction rebuilt from
+    /// `params`; the coat, its entry lobe and every option kept. The
+    /// correction is the exact one, without the lookup table a constant
+    /// material builds once. None if `params` cannot be sampled.
+    pub(crate) fn at_point(&self, params: SubsurfaceParams) -> Option<Self> {
+        let probe = ProbeSampler::new(&params, &self.options.probe).ok()?;
+        let curvature = match self.options.curvature {
+            CurvatureMode::Off => None,
+            CurvatureMode::Auto => CurvatureCorrection::new_exact(&params, &probe)
+                .unwrap_or_else(|e| panic!("embedded curvature table: {e}")),
+        };
+        let lod = LodRule::new(
+            self.options.lod,
+            self.options.lod_threshold,
+            probe.rmax(),
+            probe.planar_reflectance(),
+        );
+        Some(Subsurface {
+            params,
+            options: self.options,
+            probe,
+            coat: self.coat.clone(),
+            regularized: self.regularized.clone(),
+            sw_c: self.sw_c,
+            curvature,
+            lod,
+        })
     }
 
     /// The material with level-of-detail `mode` and footprint-to-Rmax
@@ -239,19 +273,19 @@ impl Subsurface {
 
     /// The rough coat, or None for a smooth one.
     pub fn rough_coat(&self) -> Option<&RoughCoat> {
-        self.coat.as_ref()
+        self.coat.as_deref()
     }
 
     /// The coat a path meets after a non-specular vertex: the regularized
     /// one where `regularize` asks for a rougher coat, else
     /// [`rough_coat`](Self::rough_coat).
     pub fn coat_after_diffuse(&self) -> Option<&RoughCoat> {
-        self.regularized.as_ref().or(self.coat.as_ref())
+        self.regularized.as_deref().or(self.coat.as_deref())
     }
 
     /// The regularized coat, where `regularize` makes one.
     pub fn regularized_coat(&self) -> Option<&RoughCoat> {
-        self.regularized.as_ref()
+        self.regularized.as_deref()
     }
 
     pub fn eta(&self) -> f32 {

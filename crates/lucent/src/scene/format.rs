@@ -275,6 +275,10 @@ pub struct MaterialDef {
     pub albedo_texture: Option<Spanned<String>>,
     /// A texture's name: a tangent-space normal map.
     pub normal_map: Option<Spanned<String>>,
+    /// A texture's name: a height map whose slopes tilt the shading normal.
+    pub bump: Option<Spanned<String>>,
+    /// The height, in scene units, of a bump texel of value 1.
+    pub bump_scale: Option<Spanned<f64>>,
     pub eta: Option<Spanned<f64>>,
     // subsurface: parameters (one of three forms)
     pub preset: Option<Spanned<String>>,
@@ -282,6 +286,9 @@ pub struct MaterialDef {
     pub sigma_a: Option<Spanned<Triple3>>,
     pub g: Option<Spanned<f64>>,
     pub dmfp: Option<Spanned<Triple3>>,
+    /// A texture's name: a factor per channel on a subsurface medium's
+    /// lengths (`dmfp`, or a preset's or measured medium's).
+    pub dmfp_texture: Option<Spanned<String>>,
     pub fit: Option<Spanned<String>>,
     pub albedo_source: Option<Spanned<String>>,
     // subsurface: sampling options
@@ -327,6 +334,9 @@ impl MaterialDef {
             self.albedo_texture.as_ref().map(|x| x.span()),
         );
         add("normal_map", self.normal_map.as_ref().map(|x| x.span()));
+        add("bump", self.bump.as_ref().map(|x| x.span()));
+        add("bump_scale", self.bump_scale.as_ref().map(|x| x.span()));
+        add("dmfp_texture", self.dmfp_texture.as_ref().map(|x| x.span()));
         add("metal", self.metal.as_ref().map(|x| x.span()));
         add("n", self.n.as_ref().map(|x| x.span()));
         add("k", self.k.as_ref().map(|x| x.span()));

@@ -110,7 +110,8 @@ fn build(cx: &Cx, def: SceneFile) -> Res<Scene> {
     let mut material_index = HashMap::new();
     for (name, m) in &def.materials {
         material_index.insert(name.as_str(), materials.len());
-        let base = material(cx, name, m, units_per_mm, def.units_per_mm.as_ref())?;
+        let units_def = def.units_per_mm.as_ref();
+        let base = material(cx, name, m, units_per_mm, units_def, &texture_table)?;
         materials.push(textures::textured(cx, name, m, base, &texture_table)?);
     }
     let reads_textures: Vec<bool> = materials.iter().map(Material::reads_textures).collect();

@@ -25,6 +25,8 @@ use crate::bssrdf::{AlbedoSource, Fit, Measured, SubsurfaceParams};
 use crate::error::{Constraint, InputError, Param, ParamError};
 #[cfg(feature = "subsurface")]
 use crate::materials::estimator_options::{EstimatorOptions, OptionError, OPTIONS};
+#[cfg(feature = "subsurface")]
+use crate::materials::textured_medium::{MediumRecipe, Reduced};
 use crate::materials::Material;
 #[cfg(feature = "subsurface")]
 use crate::materials::Subsurface;
@@ -42,6 +44,8 @@ const PARAMETER_KEYS: &[&str] = &[
     "eta",
     "fit",
     "albedo_source",
+    "albedo_texture",
+    "dmfp_texture",
 ];
 
 /// The parameter forms, for messages.
@@ -58,6 +62,7 @@ pub(super) fn material(
     m: &Spanned<MaterialDef>,
     units_per_mm: f32,
     units_def: Option<&Spanned<f64>>,
+    textures: &super::textures::Table,
 ) -> Res<Material> {
     let field = format!("materials.{}", key_segment(name));
     let d = m.get_ref();
@@ -75,7 +80,13 @@ pub(super) fn material(
     };
     match kind {
         MaterialKind::Diffuse => {
-            let keys = ["albedo", "albedo_texture", "normal_map"];
+            let keys = [
+                "albedo",
+                "albedo_texture",
+                "normal_map",
+                "bump",
+                "bump_scale",
+            ];
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             // With a texture the albedo is a factor on it, 1 by default.
             let albedo = match (&d.albedo, &d.albedo_texture) {
@@ -92,12 +103,27 @@ pub(super) fn material(
             glossy_material::dielectric(cx, &field, d, eta)
         }
         MaterialKind::Conductor => {
-            let keys = ["metal", "n", "k", "roughness", "normal_map"];
+            let keys = [
+                "metal",
+                "n",
+                "k",
+                "roughness",
+                "normal_map",
+                "bump",
+                "bump_scale",
+            ];
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             glossy_material::conductor(cx, &field, m)
         }
         MaterialKind::Plastic => {
-            let keys = ["albedo", "eta", "roughness", "normal_map"];
+            let keys = [
+                "albedo",
+                "eta",
+                "roughness",
+                "normal_map",
+                "bump",
+                "bump_scale",
+            ];
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             glossy_material::plastic(cx, &field, m)
         }
@@ -117,12 +143,13 @@ pub(super) fn material(
                 .chain(OPTIONS.iter().map(|o| o.name))
                 .collect();
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
-            let params = parameters(cx, &field, m, units_per_mm as f64)?;
+            let (params, recipe) = parameters(cx, &field, m, units_per_mm as f64)?;
             let options = estimator_options(cx, &field, m)?;
             let ss = Subsurface::from_options(params, &options)
                 .map_err(|e| locate_param(cx, &field, m, &e))?;
             check_rmax(cx, &field, m, &ss, units_per_mm, units_def)?;
-            Ok(Material::Subsurface(Arc::new(ss)))
+            let base = Material::Subsurface(Arc::new(ss));
+            super::textures::subsurface(cx, &field, m, base, recipe, textures)
         }
     }
 }
@@ -277,9 +304,14 @@ fn triple(cx: &Cx, field: &str, v: &Option<Spanned<Triple3>>, k: &str) -> Res<Op
 }
 
 /// The medium parameters of a subsurface material, from whichever of the
-/// three forms its table uses.
+/// three forms its table uses, and how they follow from textures.
 #[cfg(feature = "subsurface")]
-fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res<SubsurfaceParams> {
+fn parameters(
+    cx: &Cx,
+    field: &str,
+    m: &Spanned<MaterialDef>,
+    units: f64,
+) -> Res<(SubsurfaceParams, MediumRecipe)> {
     let d = m.get_ref();
     let f = |k: &str| format!("{field}.{k}");
     let located = |e: ParamError| locate_param(cx, field, m, &e);
@@ -296,13 +328,25 @@ fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res
         .as_ref()
         .map(|e| cx.positive(e, &f("eta")))
         .transpose()?;
-    let albedo = triple(cx, field, &d.albedo, "albedo")?;
+    let mut albedo = triple(cx, field, &d.albedo, "albedo")?;
     let (sigma_s, sigma_a, dmfp) = (
         triple(cx, field, &d.sigma_s_prime, "sigma_s_prime")?,
         triple(cx, field, &d.sigma_a, "sigma_a")?,
         triple(cx, field, &d.dmfp, "dmfp")?,
     );
     one_form(cx, field, m)?;
+    if let Some(t) = &d.albedo_texture {
+        if dmfp.is_none() {
+            return Err(cx.err(
+                t.span(),
+                &f("albedo_texture"),
+                "a textured albedo needs the artist form (`albedo_texture` with `dmfp`): a \
+                 preset's or measured medium's A follows from its coefficients",
+            ));
+        }
+        // With a texture the albedo is a factor on it, 1 by default.
+        albedo = albedo.or(Some([1.0; 3]));
+    }
     let missing_albedo = |form: &str| {
         cx.err(
             m.span(),
@@ -312,7 +356,9 @@ fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res
     };
     match (text(&d.preset), sigma_s.or(sigma_a), dmfp) {
         (Some((name, _)), None, None) if albedo.is_none() && d.g.is_none() => {
-            SubsurfaceParams::from_preset_with(name, units, fit, source, eta).map_err(located)
+            SubsurfaceParams::from_preset_with(name, units, fit, source, eta)
+                .map(|p| (p, MediumRecipe::Lengths))
+                .map_err(located)
         }
         (None, Some(_), None) => {
             let (Some(ss), Some(sa)) = (sigma_s, sigma_a) else {
@@ -331,18 +377,23 @@ fn parameters(cx: &Cx, field: &str, m: &Spanned<MaterialDef>, units: f64) -> Res
             let measured = measured(ss, sa, d.g.as_ref().map(|g| *g.get_ref()), albedo, eta);
             measured
                 .and_then(|ms| SubsurfaceParams::from_measured_with(&ms, units, fit, source))
+                .map(|p| (p, MediumRecipe::Lengths))
                 .map_err(located)
         }
         (None, None, Some(mfp)) if d.g.is_none() => {
             let albedo = albedo.ok_or_else(|| missing_albedo("the artist form"))?;
-            SubsurfaceParams::from_artist_with(
+            let (dmfp, eta) = (mfp.map(|x| x * units), eta.unwrap_or(1.3));
+            let reduced = Reduced::new(albedo, eta, source, d.albedo_texture.is_some());
+            let recipe = MediumRecipe::Artist {
                 albedo,
-                mfp.map(|x| x * units),
-                eta.unwrap_or(1.3),
+                dmfp,
+                eta,
                 fit,
-                source,
-            )
-            .map_err(located)
+                reduced,
+            };
+            SubsurfaceParams::from_artist_with(albedo, dmfp, eta, fit, source)
+                .map(|p| (p, recipe))
+                .map_err(located)
         }
         _ => Err(cx.err(m.span(), field, format!("subsurface parameters: {FORMS}"))),
     }

@@ -21,7 +21,7 @@ use super::regular_file::read_regular_file;
 use super::{textures, Object};
 use crate::error::InputError;
 use crate::geometry::{Mesh, Vec3};
-use crate::materials::{Material, Plastic, Textured};
+use crate::materials::{Material, Plastic, TextureUse, Textured};
 use crate::texture::{ColorSpace, Texture, TextureRef, Wrap};
 
 /// The albedo of an MTL material without `Kd` or `map_Kd`.
@@ -326,12 +326,20 @@ fn material(
     if albedo.is_none() && normal.is_none() {
         return Ok(base);
     }
-    Ok(Material::Textured(Arc::new(Textured {
-        base,
-        albedo: albedo.map(|texture| TextureRef {
-            texture,
-            scale: Vec3::ONE,
-        }),
-        normal,
-    })))
+    let albedo = albedo.map(|texture| TextureRef {
+        texture,
+        scale: Vec3::ONE,
+    });
+    let names = [("map_Kd", &m.map_kd), ("map_Bump", &m.normal)]
+        .into_iter()
+        .filter_map(|(key, f)| {
+            f.as_ref().map(|(file, _)| TextureUse {
+                key,
+                texture: file.clone(),
+            })
+        })
+        .collect();
+    Ok(Material::Textured(Arc::new(
+        Textured::new(base, albedo, normal).named(names),
+    )))
 }

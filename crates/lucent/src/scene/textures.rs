@@ -1,6 +1,7 @@
 //! `[textures.NAME]` → the scene's texture table (each image read once,
 //! shared by every material that names it), and the materials that name
-//! textures (`albedo_texture`, `normal_map`) → [`Textured`] materials
+//! textures (`albedo_texture`, `normal_map`, a subsurface material's
+//! `dmfp_texture`) → [`Textured`] materials
 //! (`docs/scene-format.md`, "Textures").
 
 use std::collections::{BTreeMap, HashMap};
@@ -11,8 +12,12 @@ use super::checked::{Cx, Res};
 use super::format::{MaterialDef, Spanned, TextureDef};
 use super::key_path::{key_segment, quoted};
 use super::regular_file::{open_regular, read_regular_bytes};
+#[cfg(feature = "subsurface")]
+use super::MAX_SUBSURFACE_RADIUS;
 use crate::geometry::Vec3;
-use crate::materials::{Material, Textured};
+#[cfg(feature = "subsurface")]
+use crate::materials::textured_medium::MediumRecipe;
+use crate::materials::{Bump, Material, TextureUse, Textured};
 use crate::texture::file::{self, Format, TextureError};
 use crate::texture::{ColorSpace, Texture, TextureRef, Wrap};
 
@@ -137,10 +142,15 @@ pub(super) fn textured(
     table: &Table,
 ) -> Res<Material> {
     let d = m.get_ref();
-    if d.albedo_texture.is_none() && d.normal_map.is_none() {
+    // a subsurface material's textures are read with its parameters
+    let field = format!("materials.{}", key_segment(name));
+    if matches!(base, Material::Textured(_)) {
         return Ok(base);
     }
-    let field = format!("materials.{}", key_segment(name));
+    let bump = bump(cx, &field, d, table)?;
+    if d.albedo_texture.is_none() && d.normal_map.is_none() && bump.is_none() {
+        return Ok(base);
+    }
     let albedo = match &d.albedo_texture {
         Some(t) => {
             let e = lookup(cx, &format!("{field}.albedo_texture"), t, table)?;
@@ -155,30 +165,157 @@ pub(super) fn textured(
         }
         None => None,
     };
-    let normal = match &d.normal_map {
-        Some(t) => {
-            let key = format!("{field}.normal_map");
-            let e = lookup(cx, &key, t, table)?;
-            if e.space != ColorSpace::Linear {
-                return Err(cx.err(
-                    t.span(),
-                    &key,
-                    format!(
-                        "texture {} is declared sRGB, but a normal map is data: give it \
-                         color_space = \"linear\"",
-                        quoted(t.get_ref())
-                    ),
-                ));
+    let normal = d
+        .normal_map
+        .as_ref()
+        .map(|t| data(cx, &format!("{field}.normal_map"), t, table, "a normal map"))
+        .transpose()?;
+    let names = uses(&[
+        ("albedo_texture", &d.albedo_texture),
+        ("normal_map", &d.normal_map),
+        ("bump", &d.bump),
+    ]);
+    let mut t = Textured::new(base, albedo, normal).named(names);
+    t.bump = bump;
+    Ok(Material::Textured(Arc::new(t)))
+}
+
+/// The bump map of material `field` (table `d`): its `bump` texture
+/// (data) and `bump_scale` (finite, default 1). Refused: `bump_scale`
+/// alone, `bump` with `normal_map`.
+fn bump(cx: &Cx, field: &str, d: &MaterialDef, table: &Table) -> Res<Option<Bump>> {
+    let scale = match &d.bump_scale {
+        Some(s) => {
+            let key = format!("{field}.bump_scale");
+            if d.bump.is_none() {
+                return Err(cx.err(s.span(), &key, "`bump_scale` without `bump`"));
             }
-            Some(e.texture.clone())
+            cx.scalar(s, &key)?
+        }
+        None => 1.0,
+    };
+    let Some(t) = &d.bump else {
+        return Ok(None);
+    };
+    let key = format!("{field}.bump");
+    if d.normal_map.is_some() {
+        return Err(cx.err(
+            t.span(),
+            &key,
+            "give either `normal_map` or `bump`: both set the shading normal",
+        ));
+    }
+    let texture = data(cx, &key, t, table, "a height map")?;
+    Ok(Some(Bump { texture, scale }))
+}
+
+/// The linear texture `t` names (at `key`), refused when declared sRGB:
+/// `what` is data.
+fn data(cx: &Cx, key: &str, t: &Spanned<String>, table: &Table, what: &str) -> Res<Arc<Texture>> {
+    let e = lookup(cx, key, t, table)?;
+    if e.space != ColorSpace::Linear {
+        return Err(cx.err(
+            t.span(),
+            key,
+            format!(
+                "texture {} is declared sRGB, but {what} is data: give it \
+                 color_space = \"linear\"",
+                quoted(t.get_ref())
+            ),
+        ));
+    }
+    Ok(e.texture.clone())
+}
+
+/// The subsurface material `base` (`field`, table `m`) with the textures
+/// its `albedo_texture` (A, a factor on `albedo`) and `dmfp_texture` (a
+/// factor on its lengths, data) name, its parameters at a point following
+/// `recipe`; `base` when it names neither.
+#[cfg(feature = "subsurface")]
+pub(super) fn subsurface(
+    cx: &Cx,
+    field: &str,
+    m: &Spanned<MaterialDef>,
+    base: Material,
+    recipe: MediumRecipe,
+    table: &Table,
+) -> Res<Material> {
+    let d = m.get_ref();
+    if d.albedo_texture.is_none() && d.dmfp_texture.is_none() {
+        return Ok(base);
+    }
+    let unit = |texture| TextureRef {
+        texture,
+        scale: Vec3::ONE,
+    };
+    let albedo = match &d.albedo_texture {
+        Some(t) => Some(unit(
+            lookup(cx, &format!("{field}.albedo_texture"), t, table)?
+                .texture
+                .clone(),
+        )),
+        None => None,
+    };
+    let dmfp = match &d.dmfp_texture {
+        Some(t) => {
+            let key = format!("{field}.dmfp_texture");
+            Some(unit(data(cx, &key, t, table, "a length factor")?))
         }
         None => None,
     };
-    Ok(Material::Textured(Arc::new(Textured {
-        base,
-        albedo,
-        normal,
-    })))
+    let names = uses(&[
+        ("albedo_texture", &d.albedo_texture),
+        ("dmfp_texture", &d.dmfp_texture),
+    ]);
+    if let (Some(k), Some(v), Material::Subsurface(ss)) = (&dmfp, &d.dmfp_texture, &base) {
+        let key = format!("{field}.dmfp_texture");
+        check_longest(cx, &key, v, ss, &recipe, k.texture.max_texel())?;
+    }
+    let mut t = Textured::new(base, albedo, None).named(names);
+    t.dmfp = dmfp;
+    t.medium = Some(recipe);
+    Ok(Material::Textured(Arc::new(t)))
+}
+
+/// Refuses a length texture whose largest texels `max` would make the
+/// probe radius of `ss` exceed [`MAX_SUBSURFACE_RADIUS`] (at the
+/// material's own albedo).
+#[cfg(feature = "subsurface")]
+fn check_longest(
+    cx: &Cx,
+    key: &str,
+    v: &Spanned<String>,
+    ss: &crate::materials::Subsurface,
+    recipe: &MediumRecipe,
+    max: Vec3,
+) -> Res<()> {
+    let params = recipe.params_at(ss.params(), None, Some(max));
+    let rmax = ss.at_point(params).map_or(0.0, |p| p.probe().rmax());
+    if rmax <= MAX_SUBSURFACE_RADIUS {
+        return Ok(());
+    }
+    Err(cx.err(
+        v.span(),
+        key,
+        format!(
+            "texture {}'s largest texels {max} make the subsurface probe radius Rmax = \
+             {rmax:e} scene units, beyond {MAX_SUBSURFACE_RADIUS:e}, the supported range \
+             (see \"Supported ranges\" in docs/scene-format.md)",
+            quoted(v.get_ref())
+        ),
+    ))
+}
+
+/// The texture keys given, with the names they give.
+fn uses(keys: &[(&'static str, &Option<Spanned<String>>)]) -> Vec<TextureUse> {
+    keys.iter()
+        .filter_map(|(key, v)| {
+            v.as_ref().map(|v| TextureUse {
+                key,
+                texture: v.get_ref().clone(),
+            })
+        })
+        .collect()
 }
 
 /// The texture `t` names, or an error at `field` listing those defined.

@@ -125,7 +125,7 @@ fn sampling(scene: &Scene) -> Vec<(String, String)> {
     let mut sampling = Vec::new();
     #[cfg(feature = "subsurface")]
     for (i, m) in scene.materials.iter().enumerate() {
-        let crate::materials::Material::Subsurface(ss) = m else {
+        let crate::materials::Material::Subsurface(ss) = m.base() else {
             continue;
         };
         let users: Vec<&str> = scene

@@ -83,6 +83,15 @@ impl Texture {
         (0..l.texels.len() * 3).map(|i| l.texels[i / 3][i % 3].to_bits())
     }
 
+    /// The largest value of each channel over level 0 (the largest any
+    /// lookup returns: the levels and the filter average texels).
+    pub fn max_texel(&self) -> Vec3 {
+        self.levels[0]
+            .texels
+            .iter()
+            .fold(Vec3::splat(f32::NEG_INFINITY), |m, &t| m.max(t))
+    }
+
     /// Bytes held by all levels.
     pub fn bytes(&self) -> usize {
         self.levels

@@ -77,6 +77,9 @@ pub struct MaterialPlan {
     pub kind: String,
     /// The objects using it (none: it costs nothing).
     pub objects: Vec<String>,
+    /// Parameters read from textures at each hit, `key=texture`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub textures: Vec<String>,
     /// Subsurface materials: the estimator(s), in the order they are tried.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub subsurface: Vec<SubsurfaceMethod>,
@@ -154,6 +157,14 @@ fn base_plan(scene: &Scene, i: usize, m: &Material) -> MaterialPlan {
         }
         .into(),
         objects: users(scene, i),
+        textures: match m {
+            Material::Textured(t) => t
+                .names
+                .iter()
+                .map(|u| format!("{}={}", u.key, u.texture))
+                .collect(),
+            _ => Vec::new(),
+        },
         subsurface: Vec::new(),
         coat: None,
         exit_lobe: None,

@@ -60,6 +60,13 @@ pub fn render(p: &Explanation) -> String {
             format!("objects: {}", m.objects.join(", "))
         };
         r.push_str(&format!("material {} ({}; {users})\n", m.name, m.kind));
+        if !m.textures.is_empty() {
+            let which = format!(
+                "{} (docs/scene-format.md, \"Textured parameters\")",
+                m.textures.join(" ")
+            );
+            row(r, "textures", "read per hit", &which);
+        }
         for s in &m.subsurface {
             match s {
                 SubsurfaceMethod::Diffusion {
