@@ -96,8 +96,8 @@ pub struct ProbeSampler {
     active: [usize; 3],
     n_active: usize,
     rmax: f64,
-    /// The widest active channel's d (for a tabulated profile, the d whose
-    /// fit has the same Rmax): the length curvature is measured in.
+    /// The widest active channel's d (the fit's, for either profile): the
+    /// length curvature is measured in.
     d_max: f64,
     /// p(xi) and Rd at an entry point.
     density: ProbeDensity,
@@ -157,13 +157,7 @@ impl ProbeSampler {
             active,
             n_active,
             rmax,
-            // the fit's d whose quantile is this Rmax: the length the
-            // tangent-axis rule reads curvature in, for either profile
-            d_max: if tables.is_some() {
-                rmax / profile::quantile(opts.rmax_quantile)
-            } else {
-                params.max_active_d()
-            },
+            d_max: params.max_active_d(),
             density,
             planar,
         })
