@@ -343,6 +343,55 @@ fn a_tabulated_profile_reflects_a_times_its_cdf_on_a_plane() {
     }
 }
 
+/// The shape, not only the total: xo sits on the plane's extension a
+/// distance D = one diffusion length (of marble's red) outside a
+/// half-plane, so the estimator sees only the profile beyond D. Its mean
+/// is A·∫ R(r)·2r·acos(D/r) dr over D … Rmax of the table's own R, more
+/// than twice the fit's there; an estimator that weighed Rd from the fit
+/// (or sampled the fit) would converge to the latter.
+#[test]
+fn a_tabulated_profile_reaches_a_half_plane_one_diffusion_length_away() {
+    let params = SubsurfaceParams::from_preset("marble", 1.0, profile::Fit::Searchlight).unwrap();
+    let m = params.medium.unwrap();
+    let dl = crate::bssrdf::params::diffuse_mfp(m.sigma_s[0] * (1.0 - m.g), m.sigma_a[0]);
+    let mut mesh = planes(2000.0, &[0.0]);
+    mesh.transform(|q| q + Vec3::new(dl as f32 + 2000.0, 0.0, 0.0), |n| n);
+    let accel = Brute { meshes: vec![mesh] };
+    let opts = ProbeOptions {
+        profile: crate::bssrdf::ProfileShape::Tabulated,
+        ..ProbeOptions::default()
+    };
+    let s = ProbeSampler::new(&params, &opts).unwrap();
+    // ∫_D^Rmax f(r) 2r acos(D/r) dr by the midpoint rule in t, r = D + (Rmax − D) t²
+    let beyond = |f: &dyn Fn(f64) -> f64, rmax: f64| -> f64 {
+        let n = 200_000;
+        (0..n)
+            .map(|i| {
+                let t = (i as f64 + 0.5) / n as f64;
+                let r = dl + (rmax - dl) * t * t;
+                f(r) * 2.0 * r * (dl / r).acos() * 2.0 * (rmax - dl) * t / n as f64
+            })
+            .sum()
+    };
+    let truth: [f64; 3] = std::array::from_fn(|c| beyond(&|r| s.rd(r)[c], s.rmax()));
+    let fit = ProbeSampler::new(&params, &ProbeOptions::default()).unwrap();
+    let fit_mean = beyond(&|r| fit.rd(r)[0], fit.rmax());
+    let st = run(
+        &s,
+        &accel,
+        Vec3::ZERO,
+        &Frame::from_normal(Vec3::Z),
+        100_000,
+        11,
+    );
+    println!(
+        "beyond one ld: {:?} ± {:?}, truth {truth:?}, fit {fit_mean}",
+        st.mean, st.se
+    );
+    assert_close(&st, truth, "tabulated, half-plane beyond one ld");
+    assert!(truth[0] > 2.0 * fit_mean && truth[0] - fit_mean > 20.0 * st.se[0]);
+}
+
 #[test]
 fn ketchup_blue_is_exactly_zero() {
     // The Jensen table's A = 0 in blue (the albedo table gives ≈ 0.002).
