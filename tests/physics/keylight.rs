@@ -149,9 +149,9 @@ fn each_half_of_a_sphere_under_a_key_light_is_within_3_percent_of_the_random_wal
 /// against 0.25 / 0.20 / 0.19; here 0.72 / 0.49 / 0.60 against
 /// 0.30 / 0.17 / 0.22), and the lit half stays within 20 % of the walk
 /// (−7…−8 % at 48², here −6…−13 %: the lit half's noise at these counts
-/// is ≈ 10 %). A profile whose tail were cut short again — sampled or
-/// weighed from the fit, or truncated at the fit's Rmax — fails the far
-/// bound. Four seeds of 32 spp at 24² per side (5.5 s).
+/// is ≈ 10 %). Rd weighed from the fit's shape fails the far bound;
+/// truncating the table at the fit's Rmax (16 mm, short of the 20 mm
+/// diameter) does not (far 0.67 / 0.46 / 0.59). Four seeds of 32 spp at 24² per side (5.5 s).
 #[test]
 fn the_tabulated_profile_carries_a_key_light_to_the_far_half() {
     let sides = |integrator, extra: &str| {
