@@ -48,7 +48,7 @@ impl TabulatedProfile {
     pub fn for_channel(table: &ProfileTable, medium: &Medium, c: usize, eta: f64) -> Option<Self> {
         let ss = medium.sigma_s[c] * (1.0 - medium.g);
         let sa = medium.sigma_a[c];
-        if !(ss > 0.0) {
+        if ss.is_nan() || ss <= 0.0 {
             return None;
         }
         let ld = diffuse_mfp(ss, sa);
@@ -67,7 +67,7 @@ impl TabulatedProfile {
 
     /// The mass within radius r.
     pub fn cdf(&self, r: f64) -> f64 {
-        if !(r > 0.0) {
+        if r.is_nan() || r <= 0.0 {
             return 0.0;
         }
         if r >= self.reach() {
@@ -80,7 +80,7 @@ impl TabulatedProfile {
     /// R(r) per unit area, 0 beyond the table; r > 0.
     #[inline]
     pub fn profile(&self, r: f64) -> f64 {
-        if !(r < self.reach()) {
+        if r.is_nan() || r >= self.reach() {
             return 0.0;
         }
         self.dens[self.bin(r)] / (2.0 * PI * r)
