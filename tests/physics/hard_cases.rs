@@ -191,6 +191,7 @@ fn all_options() -> Vec<ProbeOptions> {
                         radius,
                         rmax_quantile: 0.999,
                         renormalize,
+                        profile: lucent::bssrdf::ProfileShape::Burley,
                     });
                 }
             }

@@ -19,7 +19,10 @@
 //! (`scripts/keylight-report.sh`, 48², 4 × 256 spp; here −72…−79 %). The
 //! profile's tail is far shorter than the medium's transfer, more so on a
 //! curved body, and the exit lobe is blind to where the light came from
-//! (`docs/bssrdf.md` §10, "Where the light leaves").
+//! (`docs/bssrdf.md` §10, "Where the light leaves"). The tabulated
+//! profile (`profile = "tabulated"`) fixes the shape on the half-space:
+//! far half −29…−45 %, lit −7…−8 %; what is left is curvature and the
+//! exit. The last test here pins that much.
 
 use std::path::Path;
 
@@ -34,8 +37,16 @@ const SEEDS: u64 = 8;
 
 /// The scene file at RES², with `spp` and `seed`.
 fn scene(spp: u32, seed: u64) -> Scene {
-    let text = include_str!("../../scenes/keylight-sphere.toml");
-    let mut s = load_str(text, Path::new("scenes/keylight-sphere.toml")).unwrap();
+    scene_with(spp, seed, "")
+}
+
+/// [`scene`] with `extra` (TOML lines) added to the marble material.
+fn scene_with(spp: u32, seed: u64, extra: &str) -> Scene {
+    let text = include_str!("../../scenes/keylight-sphere.toml").replace(
+        "preset = \"marble\"",
+        &format!("preset = \"marble\"\n{extra}"),
+    );
+    let mut s = load_str(&text, Path::new("scenes/keylight-sphere.toml")).unwrap();
     let c = &s.camera;
     s.camera = Camera::new(c.look_from, c.look_at, c.up, c.fov_y, RES, RES);
     s.settings.spp = spp;
@@ -102,7 +113,7 @@ fn mean_se(per_seed: &[[[f64; 3]; 2]]) -> [[(f64, f64); 3]; 2] {
 }
 
 #[test]
-#[ignore = "the model does not yet carry light across the body: far half −75…−82 % (docs/accuracy.md, \"Key light\")"]
+#[ignore = "the model does not yet carry light across the body: far half −75…−82 % with the fit, −29…−45 % with the tabulated profile (docs/accuracy.md, \"Key light\")"]
 fn each_half_of_a_sphere_under_a_key_light_is_within_3_percent_of_the_random_walk() {
     let sides = |integrator, spp| {
         let v: Vec<_> = (1..=SEEDS)
@@ -129,4 +140,45 @@ fn each_half_of_a_sphere_under_a_key_light_is_within_3_percent_of_the_random_wal
         }
     }
     assert!(failures.is_empty(), "{failures:?}");
+}
+
+/// The tabulated profile (`profile = "tabulated"`, `docs/bssrdf.md` §10)
+/// carries the key light across the body: on the far half it returns
+/// more than 40 % of the walk's light in every channel, where the fit
+/// returns less than 35 % (at 4 × 256 spp, 48²: 0.71 / 0.64 / 0.56
+/// against 0.25 / 0.20 / 0.19; here 0.72 / 0.49 / 0.60 against
+/// 0.30 / 0.17 / 0.22), and the lit half stays within 20 % of the walk
+/// (−7…−8 % at 48², here −6…−13 %: the lit half's noise at these counts
+/// is ≈ 10 %). Rd weighed from the fit's shape fails the far bound;
+/// truncating the table at the fit's Rmax (16 mm, short of the 20 mm
+/// diameter) does not (far 0.67 / 0.46 / 0.59). Four seeds of 32 spp at 24² per side (5.5 s).
+#[test]
+fn the_tabulated_profile_carries_a_key_light_to_the_far_half() {
+    let sides = |integrator, extra: &str| {
+        let v: Vec<_> = (1..=4)
+            .map(|seed| halves(&run(&scene_with(32, seed, extra), integrator)))
+            .collect();
+        mean_se(&v)
+    };
+    let walk = sides(IntegratorKind::RandomWalk, "");
+    let tab = sides(IntegratorKind::Path, "profile = \"tabulated\"");
+    let fit = sides(IntegratorKind::Path, "profile = \"burley\"");
+    let ratio = |d: [[(f64, f64); 3]; 2], s: usize, c: usize| d[s][c].0 / walk[s][c].0;
+    let rows: Vec<[f64; 3]> = (0..3)
+        .map(|c| [ratio(tab, 0, c), ratio(tab, 1, c), ratio(fit, 1, c)])
+        .collect();
+    for (c, [lit, far, fit_far]) in rows.iter().enumerate() {
+        println!("ch{c}: tabulated lit {lit:.3}, far {far:.3}; fit far {fit_far:.3}");
+    }
+    for (c, &[lit, far, fit_far]) in rows.iter().enumerate() {
+        assert!(far > 0.4, "ch{c}: tabulated far half {far:.3} of the walk");
+        assert!(
+            fit_far < 0.4,
+            "ch{c}: fit far half {fit_far:.3} of the walk"
+        );
+        assert!(
+            (lit - 1.0).abs() < 0.2,
+            "ch{c}: tabulated lit half {lit:.3}"
+        );
+    }
 }

@@ -15,6 +15,8 @@
 //! - [`sphere_transfer`]: where light entering a sphere at one point
 //!   leaves it, by chord distance — the diffusion profile's ground truth
 //!   on a curved body (`docs/bssrdf.md` §10).
+//! - [`profile_table`]: the tabulated profile's generator — where light
+//!   entering the half-space leaves it, by distance (`docs/bssrdf.md` §10).
 //! - [`plot`]: the PNG canvas, font, palette and log axes both draw with.
 //! - [`progress`]: a render's [`lucent::progress::Progress`] drawn as a bar
 //!   on stderr (indicatif).
@@ -26,6 +28,8 @@ pub mod bench;
 #[cfg(feature = "subsurface")]
 pub mod halfspace;
 pub mod plot;
+#[cfg(feature = "subsurface")]
+pub mod profile_table;
 pub mod progress;
 #[cfg(feature = "subsurface")]
 pub mod sphere_albedo;

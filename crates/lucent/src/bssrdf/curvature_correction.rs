@@ -17,7 +17,9 @@ use super::curvature_table::CurvatureTable;
 use super::params::{diffuse_mfp, SubsurfaceParams};
 use super::probe::ProbeSampler;
 use super::profile;
+use super::tabulated::TabulatedProfile;
 use crate::geometry::Vec3;
+use std::sync::Arc;
 
 /// The largest factor applied to a weight (on a body far smaller than the
 /// diffusion length, where the half-space profile has nothing left to
@@ -41,6 +43,8 @@ pub(crate) struct ExitFactor {
 struct Channel {
     albedo: f64,
     d: f64,
+    /// The tabulated profile, if the sampler uses one (else the fit's).
+    tabulated: Option<Arc<TabulatedProfile>>,
     ld: f64,
     h: Vec<f64>,
 }
@@ -119,6 +123,7 @@ impl CurvatureCorrection {
             Some(Channel {
                 albedo: params.albedo[c],
                 d: params.d[c],
+                tabulated: sampler.dist(c).and_then(|d| d.tabulated_profile().cloned()),
                 ld: diffuse_mfp(ss, sa),
                 h: table.row(x, params.eta as f64),
             })
@@ -181,8 +186,11 @@ impl CurvatureCorrection {
                 let radius = 1.0 / k;
                 let h = self.table.at_rho(&ch.h, radius / ch.ld);
                 let a_sphere = 1.0 - h * (1.0 - ch.albedo);
-                let g = profile::cdf((2.0 * radius).min(self.rmax), ch.d)
-                    / profile::cdf(self.rmax, ch.d);
+                let cdf = |r: f64| match &ch.tabulated {
+                    Some(p) => p.cdf(r),
+                    None => profile::cdf(r, ch.d),
+                };
+                let g = cdf((2.0 * radius).min(self.rmax)) / cdf(self.rmax);
                 let f = a_sphere / (ch.albedo * g);
                 if f.is_finite() {
                     f.clamp(MIN_FACTOR, MAX_FACTOR)

@@ -40,7 +40,7 @@ pub struct CurvatureTable {
 
 /// The index i of the cell [v[i], v[i+1]] holding `t` (clamped to the
 /// grid) and the weight of v[i+1].
-fn cell(v: &[f64], t: f64) -> (usize, f64) {
+pub(crate) fn cell(v: &[f64], t: f64) -> (usize, f64) {
     let n = v.len();
     if t <= v[0] {
         return (0, 0.0);

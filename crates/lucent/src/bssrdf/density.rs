@@ -26,6 +26,9 @@ enum Disk {
     Constant(f32),
     /// A table sampler: L² times its density at the scene-unit radius.
     Table(RadialDist),
+    /// The tabulated profile (`super::tabulated`): the density as for
+    /// `Table`, and Rd from the same table.
+    Tabulated(RadialDist),
 }
 
 /// Per-material constants of the density, lengths in units of L.
@@ -48,6 +51,8 @@ pub(crate) struct ProbeDensity {
     disk: [Disk; 3],
     /// Per channel: L²·Rd(r)·r/(e^{−ρ} + e^{−ρ/3}) = scale·L/(8π d).
     k_rd: [f32; 3],
+    /// Per channel: A, or A/CDF(Rmax) (L²·scale for a tabulated profile).
+    scale_l2: [f64; 3],
 }
 
 impl ProbeDensity {
@@ -81,6 +86,7 @@ impl ProbeDensity {
             0.0,
         );
         let disk = std::array::from_fn(|c| match (&dists[c], sampler) {
+            (Some(dist), _) if dist.tabulated_profile().is_some() => Disk::Tabulated(dist.clone()),
             (Some(dist), RadiusSampler::Uniform) => {
                 Disk::Constant((len * len * dist.pdf(0.0)) as f32)
             }
@@ -99,6 +105,7 @@ impl ProbeDensity {
             rmin: per(&|c| RHO_MIN * d[c] / len, 1.0).map(Vec4::splat),
             disk,
             k_rd: per(&|c| scale[c] * len / (pi8 * d[c]), 0.0),
+            scale_l2: scale.map(|s| s * len * len),
         }
     }
 
@@ -137,9 +144,16 @@ impl ProbeDensity {
             pdf[c] = match &self.disk[c] {
                 Disk::Profile(k) => k * w.dot(v),
                 Disk::Constant(k) => k * (w.x + w.y + w.z),
-                Disk::Table(dist) => w.dot(self.table_lanes(dist, local)),
+                Disk::Table(dist) | Disk::Tabulated(dist) => w.dot(self.table_lanes(dist, local)),
             };
-            rd[c] = self.k_rd[c] * v.w;
+            rd[c] = match &self.disk[c] {
+                Disk::Tabulated(dist) => {
+                    let dist3 =
+                        (local[0] * local[0] + local[1] * local[1] + local[2] * local[2]).sqrt();
+                    (self.scale_l2[c] * dist.profile_at(dist3)) as f32
+                }
+                _ => self.k_rd[c] * v.w,
+            };
         }
         let p = match single {
             Some(ch) => pdf[ch],

@@ -4,7 +4,8 @@
 //! restated, with the course report's errors corrected, in `docs/bssrdf.md`;
 //! how an integrator calls this module, step by step: §12.4.
 //!
-//! [`profile`] R(r) and its inverse; [`params`] parameters → per-channel
+//! [`profile`] R(r) and its inverse; [`profile_table`] and [`tabulated`]
+//! the half-space's own R(r), by the random walk, in its place; [`params`] parameters → per-channel
 //! (A, d); [`albedo_table`] and [`dipole`] the A a medium reflects;
 //! [`curvature_table`] and [`curvature_correction`] the convex-body factor;
 //! [`radius`] the radius samplers; [`probe`] probe segments and hit
@@ -23,13 +24,15 @@ pub mod fresnel_moment;
 pub mod params;
 pub mod probe;
 pub mod profile;
+pub mod profile_table;
 pub mod radius;
+pub mod tabulated;
 
 pub use fresnel_moment::{sw, sw_normalization, transmittance};
 pub use params::{AlbedoSource, Measured, Preset, SubsurfaceParams, PRESETS};
 pub use probe::{
     pick_by_score, ChannelStrategy, PlaneModel, ProbeAxes, ProbeEntry, ProbeOptions, ProbeRandoms,
-    ProbeSampler, ProbeSegment,
+    ProbeSampler, ProbeSegment, ProfileShape,
 };
 pub use profile::Fit;
 pub use radius::{RadialDist, RadiusSampler, TableSpacing};

@@ -23,17 +23,21 @@ mod segment;
 mod tests;
 
 pub use axes::{tangent_probability, ProbeAxes, TANGENT_PROB_FULL_AT, TANGENT_PROB_MIN};
-pub use options::{ChannelStrategy, ProbeOptions};
+pub use options::{ChannelStrategy, ProbeOptions, ProfileShape};
 pub use pick::pick_by_score;
 pub use randoms::ProbeRandoms;
 pub use segment::{PlaneModel, ProbeEntry, ProbeSegment};
+
+use std::sync::Arc;
 
 use glam::DVec3;
 
 use super::density::ProbeDensity;
 use super::params::SubsurfaceParams;
 use super::profile;
+use super::profile_table::ProfileTable;
 use super::radius::RadialDist;
+use super::tabulated::TabulatedProfile;
 use crate::error::ParamError;
 use crate::geometry::{Frame, Ray, Vec3};
 
@@ -49,6 +53,24 @@ struct Shared {
     h: f64,
     probs: [f64; 3],
     axes: [DVec3; 3],
+}
+
+/// The tabulated profile of each channel when `opts` asks for it and
+/// `params` records a medium; None otherwise (the fit is used). Err-free:
+/// the embedded table is checked by its tests, so a failure to load it is
+/// a build defect, reported by panicking with the file, line and field.
+fn tabulated_profiles(
+    params: &SubsurfaceParams,
+    opts: &ProbeOptions,
+) -> Option<[Option<TabulatedProfile>; 3]> {
+    let medium = params.medium.as_ref()?;
+    if opts.profile != ProfileShape::Tabulated {
+        return None;
+    }
+    let table = ProfileTable::get().unwrap_or_else(|e| panic!("embedded profile table: {e}"));
+    Some(std::array::from_fn(|c| {
+        TabulatedProfile::for_channel(table, medium, c, params.eta as f64)
+    }))
 }
 
 /// ⌊u·n⌋ for u ∈ [0, 1], n ≥ 1, clamped to n − 1. For u < 1 the product
@@ -70,12 +92,12 @@ pub struct ProbeSampler {
     opts: ProbeOptions,
     /// A per channel, divided by CDF(Rmax) when renormalizing.
     scale: [f64; 3],
-    d: [f64; 3],
     dists: [Option<RadialDist>; 3],
     active: [usize; 3],
     n_active: usize,
     rmax: f64,
-    /// The widest active channel's d: the length curvature is measured in.
+    /// The widest active channel's d (the fit's, for either profile): the
+    /// length curvature is measured in.
     d_max: f64,
     /// p(xi) and Rd at an entry point.
     density: ProbeDensity,
@@ -90,7 +112,17 @@ impl ProbeSampler {
     pub fn new(params: &SubsurfaceParams, opts: &ProbeOptions) -> Result<Self, ParamError> {
         params.validate()?;
         opts.validate()?;
-        let rmax = profile::quantile(opts.rmax_quantile) * params.max_active_d();
+        let tables = tabulated_profiles(params, opts);
+        // the widest active channel's quantile, of its own profile
+        let fit_rmax = profile::quantile(opts.rmax_quantile) * params.max_active_d();
+        let rmax = (0..3)
+            .filter(|&c| params.active(c))
+            .map(|c| match tables.as_ref().and_then(|t| t[c].as_ref()) {
+                Some(p) => p.inverse_cdf(opts.rmax_quantile),
+                None => profile::quantile(opts.rmax_quantile) * params.d[c],
+            })
+            .fold(0.0, f64::max);
+        let rmax = if tables.is_some() { rmax } else { fit_rmax };
         let mut active = [0; 3];
         let mut n_active = 0;
         let mut dists: [Option<RadialDist>; 3] = [None, None, None];
@@ -99,7 +131,10 @@ impl ProbeSampler {
             if !params.active(c) {
                 continue;
             }
-            let dist = RadialDist::new(opts.radius, params.d[c], rmax)?;
+            let dist = match tables.as_ref().and_then(|t| t[c].clone()) {
+                Some(p) => RadialDist::tabulated(Arc::new(p), params.d[c], rmax)?,
+                None => RadialDist::new(opts.radius, params.d[c], rmax)?,
+            };
             scale[c] = params.albedo[c]
                 / if opts.renormalize {
                     dist.profile_mass()
@@ -118,7 +153,6 @@ impl ProbeSampler {
         Ok(ProbeSampler {
             opts: *opts,
             scale,
-            d: params.d,
             dists,
             active,
             n_active,
@@ -148,10 +182,16 @@ impl ProbeSampler {
     /// Rd(r) per channel as the estimator uses it (A·R, or A·R/CDF(Rmax)).
     #[inline]
     pub fn rd(&self, r: f64) -> [f64; 3] {
-        std::array::from_fn(|c| match self.dists[c] {
-            Some(_) => self.scale[c] * profile::profile(r, self.d[c]),
+        std::array::from_fn(|c| match &self.dists[c] {
+            Some(dist) => self.scale[c] * dist.profile_at(r),
             None => 0.0,
         })
+    }
+
+    /// Channel `c`'s radius distribution (None for an inactive channel):
+    /// its profile's CDF is what the curvature correction integrates.
+    pub fn dist(&self, c: usize) -> Option<&RadialDist> {
+        self.dists[c].as_ref()
     }
 
     /// Axis probabilities (T, B, N) at an exit point where the surface's

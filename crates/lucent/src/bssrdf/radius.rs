@@ -16,6 +16,7 @@ use std::f64::consts::PI;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use super::profile::{self, RHO_MIN};
+use super::tabulated::TabulatedProfile;
 use crate::error::{Constraint, Param, ParamError};
 
 /// Where the nodes of a tabulated inverse CDF sit.
@@ -284,6 +285,12 @@ enum Kind {
         p1: f64,
         c: f64,
     },
+    /// The tabulated profile, sampled by its own inverse CDF.
+    Tabulated {
+        profile: Arc<TabulatedProfile>,
+        /// Its mass within Rmax.
+        c: f64,
+    },
 }
 
 /// One channel's radius distribution: a sampler with its d and Rmax and the
@@ -338,6 +345,37 @@ impl RadialDist {
         Ok(RadialDist { d, rmax, kind })
     }
 
+    /// The distribution of a tabulated profile truncated at `rmax`; `d`
+    /// (the fit's, positive) only sets the smallest radius, `RHO_MIN·d`.
+    pub fn tabulated(
+        profile: Arc<TabulatedProfile>,
+        d: f64,
+        rmax: f64,
+    ) -> Result<Self, ParamError> {
+        let mut dist = RadialDist::new(RadiusSampler::Uniform, d, rmax)?;
+        let c = profile.cdf(rmax);
+        dist.kind = Kind::Tabulated { profile, c };
+        Ok(dist)
+    }
+
+    /// Whether the profile is tabulated (else the normalized-diffusion
+    /// fit, whatever the sampler).
+    pub(crate) fn tabulated_profile(&self) -> Option<&Arc<TabulatedProfile>> {
+        match &self.kind {
+            Kind::Tabulated { profile, .. } => Some(profile),
+            _ => None,
+        }
+    }
+
+    /// R(r) per unit area (untruncated), r clamped to at least `RHO_MIN·d`.
+    #[inline]
+    pub(crate) fn profile_at(&self, r: f64) -> f64 {
+        match &self.kind {
+            Kind::Tabulated { profile, .. } => profile.profile(r.max(RHO_MIN * self.d)),
+            _ => profile::profile(r, self.d),
+        }
+    }
+
     pub fn d(&self) -> f64 {
         self.d
     }
@@ -348,7 +386,10 @@ impl RadialDist {
     /// The profile's energy within Rmax, CDF(Rmax/d), whatever the sampler:
     /// the factor a truncated estimate falls short of A by.
     pub(crate) fn profile_mass(&self) -> f64 {
-        profile::cdf_unit(self.rmax / self.d)
+        match &self.kind {
+            Kind::Tabulated { c, .. } => *c,
+            _ => profile::cdf_unit(self.rmax / self.d),
+        }
     }
 
     /// Draws r ∈ [RHO_MIN·d, Rmax] from u ∈ [0, 1); returns (r, disk pdf).
@@ -382,6 +423,7 @@ impl RadialDist {
                     -3.0 * d * (-xi * w2_3).ln_1p()
                 }
             }
+            Kind::Tabulated { profile, c } => profile.inverse_cdf(u * c),
         };
         // a NaN r gives the lower bound
         r.max(RHO_MIN * d).min(self.rmax)
@@ -400,6 +442,7 @@ impl RadialDist {
                 table.density_unit(rho) / (c * 2.0 * PI * rho * self.d * self.d)
             }
             Kind::Analytic { c, .. } | Kind::Mixture { c, .. } => profile::profile(r, self.d) / c,
+            Kind::Tabulated { profile, c } => profile.profile(r.max(RHO_MIN * self.d)) / c,
         }
     }
 

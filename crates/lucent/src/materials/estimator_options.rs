@@ -14,7 +14,7 @@
 use std::fmt;
 
 use super::lod::{LodMode, DEFAULT_THRESHOLD};
-use crate::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, RadiusSampler};
+use crate::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, ProfileShape, RadiusSampler};
 use crate::error::ParamError;
 
 /// The default of [`EstimatorOptions::regularize`], chosen by time to
@@ -255,7 +255,7 @@ fn number<T: std::str::FromStr>(s: &str) -> Result<T, OptionError> {
 
 /// Every option, in the order the EXR header and a part's identity list
 /// them.
-pub static OPTIONS: [EstimatorOption; 15] = [
+pub static OPTIONS: [EstimatorOption; 16] = [
     EstimatorOption {
         name: "radius",
         values: &["analytic", "mixture"],
@@ -459,6 +459,22 @@ pub static OPTIONS: [EstimatorOption; 15] = [
             Ok(())
         },
         get: |o| o.regularize.to_string(),
+    },
+    EstimatorOption {
+        name: "profile",
+        values: &["burley", "tabulated"],
+        research: &[],
+        research_in_scenes: true,
+        flag: true,
+        description: "Diffusion profile: the normalized-diffusion fit; or the half-space's \
+                      transfer by the random walk, tabulated (light reaches farther, as under \
+                      a key light; sampled by its own inverse CDF)",
+        set: |o, s| {
+            let all = ProfileShape::ALL.map(|p| (p.name(), p));
+            o.probe.profile = choose("profile", s, &all)?;
+            Ok(())
+        },
+        get: |o| o.probe.profile.name().into(),
     },
 ];
 

@@ -312,6 +312,8 @@ pub struct MaterialDef {
     pub probe_pair: Option<Spanned<bool>>,
     // subsurface: the coat's least roughness after a non-specular vertex
     pub regularize: Option<Spanned<f64>>,
+    // subsurface: the diffusion profile's shape
+    pub profile: Option<Spanned<String>>,
     // conductor: a named metal, or its complex index n + ik per channel
     // (`roughness` above serves the conductor, plastic and dielectric too)
     pub metal: Option<Spanned<String>>,
@@ -381,6 +383,7 @@ impl MaterialDef {
         );
         add("probe_pair", self.probe_pair.as_ref().map(|x| x.span()));
         add("regularize", self.regularize.as_ref().map(|x| x.span()));
+        add("profile", self.profile.as_ref().map(|x| x.span()));
         v
     }
 }

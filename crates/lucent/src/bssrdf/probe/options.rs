@@ -1,6 +1,6 @@
 //! The probe estimator's options: the axis rule, the channel strategy, the
-//! radius sampler, Rmax's quantile and renormalization (`docs/bssrdf.md`
-//! §12.1).
+//! radius sampler, Rmax's quantile, renormalization and the profile's
+//! shape (`docs/bssrdf.md` §10 and §12.1).
 
 use super::axes::ProbeAxes;
 use crate::bssrdf::radius::RadiusSampler;
@@ -27,6 +27,31 @@ impl ChannelStrategy {
     }
 }
 
+/// The shape of the diffusion profile R(r).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum ProfileShape {
+    /// The normalized-diffusion fit (Christensen & Burley 2015).
+    #[default]
+    Burley,
+    /// The half-space's transfer by the random walk, tabulated
+    /// (`bssrdf::tabulated`); sampled by its own inverse CDF, so the
+    /// radius sampler is not used. Materials that record no medium keep
+    /// the fit.
+    Tabulated,
+}
+
+impl ProfileShape {
+    pub const ALL: [ProfileShape; 2] = [ProfileShape::Burley, ProfileShape::Tabulated];
+
+    /// The name the scene format and the command line use.
+    pub fn name(self) -> &'static str {
+        match self {
+            ProfileShape::Burley => "burley",
+            ProfileShape::Tabulated => "tabulated",
+        }
+    }
+}
+
 /// Options of the probe estimator; `Default` is the recommended setting.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProbeOptions {
@@ -37,6 +62,8 @@ pub struct ProbeOptions {
     pub rmax_quantile: f64,
     /// Divide Rd by CDF(Rmax) so truncation loses no energy.
     pub renormalize: bool,
+    /// The profile's shape.
+    pub profile: ProfileShape,
 }
 
 impl Default for ProbeOptions {
@@ -47,6 +74,7 @@ impl Default for ProbeOptions {
             radius: RadiusSampler::Analytic,
             rmax_quantile: 0.999,
             renormalize: false,
+            profile: ProfileShape::Burley,
         }
     }
 }
@@ -62,6 +90,7 @@ impl ProbeOptions {
             radius,
             rmax_quantile: 0.999,
             renormalize: false,
+            profile: ProfileShape::Burley,
         }
     }
 

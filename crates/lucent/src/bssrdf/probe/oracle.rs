@@ -3,7 +3,6 @@
 use glam::DVec3;
 
 use super::ProbeSampler;
-use crate::bssrdf::profile;
 use crate::geometry::Frame;
 
 /// The f64 transcription of the density and weights, term by term from the
@@ -106,7 +105,9 @@ impl ProbeSampler {
         if !(p > 0.0 && p.is_finite()) {
             return None;
         }
-        let w = |c: usize| (self.scale[c] * profile::profile(dist3, self.d[c]) / p) as f32;
+        let w = |c: usize| {
+            (self.scale[c] * self.dists[c].as_ref().map_or(0.0, |d| d.profile_at(dist3)) / p) as f32
+        };
         Some(match self.single(ch) {
             Some(ch) => std::array::from_fn(|c| if c == ch { w(c) } else { 0.0 }),
             None => std::array::from_fn(w),

@@ -52,6 +52,7 @@ fn weights_match_the_f64_oracle() {
                             radius,
                             rmax_quantile: 0.999,
                             renormalize,
+                            profile: crate::bssrdf::ProfileShape::Burley,
                         };
                         let s = ProbeSampler::new(params, &opts).unwrap();
                         // the curvature rule draws its own cases, so the

@@ -201,6 +201,7 @@ fn all_options() -> Vec<ProbeOptions> {
                         radius,
                         rmax_quantile: 0.999,
                         renormalize,
+                        profile: crate::bssrdf::ProfileShape::Burley,
                     });
                 }
             }
@@ -290,6 +291,105 @@ fn flat_plane_reflects_a_times_cdf_rmax_for_every_option() {
             }
         }
     }
+}
+
+/// The tabulated profile (`bssrdf::tabulated`) on an infinite plane: the
+/// mean weight is A·CDF(Rmax) of the table's own CDF per channel, or A
+/// renormalized, for every axis rule, both channel strategies and a tilted
+/// shading normal, with Rmax the table's quantile (longer than the fit's:
+/// the medium's transfer has the longer tail). A density that disagreed
+/// with what is sampled, or Rd read from the fit, would miss it.
+#[test]
+fn a_tabulated_profile_reflects_a_times_its_cdf_on_a_plane() {
+    let params = SubsurfaceParams::from_preset("marble", 1.0, profile::Fit::Searchlight).unwrap();
+    let accel = Brute {
+        meshes: vec![planes(4000.0, &[0.0])],
+    };
+    let xo = Vec3::new(0.37, -0.21, 0.0);
+    let fit = ProbeSampler::new(&params, &ProbeOptions::default()).unwrap();
+    for (i, axes) in ProbeAxes::ALL.into_iter().enumerate() {
+        for (j, channel) in [ChannelStrategy::Single, ChannelStrategy::Mis]
+            .into_iter()
+            .enumerate()
+        {
+            for renormalize in [false, true] {
+                let opts = ProbeOptions {
+                    axes,
+                    channel,
+                    renormalize,
+                    profile: crate::bssrdf::ProfileShape::Tabulated,
+                    ..ProbeOptions::default()
+                };
+                let s = ProbeSampler::new(&params, &opts).unwrap();
+                assert!(
+                    s.rmax() > 1.5 * fit.rmax(),
+                    "{} vs {}",
+                    s.rmax(),
+                    fit.rmax()
+                );
+                let truth = s.planar_reflectance();
+                for c in 0..3 {
+                    let mass = s.dist(c).unwrap().profile_mass();
+                    let want = params.albedo[c] * if renormalize { 1.0 } else { mass };
+                    assert!((truth[c] - want).abs() < 1e-12);
+                }
+                for (k, deg) in [0.0f32, 40.0].into_iter().enumerate() {
+                    let key = (100 + i * 16 + j * 4 + k * 2 + renormalize as usize) as u64;
+                    let st = run(&s, &accel, xo, &tilted(deg), 40_000, key);
+                    assert_close(&st, truth, &format!("{opts:?} tilt {deg}°"));
+                }
+            }
+        }
+    }
+}
+
+/// The shape, not only the total: xo sits on the plane's extension a
+/// distance D = one diffusion length (of marble's red) outside a
+/// half-plane, so the estimator sees only the profile beyond D. Its mean
+/// is A·∫ R(r)·2r·acos(D/r) dr over D … Rmax of the table's own R, more
+/// than twice the fit's there; an estimator that weighed Rd from the fit
+/// (or sampled the fit) would converge to the latter.
+#[test]
+fn a_tabulated_profile_reaches_a_half_plane_one_diffusion_length_away() {
+    let params = SubsurfaceParams::from_preset("marble", 1.0, profile::Fit::Searchlight).unwrap();
+    let m = params.medium.unwrap();
+    let dl = crate::bssrdf::params::diffuse_mfp(m.sigma_s[0] * (1.0 - m.g), m.sigma_a[0]);
+    let mut mesh = planes(2000.0, &[0.0]);
+    mesh.transform(|q| q + Vec3::new(dl as f32 + 2000.0, 0.0, 0.0), |n| n);
+    let accel = Brute { meshes: vec![mesh] };
+    let opts = ProbeOptions {
+        profile: crate::bssrdf::ProfileShape::Tabulated,
+        ..ProbeOptions::default()
+    };
+    let s = ProbeSampler::new(&params, &opts).unwrap();
+    // ∫_D^Rmax f(r) 2r acos(D/r) dr by the midpoint rule in t, r = D + (Rmax − D) t²
+    let beyond = |f: &dyn Fn(f64) -> f64, rmax: f64| -> f64 {
+        let n = 200_000;
+        (0..n)
+            .map(|i| {
+                let t = (i as f64 + 0.5) / n as f64;
+                let r = dl + (rmax - dl) * t * t;
+                f(r) * 2.0 * r * (dl / r).acos() * 2.0 * (rmax - dl) * t / n as f64
+            })
+            .sum()
+    };
+    let truth: [f64; 3] = std::array::from_fn(|c| beyond(&|r| s.rd(r)[c], s.rmax()));
+    let fit = ProbeSampler::new(&params, &ProbeOptions::default()).unwrap();
+    let fit_mean = beyond(&|r| fit.rd(r)[0], fit.rmax());
+    let st = run(
+        &s,
+        &accel,
+        Vec3::ZERO,
+        &Frame::from_normal(Vec3::Z),
+        100_000,
+        11,
+    );
+    println!(
+        "beyond one ld: {:?} ± {:?}, truth {truth:?}, fit {fit_mean}",
+        st.mean, st.se
+    );
+    assert_close(&st, truth, "tabulated, half-plane beyond one ld");
+    assert!(truth[0] > 2.0 * fit_mean && truth[0] - fit_mean > 20.0 * st.se[0]);
 }
 
 #[test]
@@ -850,6 +950,7 @@ fn every_entry_point_lies_within_rmax_of_xo_on_curved_geometry() {
                     radius,
                     rmax_quantile,
                     renormalize: false,
+                    profile: crate::bssrdf::ProfileShape::Burley,
                 };
                 let s = ProbeSampler::new(&params, &opts).unwrap();
                 let rm = s.rmax() as f32;
@@ -1231,6 +1332,7 @@ fn sampled_entry_points_follow_the_density_the_estimator_divides_by() {
                     radius,
                     rmax_quantile: 0.99,
                     renormalize: false,
+                    profile: crate::bssrdf::ProfileShape::Burley,
                 };
                 let s = ProbeSampler::new(&params, &opts).unwrap();
                 let rm = s.rmax();
@@ -1378,6 +1480,7 @@ fn a_chosen_entry_point_has_density_p_times_its_share_of_the_segments_weight() {
             radius,
             rmax_quantile: 0.99,
             renormalize: false,
+            profile: crate::bssrdf::ProfileShape::Burley,
         };
         let s = ProbeSampler::new(&params, &opts).unwrap();
         let rm = s.rmax();
