@@ -24,6 +24,8 @@ mod scene_errors;
 mod session;
 #[cfg(feature = "subsurface")]
 mod study;
+#[cfg(feature = "subsurface")]
+mod study_convergence;
 mod subsurface_feature;
 mod textures;
 mod transparent;

@@ -153,10 +153,11 @@ fn slab_exact_samplers_are_unbiased_and_outputs_exist() {
         "error-vs-time.png",
         "bias-vs-rmax.png",
         "bias-vs-table.png",
+        "relmse-spp.png",
     ] {
         assert!(dir.path().join(f).is_file(), "missing {f}");
     }
-    assert_eq!(out.plots.len(), 3);
+    assert_eq!(out.plots.len(), 4);
     for p in &out.plots {
         assert_png(p);
     }

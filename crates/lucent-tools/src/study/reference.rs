@@ -159,7 +159,7 @@ pub(super) fn reference(
     let (film, stats) = render::render(
         &ref_scene,
         accel,
-        &render_opts(s, s.reference_spp, ref_seed, s.reference, s.progress),
+        &render_opts(s, s.reference_spp, ref_seed, s.reference, None, s.progress),
     )
     .map_err(runtime)?;
     film.write_exr_and_preview(&path, ToneMap::Filmic, 0.0)

@@ -11,13 +11,14 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use super::config::{self, Axis, Config};
+use super::convergence;
 use super::metrics::time_to_reach;
 use super::results::Row;
 use super::{ReferenceInfo, Settings};
 use lucent::film::atomic_write;
 use lucent::scene::Scene;
 
-fn ladder_of<'a>(rows: &'a [Row], config: &str) -> Vec<&'a Row> {
+pub(super) fn ladder_of<'a>(rows: &'a [Row], config: &str) -> Vec<&'a Row> {
     let mut v: Vec<&Row> = rows.iter().filter(|r| r.config == config).collect();
     v.sort_by_key(|r| r.spp);
     v
@@ -75,6 +76,7 @@ pub fn write(
     rows: &[Row],
     reference: &ReferenceInfo,
     plots: &[PathBuf],
+    no_denoise: Option<&str>,
     run_seconds: f64,
 ) -> Result<PathBuf, lucent::Error> {
     let path = s.out_dir.join("report.md");
@@ -88,10 +90,21 @@ pub fn write(
     writeln!(r, "# Accuracy vs time: {name}\n").unwrap();
     writeln!(r, "Reproduce with:\n\n    {}\n", command_line(s)).unwrap();
     setup_section(&mut r, s, scene, configs, reference, run_seconds);
+    if let Some(why) = no_denoise {
+        writeln!(
+            r,
+            "**No denoised curve:** Open Image Denoise is unavailable ({why}).\n"
+        )
+        .unwrap();
+    }
     let pixels = (w as f64) * (h as f64);
     results_table(&mut r, configs, rows, pixels);
+    convergence::table(&mut r, configs, rows);
     writeln!(r, "## Headlines\n").unwrap();
-    for h in headlines(configs, rows, pixels) {
+    for h in headlines(configs, rows, pixels)
+        .into_iter()
+        .chain(convergence::headlines(configs, rows))
+    {
         writeln!(r, "- {h}").unwrap();
     }
     writeln!(r).unwrap();
@@ -135,7 +148,8 @@ fn setup_section(
         .collect();
     writeln!(
         r,
-        "- Sample-count ladder {} (progressive: rung j adds a chunk with seed base + j; times are cumulative wall time).",
+        "- Sample-count ladder {} (progressive: rung j adds the next range of samples of the one seed, as a farm's parts split them; \
+         times are cumulative wall time, with the denoise of that rung's image for a denoising configuration).",
         spps.join(", ")
     )
     .unwrap();
@@ -235,7 +249,13 @@ fn results_table(r: &mut String, configs: &[Config], rows: &[Row], pixels: f64) 
 }
 
 /// How much less time `a` needs than `b` to reach `b`'s final RMSE.
-fn time_sentence(rows: &[Row], a: &str, a_label: &str, b: &str, b_label: &str) -> Option<String> {
+pub(super) fn time_sentence(
+    rows: &[Row],
+    a: &str,
+    a_label: &str,
+    b: &str,
+    b_label: &str,
+) -> Option<String> {
     let (la, lb) = (ladder_of(rows, a), ladder_of(rows, b));
     let (a_last, b_last) = (la.last()?, lb.last()?);
     let pts: Vec<(f64, f64)> = la.iter().map(|x| (x.seconds, x.rmse)).collect();
