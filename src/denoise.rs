@@ -29,6 +29,10 @@ pub(crate) struct DenoiseArgs {
     /// Exposure of the PNG preview in stops.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = exposure_stops)]
     exposure: f32,
+    /// Also denoise each light path and light group layer, as
+    /// `denoised_<layer>`, with the beauty's guides.
+    #[arg(long)]
+    layers: bool,
     /// No summary line.
     #[arg(short, long)]
     quiet: bool,
@@ -41,7 +45,10 @@ pub(crate) fn run(a: DenoiseArgs) -> Result<(), Error> {
         exposure: a.exposure,
     };
     let output = a.output.unwrap_or_else(|| a.frame.clone());
-    let opts = DenoiseOptions::with_threads(a.threads);
+    let opts = DenoiseOptions {
+        layers: a.layers,
+        ..DenoiseOptions::with_threads(a.threads)
+    };
     let d = session::denoise_file(&a.frame, &output, preview, &opts)?;
     if !a.quiet {
         // a closed stderr drops the line; the exit status still tells

@@ -155,6 +155,10 @@ enum Command {
         /// split render after the merge (docs/output.md, "Denoising").
         #[arg(long)]
         denoise: bool,
+        /// With --denoise, also each light path and light group layer, as
+        /// `denoised_<layer>`, with the beauty's guides.
+        #[arg(long, requires = "denoise")]
+        denoise_layers: bool,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
         #[command(flatten)]
@@ -193,6 +197,10 @@ enum Command {
         /// passes (docs/output.md, "Denoising").
         #[arg(long)]
         denoise: bool,
+        /// With --denoise, also each light path and light group layer, as
+        /// `denoised_<layer>`, with the beauty's guides.
+        #[arg(long, requires = "denoise")]
+        denoise_layers: bool,
         /// The denoiser's threads, 1 to 1024 (default: all cores).
         #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
         threads: Option<usize>,
@@ -360,6 +368,7 @@ fn main() -> ExitCode {
             explain,
             stats,
             denoise,
+            denoise_layers,
             subsurface,
             file,
             split,
@@ -408,7 +417,10 @@ fn main() -> ExitCode {
                         tonemap: tonemap.into(),
                         exposure,
                     },
-                    denoise: denoise.then(|| DenoiseOptions::with_threads(threads)),
+                    denoise: denoise.then(|| DenoiseOptions {
+                        layers: denoise_layers,
+                        ..DenoiseOptions::with_threads(threads)
+                    }),
                 };
                 run_render(&r, quiet)
             })
@@ -421,13 +433,17 @@ fn main() -> ExitCode {
             quiet,
             mixed_backends,
             denoise,
+            denoise_layers,
             threads,
         } => {
             let preview = Preview {
                 tonemap: tonemap.into(),
                 exposure,
             };
-            let d = denoise.then(|| DenoiseOptions::with_threads(threads));
+            let d = denoise.then(|| DenoiseOptions {
+                layers: denoise_layers,
+                ..DenoiseOptions::with_threads(threads)
+            });
             session::merge_parts(&parts, &output, preview, mixed_backends, d.as_ref()).map(|m| {
                 if !quiet {
                     tell!("{}", m.summary(&output));

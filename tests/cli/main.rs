@@ -11,6 +11,7 @@ mod aov;
 mod bench_cli;
 mod cli;
 mod denoise;
+mod denoise_layers;
 mod environment_image;
 mod exr_oiio;
 mod farm;
