@@ -91,6 +91,7 @@ fn main() {
                 threads: Some(threads),
                 prefilter_guides,
                 layers: false,
+                max_memory_mb: None,
             };
             let t = Instant::now();
             let out = denoise(&input, &opts).unwrap_or_else(|e| panic!("{path}: {e}"));

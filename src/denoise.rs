@@ -33,6 +33,10 @@ pub(crate) struct DenoiseArgs {
     /// `denoised_<layer>`, with the beauty's guides.
     #[arg(long)]
     layers: bool,
+    /// OIDN's scratch memory cap in MB (it then denoises in overlapping
+    /// tiles; default: OIDN's own).
+    #[arg(long, value_name = "MB")]
+    max_memory: Option<u32>,
     /// No summary line.
     #[arg(short, long)]
     quiet: bool,
@@ -47,6 +51,7 @@ pub(crate) fn run(a: DenoiseArgs) -> Result<(), Error> {
     let output = a.output.unwrap_or_else(|| a.frame.clone());
     let opts = DenoiseOptions {
         layers: a.layers,
+        max_memory_mb: a.max_memory,
         ..DenoiseOptions::with_threads(a.threads)
     };
     let d = session::denoise_file(&a.frame, &output, preview, &opts)?;

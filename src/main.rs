@@ -159,6 +159,10 @@ enum Command {
         /// `denoised_<layer>`, with the beauty's guides.
         #[arg(long, requires = "denoise")]
         denoise_layers: bool,
+        /// With --denoise, OIDN's scratch memory cap in MB (it then
+        /// denoises in overlapping tiles; default: OIDN's own).
+        #[arg(long, requires = "denoise", value_name = "MB")]
+        denoise_memory: Option<u32>,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
         #[command(flatten)]
@@ -201,6 +205,10 @@ enum Command {
         /// `denoised_<layer>`, with the beauty's guides.
         #[arg(long, requires = "denoise")]
         denoise_layers: bool,
+        /// With --denoise, OIDN's scratch memory cap in MB (it then
+        /// denoises in overlapping tiles; default: OIDN's own).
+        #[arg(long, requires = "denoise", value_name = "MB")]
+        denoise_memory: Option<u32>,
         /// The denoiser's threads, 1 to 1024 (default: all cores).
         #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
         threads: Option<usize>,
@@ -369,6 +377,7 @@ fn main() -> ExitCode {
             stats,
             denoise,
             denoise_layers,
+            denoise_memory,
             subsurface,
             file,
             split,
@@ -419,6 +428,7 @@ fn main() -> ExitCode {
                     },
                     denoise: denoise.then(|| DenoiseOptions {
                         layers: denoise_layers,
+                        max_memory_mb: denoise_memory,
                         ..DenoiseOptions::with_threads(threads)
                     }),
                 };
@@ -434,6 +444,7 @@ fn main() -> ExitCode {
             mixed_backends,
             denoise,
             denoise_layers,
+            denoise_memory,
             threads,
         } => {
             let preview = Preview {
@@ -442,6 +453,7 @@ fn main() -> ExitCode {
             };
             let d = denoise.then(|| DenoiseOptions {
                 layers: denoise_layers,
+                max_memory_mb: denoise_memory,
                 ..DenoiseOptions::with_threads(threads)
             });
             session::merge_parts(&parts, &output, preview, mixed_backends, d.as_ref()).map(|m| {

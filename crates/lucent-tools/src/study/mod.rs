@@ -185,17 +185,13 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
         .cloned()
         .collect();
     let plots = plots::write_all(&s.out_dir, &rows, &configs).map_err(runtime)?;
-    let report = report::write(
-        s,
-        &scene,
-        &configs,
-        &rows,
-        &ref_info,
-        &plots,
-        no_denoise.as_deref(),
-        started.elapsed().as_secs_f64(),
-    )
-    .map_err(runtime)?;
+    let made = report::Made {
+        reference: &ref_info,
+        plots: &plots,
+        no_denoise: no_denoise.as_deref(),
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    let report = report::write(s, &scene, &configs, &rows, &made).map_err(runtime)?;
     Ok(Outcome {
         configs,
         rows,

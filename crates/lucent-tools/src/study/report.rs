@@ -67,6 +67,16 @@ fn fmt_opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
     v.map(f).unwrap_or_else(|| "—".into())
 }
 
+/// What a run made besides the rows, for its report.
+pub struct Made<'a> {
+    pub reference: &'a ReferenceInfo,
+    pub plots: &'a [PathBuf],
+    /// Why there is no denoised curve, if there is none.
+    pub no_denoise: Option<&'a str>,
+    /// How long this run took.
+    pub seconds: f64,
+}
+
 /// Writes `DIR/report.md`; returns its path, or why it could not be written
 /// (`cannot write PATH: …`).
 pub fn write(
@@ -74,11 +84,14 @@ pub fn write(
     scene: &Scene,
     configs: &[Config],
     rows: &[Row],
-    reference: &ReferenceInfo,
-    plots: &[PathBuf],
-    no_denoise: Option<&str>,
-    run_seconds: f64,
+    made: &Made,
 ) -> Result<PathBuf, lucent::Error> {
+    let Made {
+        reference,
+        plots,
+        no_denoise,
+        seconds: run_seconds,
+    } = *made;
     let path = s.out_dir.join("report.md");
     let name = s
         .scene

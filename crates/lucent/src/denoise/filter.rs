@@ -40,6 +40,10 @@ pub struct DenoiseOptions {
     /// Denoise each light layer (light paths, light groups) too, with the
     /// beauty's guides (`--denoise-layers`).
     pub layers: bool,
+    /// OIDN's `maxMemoryMB`: about this much scratch memory per filter,
+    /// which OIDN keeps by denoising the image in overlapping tiles (None:
+    /// OIDN's own choice).
+    pub max_memory_mb: Option<u32>,
 }
 
 impl DenoiseOptions {
@@ -51,6 +55,7 @@ impl DenoiseOptions {
             threads,
             prefilter_guides: true,
             layers: false,
+            max_memory_mb: None,
         }
     }
 }
@@ -80,7 +85,7 @@ pub fn denoise_with(
     let size = (input.width as usize, input.height as usize);
     if opts.prefilter_guides {
         for (name, guide) in [("albedo", &mut albedo), ("normal", &mut normal)] {
-            let f = device.filter()?;
+            let f = device.filter_capped(opts.max_memory_mb)?;
             let p = guide.as_mut_ptr().cast::<c_void>();
             f.image(name, p, size);
             f.image("output", p, size);
@@ -90,7 +95,7 @@ pub fn denoise_with(
     let mut outs = Vec::with_capacity(1 + more.len());
     for color in std::iter::once(input.color).chain(more.iter().copied()) {
         let mut out = vec![Vec3::ZERO; color.len()];
-        let f = device.filter()?;
+        let f = device.filter_capped(opts.max_memory_mb)?;
         f.image("color", color.as_ptr().cast_mut().cast(), size);
         f.image("albedo", albedo.as_mut_ptr().cast(), size);
         f.image("normal", normal.as_mut_ptr().cast(), size);
@@ -188,6 +193,16 @@ impl Device {
         }
     }
 
+    /// A new `RT` filter on this device, its scratch memory capped at
+    /// `max_memory_mb` when that is given.
+    fn filter_capped(&self, max_memory_mb: Option<u32>) -> Result<Filter<'_>, Error> {
+        let f = self.filter()?;
+        if let Some(mb) = max_memory_mb {
+            f.int("maxMemoryMB", i32::try_from(mb).unwrap_or(i32::MAX));
+        }
+        Ok(f)
+    }
+
     /// A new `RT` filter on this device.
     fn filter(&self) -> Result<Filter<'_>, Error> {
         let ty = CString::new("RT").expect("no NUL");
@@ -254,6 +269,12 @@ impl Filter<'_> {
         let key = CString::new(name).expect("no NUL");
         // SAFETY: a live filter; a NUL-terminated name.
         unsafe { (self.device.api.set_filter_bool)(self.raw, key.as_ptr(), on) };
+    }
+
+    fn int(&self, name: &str, v: i32) {
+        let key = CString::new(name).expect("no NUL");
+        // SAFETY: a live filter; a NUL-terminated name.
+        unsafe { (self.device.api.set_filter_int)(self.raw, key.as_ptr(), v) };
     }
 }
 
