@@ -7,8 +7,8 @@
 
 use std::fmt::Write as _;
 
+use super::compare::{ladder_of, time_sentence};
 use super::config::{self, Axis, Config};
-use super::report::{ladder_of, time_sentence};
 use super::results::Row;
 
 /// The configurations whose convergence the report tabulates: the

@@ -15,6 +15,7 @@
 //! [`results`], [`plots`] and [`report`].
 
 pub mod cli;
+mod compare;
 pub mod config;
 mod convergence;
 mod denoised;
@@ -44,7 +45,7 @@ use lucent::sampling::SamplerKind;
 use lucent::scene::{self, Camera, Scene};
 pub use reference::{Fnv1a, ReferenceInfo, REFERENCE_SEED_OFFSET};
 use results::{Results, Row};
-pub use resume::slug;
+pub use running::slug;
 pub use settings::Settings;
 
 use lucent::Error;

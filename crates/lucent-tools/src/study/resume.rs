@@ -19,19 +19,6 @@ use lucent::film;
 use lucent::scene::Scene;
 use lucent::Error;
 
-/// A configuration name as a file name: "radius=table:16" → "radius_table_16".
-pub fn slug(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
-}
-
 /// Rows in `results.csv` are only comparable (and only resumable) under the
 /// settings that made them: the same reference (which covers the scene,
 /// resolution and reference settings), base seed, firefly factor and

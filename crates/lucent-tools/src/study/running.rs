@@ -8,7 +8,6 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use super::input_file::read_film;
-use super::resume::slug;
 use super::runtime;
 use lucent::denoise::frame::GUIDES;
 use lucent::film::layers::Layer;
@@ -137,4 +136,17 @@ pub(super) fn state_files(dir: &Path, config: &str, spp: u32) -> [PathBuf; 3] {
             .join(format!("{}-{spp}{suffix}.exr", slug(config)))
     };
     [name(""), name("-albedo"), name("-normal")]
+}
+
+/// A configuration name as a file name: "radius=table:16" → "radius_table_16".
+pub fn slug(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
