@@ -113,6 +113,20 @@ mod tests {
     use crate::film::passes::Pass;
 
     #[test]
+    fn light_layers_are_rgb_radiance_and_not_already_denoised() {
+        let ch = |c: &[&str]| c.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let (rgb, rgba) = (ch(&["R", "G", "B"]), ch(&["R", "G", "B", "A"]));
+        assert!(is_denoisable("diffuse_direct", LayerKind::Light, &rgb));
+        assert!(is_denoisable("RGBA_key", LayerKind::Light, &rgba));
+        assert!(!is_denoisable("albedo", LayerKind::Data, &rgb));
+        assert!(!is_denoisable("N", LayerKind::Data, &ch(&["X", "Y", "Z"])));
+        assert!(!is_denoisable(LAYER, LayerKind::Light, &rgb));
+        assert!(!is_denoisable("denoised_RGBA_key", LayerKind::Light, &rgb));
+        assert_eq!(layer_name("RGBA_key"), "denoised_RGBA_key");
+        assert!(!layer_name("RGBA_key").starts_with("RGBA_"));
+    }
+
+    #[test]
     fn the_guides_are_the_albedo_and_normal_passes() {
         assert_eq!(GUIDES[0].0, Pass::Albedo.name());
         assert_eq!(GUIDES[1].0, Pass::Normal.name());
