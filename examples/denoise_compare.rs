@@ -90,6 +90,8 @@ fn main() {
             let opts = DenoiseOptions {
                 threads: Some(threads),
                 prefilter_guides,
+                layers: false,
+                max_memory_mb: None,
             };
             let t = Instant::now();
             let out = denoise(&input, &opts).unwrap_or_else(|e| panic!("{path}: {e}"));

@@ -29,6 +29,14 @@ pub(crate) struct DenoiseArgs {
     /// Exposure of the PNG preview in stops.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = exposure_stops)]
     exposure: f32,
+    /// Also denoise each light path and light group layer, as
+    /// `denoised_<layer>`, with the beauty's guides.
+    #[arg(long)]
+    layers: bool,
+    /// OIDN's scratch memory cap in MB (it then denoises in overlapping
+    /// tiles; default: OIDN's own).
+    #[arg(long, value_name = "MB")]
+    max_memory: Option<u32>,
     /// No summary line.
     #[arg(short, long)]
     quiet: bool,
@@ -41,7 +49,11 @@ pub(crate) fn run(a: DenoiseArgs) -> Result<(), Error> {
         exposure: a.exposure,
     };
     let output = a.output.unwrap_or_else(|| a.frame.clone());
-    let opts = DenoiseOptions::with_threads(a.threads);
+    let opts = DenoiseOptions {
+        layers: a.layers,
+        max_memory_mb: a.max_memory,
+        ..DenoiseOptions::with_threads(a.threads)
+    };
     let d = session::denoise_file(&a.frame, &output, preview, &opts)?;
     if !a.quiet {
         // a closed stderr drops the line; the exit status still tells

@@ -155,6 +155,14 @@ enum Command {
         /// split render after the merge (docs/output.md, "Denoising").
         #[arg(long)]
         denoise: bool,
+        /// With --denoise, also each light path and light group layer, as
+        /// `denoised_<layer>`, with the beauty's guides.
+        #[arg(long, requires = "denoise")]
+        denoise_layers: bool,
+        /// With --denoise, OIDN's scratch memory cap in MB (it then
+        /// denoises in overlapping tiles; default: OIDN's own).
+        #[arg(long, requires = "denoise", value_name = "MB")]
+        denoise_memory: Option<u32>,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
         #[command(flatten)]
@@ -193,6 +201,14 @@ enum Command {
         /// passes (docs/output.md, "Denoising").
         #[arg(long)]
         denoise: bool,
+        /// With --denoise, also each light path and light group layer, as
+        /// `denoised_<layer>`, with the beauty's guides.
+        #[arg(long, requires = "denoise")]
+        denoise_layers: bool,
+        /// With --denoise, OIDN's scratch memory cap in MB (it then
+        /// denoises in overlapping tiles; default: OIDN's own).
+        #[arg(long, requires = "denoise", value_name = "MB")]
+        denoise_memory: Option<u32>,
         /// The denoiser's threads, 1 to 1024 (default: all cores).
         #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
         threads: Option<usize>,
@@ -360,6 +376,8 @@ fn main() -> ExitCode {
             explain,
             stats,
             denoise,
+            denoise_layers,
+            denoise_memory,
             subsurface,
             file,
             split,
@@ -408,7 +426,11 @@ fn main() -> ExitCode {
                         tonemap: tonemap.into(),
                         exposure,
                     },
-                    denoise: denoise.then(|| DenoiseOptions::with_threads(threads)),
+                    denoise: denoise.then(|| DenoiseOptions {
+                        layers: denoise_layers,
+                        max_memory_mb: denoise_memory,
+                        ..DenoiseOptions::with_threads(threads)
+                    }),
                 };
                 run_render(&r, quiet)
             })
@@ -421,13 +443,19 @@ fn main() -> ExitCode {
             quiet,
             mixed_backends,
             denoise,
+            denoise_layers,
+            denoise_memory,
             threads,
         } => {
             let preview = Preview {
                 tonemap: tonemap.into(),
                 exposure,
             };
-            let d = denoise.then(|| DenoiseOptions::with_threads(threads));
+            let d = denoise.then(|| DenoiseOptions {
+                layers: denoise_layers,
+                max_memory_mb: denoise_memory,
+                ..DenoiseOptions::with_threads(threads)
+            });
             session::merge_parts(&parts, &output, preview, mixed_backends, d.as_ref()).map(|m| {
                 if !quiet {
                     tell!("{}", m.summary(&output));

@@ -34,7 +34,7 @@ fn lucent() -> Command {
 }
 
 /// Whether OIDN is there to test; panics when it must be and is not.
-fn have_oidn() -> bool {
+pub(crate) fn have_oidn() -> bool {
     if std::env::var_os("LUCENT_OIDN").is_some() {
         return true;
     }
@@ -62,7 +62,7 @@ fn small_scene(dir: &Path) -> PathBuf {
     p
 }
 
-fn run(args: &[&str]) -> Output {
+pub(crate) fn run(args: &[&str]) -> Output {
     let out = lucent().args(args).output().unwrap();
     assert!(
         out.status.success(),
@@ -106,7 +106,7 @@ fn frames() -> &'static Frames {
 }
 
 /// Every channel of the EXR at `path`, as floats.
-fn channels(path: &Path) -> BTreeMap<String, Vec<f32>> {
+pub(crate) fn channels(path: &Path) -> BTreeMap<String, Vec<f32>> {
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -128,14 +128,14 @@ fn channels(path: &Path) -> BTreeMap<String, Vec<f32>> {
 }
 
 /// The three channels `names` as pixels.
-fn rgb(ch: &BTreeMap<String, Vec<f32>>, names: [&str; 3]) -> Vec<Vec3> {
+pub(crate) fn rgb(ch: &BTreeMap<String, Vec<f32>>, names: [&str; 3]) -> Vec<Vec3> {
     let [r, g, b] = names.map(|n| &ch[n]);
     (0..r.len()).map(|i| Vec3::new(r[i], g[i], b[i])).collect()
 }
 
 /// Relative MSE against `reference` (mean over pixels and channels of
 /// (x - r)² / (r² + 0.01)).
-fn rel_mse(x: &[Vec3], reference: &[Vec3]) -> f64 {
+pub(crate) fn rel_mse(x: &[Vec3], reference: &[Vec3]) -> f64 {
     let mut s = 0.0;
     for (a, r) in x.iter().zip(reference) {
         for c in 0..3 {

@@ -11,6 +11,7 @@ mod aov;
 mod bench_cli;
 mod cli;
 mod denoise;
+mod denoise_layers;
 mod environment_image;
 mod exr_oiio;
 mod farm;
@@ -24,6 +25,8 @@ mod scene_errors;
 mod session;
 #[cfg(feature = "subsurface")]
 mod study;
+#[cfg(feature = "subsurface")]
+mod study_convergence;
 mod subsurface_feature;
 mod textures;
 mod transparent;

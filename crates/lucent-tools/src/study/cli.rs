@@ -42,7 +42,7 @@ pub struct StudyArgs {
     firefly_k: f64,
     /// Only these axes (comma separated: radius, rmax, axes, channel,
     /// renormalize, exit_sw, specular, backend, integrator, boundary, lod,
-    /// variance); the baseline always runs.
+    /// variance, sampler, denoise); the baseline always runs.
     #[arg(long, value_delimiter = ',', value_parser = parse_study_axis)]
     only: Vec<super::Axis>,
     /// No progress bars.
@@ -92,6 +92,12 @@ pub fn run_study(a: StudyArgs) -> Result<(), Error> {
     s.only = a.only;
     s.progress = !a.quiet;
     let o = super::run(&s)?;
+    if let Some(why) = &o.no_denoise {
+        let _ = writeln!(
+            std::io::stderr(),
+            "no denoised curve: Open Image Denoise is unavailable ({why})"
+        );
+    }
     if !a.quiet {
         let _ = writeln!(
             std::io::stderr(),

@@ -14,6 +14,7 @@ use lucent::bssrdf::{ChannelStrategy, ProbeAxes, ProbeOptions, RadiusSampler, Ta
 use lucent::error::ParamError;
 use lucent::integrator::IntegratorKind;
 use lucent::materials::{LodMode, Material, WalkBoundary};
+use lucent::sampling::SamplerKind;
 use lucent::scene::Scene;
 
 /// Which choice a configuration varies from the baseline.
@@ -40,10 +41,18 @@ pub enum Axis {
     /// probe pair and both
     /// (`lucent::integrator::control_variate`).
     Variance,
+    /// The other sampler than the scene's (by default the pseudo-random
+    /// stream against the Sobol' sequence), for the diffusion estimator
+    /// and for the random walk: sampler × estimator.
+    Sampler,
+    /// The baseline with its guides (albedo, normal) rendered too and
+    /// every rung's image denoised by Open Image Denoise; its time
+    /// includes the denoise.
+    Denoise,
 }
 
 impl Axis {
-    pub const ALL: [Axis; 13] = [
+    pub const ALL: [Axis; 15] = [
         Axis::Baseline,
         Axis::Radius,
         Axis::RmaxQuantile,
@@ -57,6 +66,8 @@ impl Axis {
         Axis::Boundary,
         Axis::Lod,
         Axis::Variance,
+        Axis::Sampler,
+        Axis::Denoise,
     ];
 
     /// The name used in configuration names and the CSV.
@@ -75,6 +86,8 @@ impl Axis {
             Axis::Boundary => "boundary",
             Axis::Lod => "lod",
             Axis::Variance => "variance",
+            Axis::Sampler => "sampler",
+            Axis::Denoise => "denoise",
         }
     }
 
@@ -99,6 +112,10 @@ pub struct Config {
     pub overrides: Overrides,
     pub backend: Backend,
     pub integrator: IntegratorKind,
+    /// The sampler (the scene's but on the sampler axis).
+    pub sampler: SamplerKind,
+    /// Each rung's image denoised (with the guides rendered beside it).
+    pub denoise: bool,
 }
 
 /// "uniform", "table:N" (tail-spaced), "table-uniform:N", "analytic",
@@ -196,6 +213,9 @@ struct Matrix {
     /// The baseline's overrides, which every variation starts from.
     base: Overrides,
     base_backend: Backend,
+    /// The scene's sampler, which every configuration but the sampler
+    /// axis's keeps.
+    sampler: SamplerKind,
 }
 
 impl Matrix {
@@ -214,6 +234,8 @@ impl Matrix {
             overrides: ov,
             backend,
             integrator,
+            sampler: self.sampler,
+            denoise: false,
         });
     }
 
@@ -290,9 +312,12 @@ pub fn matrix(
             overrides: base_ov.clone(),
             backend: base_backend,
             integrator: IntegratorKind::Path,
+            sampler: scene.settings.sampler,
+            denoise: false,
         }],
         base: base_ov.clone(),
         base_backend,
+        sampler: scene.settings.sampler,
     };
     for r in radius_values(quick) {
         m.vary(
@@ -415,7 +440,40 @@ pub fn matrix(
             IntegratorKind::RandomWalk,
         );
     }
+    sampler_and_denoise(&mut m, quick);
     Ok(m.out)
+}
+
+/// The sampler axis (the other sampler, for the diffusion estimator and,
+/// unless `quick`, for the random walk) and the denoised baseline.
+fn sampler_and_denoise(m: &mut Matrix, quick: bool) {
+    let other = match m.sampler {
+        SamplerKind::Sobol => SamplerKind::Random,
+        SamplerKind::Random => SamplerKind::Sobol,
+    };
+    let base = m.base.clone();
+    let estimators = [
+        (IntegratorKind::Path, ""),
+        (IntegratorKind::RandomWalk, "+randomwalk"),
+    ];
+    for &(integrator, suffix) in &estimators[..if quick { 1 } else { 2 }] {
+        m.add(
+            Axis::Sampler,
+            format!("{}{suffix}", other.name()),
+            base.clone(),
+            m.base_backend,
+            integrator,
+        );
+        m.out.last_mut().expect("just added").sampler = other;
+    }
+    m.add(
+        Axis::Denoise,
+        "oidn".into(),
+        base,
+        m.base_backend,
+        IntegratorKind::Path,
+    );
+    m.out.last_mut().expect("just added").denoise = true;
 }
 
 /// `scene` with every subsurface material rebuilt with `ov` applied to its

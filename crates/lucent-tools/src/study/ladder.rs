@@ -1,27 +1,33 @@
 //! The progressive ladder of sample counts 1, 2, 4, … every configuration
 //! is rendered at.
 //!
-//! Rung j adds a chunk of 2^j − 2^(j−1) samples (1 at j = 0) with seed
-//! `seed + j` to the running mean: with a the previous count and n the new
-//! one, mean_n = (a/n)·mean_a + ((n − a)/n)·chunk (each pixel mixed in
-//! f64, stored as f32). So the image at 2^j spp costs 2^j spp of render time in total
-//! (not 2^(j+1) − 1), and its time is the sum of the chunks' wall times.
+//! Rung j renders samples 2^(j−1) .. 2^j (0 .. 1 at j = 0) of the one
+//! seed, the sample split farm parts use (`lucent::render::Job`), and
+//! mixes them into the running mean ([`Running`]): the image at 2^j spp
+//! is the single render of 2^j samples up to the rounding of the mix, so
+//! a sequence sampler's points continue across rungs instead of starting
+//! over. It costs 2^j spp of render time in total (not 2^(j+1) − 1), and
+//! its time is the sum of the chunks' wall times, plus the denoise of
+//! that rung's image when the configuration denoises ([`denoised`]).
 //! Rungs are rendered round-robin (every configuration's rung j before any
 //! rung j + 1), so load drift on a shared machine spreads over all
 //! configurations instead of penalizing whichever ran in a busy minute.
 
 use std::fs;
+use std::ops::Range;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::config::{self, Config};
+use super::denoised;
 use super::metrics;
 use super::results::{Results, Row};
-use super::resume::{slug, state_path, Job};
+use super::resume::Job;
+use super::running::{slug, Guides, Running};
 use super::settings::Settings;
 use super::{render_opts, runtime};
+use lucent::film::passes::{Pass, PassSet};
 use lucent::film::{Film, ToneMap};
-use lucent::geometry::Vec3;
 use lucent::render;
 use lucent::Error;
 
@@ -70,7 +76,7 @@ pub(super) struct Ladder<'a> {
     /// The acceleration structure of each backend, by name.
     pub(super) accels: &'a super::Accels,
     pub(super) reference: &'a Film,
-    /// The base seed: rung j renders with `seed + j`.
+    /// The seed every rung renders with (its own range of samples).
     pub(super) seed: u64,
 }
 
@@ -110,43 +116,21 @@ impl Ladder<'_> {
         let prev_n = if j == 0 { 0 } else { self.spps[j - 1] };
         let c = job.config;
         bar.set_message(format!("{} @ {n} spp", c.name));
-        let (film, stats) = render::render(
-            &job.scene,
-            self.accels[&(
-                c.backend.name(),
-                c.integrator.traversal(job.scene.settings.traversal),
-            )]
-                .as_ref(),
-            &render_opts(
-                s,
-                n - prev_n,
-                self.seed.wrapping_add(j as u64),
-                c.integrator,
-                false,
-            ),
-        )
-        .map_err(runtime)?;
-        let (mean, seconds) = match job.acc.take() {
-            None => (film, stats.seconds),
-            Some((mut m, t)) => {
-                let (a, b) = (prev_n as f64 / n as f64, (n - prev_n) as f64 / n as f64);
-                for (p, q) in m.pixels.iter_mut().zip(&film.pixels) {
-                    let mix = |x: f32, y: f32| (a * x as f64 + b * y as f64) as f32;
-                    *p = Vec3::new(mix(p.x, q.x), mix(p.y, q.y), mix(p.z, q.z));
-                }
-                (m, t + stats.seconds)
-            }
+        let chunk = self.chunk(job, prev_n..n)?;
+        let mean = match job.acc.take() {
+            None => chunk,
+            Some(m) => m.extended(chunk, prev_n, n),
         };
         // The running mean of the last finished rung, kept also after the
         // last one so a rerun with a larger max_spp extends the ladder.
-        mean.write_exr(&state_path(&s.out_dir, &c.name, n))
-            .map_err(runtime)?;
-        if j > 0 {
-            let _ = fs::remove_file(state_path(&s.out_dir, &c.name, prev_n));
-        }
+        mean.save(&s.out_dir, &c.name, n, prev_n)?;
         let mut appended = false;
         if results.get(&c.name, n).is_none() {
-            let m = metrics::compare(&mean, self.reference, s.firefly_k).map_err(runtime)?;
+            let judged = match &mean.guides {
+                Some(g) => denoised::denoise(&mean.film, g, s.threads)?,
+                None => denoised::Judged::raw(&mean.film),
+            };
+            let m = metrics::compare(&judged.film, self.reference, s.firefly_k).map_err(runtime)?;
             results
                 .append(Row {
                     config: c.name.clone(),
@@ -155,19 +139,66 @@ impl Ladder<'_> {
                     backend: c.backend.name().into(),
                     integrator: config::integrator_name(c.integrator).into(),
                     spp: n,
-                    seconds,
+                    seconds: mean.seconds + judged.seconds,
                     rmse: m.rmse,
                     rel_mse: m.rel_mse,
                     bias: m.bias,
                     bias_stderr: m.bias_stderr,
                     fireflies: m.fireflies,
+                    denoise_seconds: judged.seconds,
                 })
                 .map_err(runtime)?;
             appended = true;
             bar.inc(1);
         }
-        job.acc = Some((mean, seconds));
+        job.acc = Some(mean);
         Ok(appended)
+    }
+
+    /// The mean of the job's samples `samples` of the one seed (with the
+    /// guides when it denoises) and their render time.
+    fn chunk(&self, job: &Job, samples: Range<u32>) -> Result<Running, Error> {
+        let c = job.config;
+        let scene = &job.scene;
+        let mut passes = PassSet::EMPTY;
+        if c.denoise {
+            passes.insert(Pass::Albedo);
+            passes.insert(Pass::Normal);
+        }
+        let work = render::Job {
+            samples,
+            passes,
+            ..render::Job::full(scene, 1)
+        };
+        let accel = self.accels[&(
+            c.backend.name(),
+            c.integrator.traversal(scene.settings.traversal),
+        )]
+            .as_ref();
+        let opts = render_opts(
+            self.settings,
+            1,
+            self.seed,
+            c.integrator,
+            Some(c.sampler),
+            false,
+        );
+        let r = render::render_job(scene, accel, &opts, &work, None, &mut |_| Ok(()))?;
+        if let Some(sig) = r.interrupted {
+            return Err(Error::Interrupted(sig));
+        }
+        let film = r.sums.film()?;
+        let guides = if c.denoise {
+            let (layers, _) = r.sums.layers(false)?;
+            Some(Guides::from_layers(&layers, film.width, film.height)?)
+        } else {
+            None
+        };
+        Ok(Running {
+            film,
+            guides,
+            seconds: r.stats.seconds,
+        })
     }
 }
 
@@ -175,7 +206,7 @@ impl Ladder<'_> {
 /// looking at: `DIR/images/<config>.exr` and `.png`.
 pub(super) fn write_final_images(s: &Settings, jobs: &[Job]) -> Result<(), Error> {
     for job in jobs {
-        if let Some((film, _)) = &job.acc {
+        if let Some(Running { film, .. }) = &job.acc {
             let img = s
                 .out_dir
                 .join("images")

@@ -4,7 +4,8 @@
 //! Renders a matrix of sampling configurations of the subsurface estimator
 //! ([`config`]: a baseline and one-axis-at-a-time variations) at a
 //! progressive ladder of sample counts 1, 2, 4, …, times each render and
-//! measures its error against a long, cached reference render
+//! measures its error (of the image denoised, for the configuration that
+//! denoises) against a long, cached reference render
 //! ([`metrics`]; the reference's seeds are offset by
 //! [`REFERENCE_SEED_OFFSET`], its cache key is [`Fnv1a`]). Writes
 //! `results.csv` ([`results`], resumable), plots ([`plots`]) and
@@ -14,7 +15,10 @@
 //! [`results`], [`plots`] and [`report`].
 
 pub mod cli;
+mod compare;
 pub mod config;
+mod convergence;
+mod denoised;
 mod input_file;
 mod ladder;
 pub mod metrics;
@@ -23,6 +27,7 @@ mod reference;
 pub mod report;
 pub mod results;
 mod resume;
+mod running;
 mod settings;
 
 use std::collections::HashMap;
@@ -36,10 +41,11 @@ use ladder::Ladder;
 use lucent::accel::{self, Accel, Backend, Traversal};
 use lucent::integrator::IntegratorKind;
 use lucent::render::RenderOptions;
+use lucent::sampling::SamplerKind;
 use lucent::scene::{self, Camera, Scene};
 pub use reference::{Fnv1a, ReferenceInfo, REFERENCE_SEED_OFFSET};
 use results::{Results, Row};
-pub use resume::slug;
+pub use running::slug;
 pub use settings::Settings;
 
 use lucent::Error;
@@ -54,6 +60,9 @@ pub struct Outcome {
     pub reference: ReferenceInfo,
     pub report: PathBuf,
     pub plots: Vec<PathBuf>,
+    /// Why the denoised configuration was left out (Open Image Denoise
+    /// could not be loaded), if it was.
+    pub no_denoise: Option<String>,
 }
 
 /// The scene at the study's resolution (the scene's aspect, `width` wide).
@@ -70,12 +79,13 @@ fn render_opts(
     spp: u32,
     seed: u64,
     integrator: IntegratorKind,
+    sampler: Option<SamplerKind>,
     progress: bool,
 ) -> RenderOptions {
     RenderOptions {
         spp: Some(spp),
         seed: Some(seed),
-        sampler: None,
+        sampler,
         threads: s.threads,
         progress: progress.then(crate::progress::Bar::sink),
         integrator,
@@ -122,11 +132,20 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
     if backends[0] == Backend::Embree {
         backends.push(Backend::Bvh);
     }
-    let configs: Vec<Config> = config::matrix(&scene, s.quick, &backends)
+    let mut configs: Vec<Config> = config::matrix(&scene, s.quick, &backends)
         .map_err(|e| Error::Input(e.to_string()))?
         .into_iter()
         .filter(|c| c.axis == Axis::Baseline || s.only.is_empty() || s.only.contains(&c.axis))
         .collect();
+    // Without the denoiser there is no denoised curve, never a stand-in.
+    let no_denoise = configs
+        .iter()
+        .any(|c| c.denoise)
+        .then(denoised::unavailable)
+        .flatten();
+    if no_denoise.is_some() {
+        configs.retain(|c| !c.denoise);
+    }
     // A directory whose results cannot be resumed is refused before
     // anything is written in it (no state/, no cached reference).
     let csv = s.out_dir.join("results.csv");
@@ -167,16 +186,13 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
         .cloned()
         .collect();
     let plots = plots::write_all(&s.out_dir, &rows, &configs).map_err(runtime)?;
-    let report = report::write(
-        s,
-        &scene,
-        &configs,
-        &rows,
-        &ref_info,
-        &plots,
-        started.elapsed().as_secs_f64(),
-    )
-    .map_err(runtime)?;
+    let made = report::Made {
+        reference: &ref_info,
+        plots: &plots,
+        no_denoise: no_denoise.as_deref(),
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    let report = report::write(s, &scene, &configs, &rows, &made).map_err(runtime)?;
     Ok(Outcome {
         configs,
         rows,
@@ -184,5 +200,6 @@ pub fn run(s: &Settings) -> Result<Outcome, Error> {
         reference: ref_info,
         report,
         plots,
+        no_denoise,
     })
 }

@@ -1,8 +1,12 @@
 //! The study's plots, as PNG files drawn with plotters into a memory buffer
 //! and encoded with `image` (no system graphics libraries):
 //!
-//! - `error-vs-time.png`: RMSE against render time, log-log, one line per
-//!   configuration (lower-left is better: less error for less time);
+//! - `error-vs-time.png`: RMSE against time (render, plus denoise for the
+//!   denoised configuration), log-log, one line per configuration
+//!   (lower-left is better: less error for less time);
+//! - `relmse-spp.png`: relMSE × spp against spp, log-log, for the sampler
+//!   × estimator and denoised configurations (flat for independent
+//!   samples);
 //! - `bias-vs-rmax.png`: mean bias at the largest sample count against the
 //!   Rmax quantile, as "nines" −log10(1 − q), with ±2σ bars;
 //! - `bias-vs-table.png`: the same against the table size of the tabulated
@@ -47,34 +51,68 @@ fn last_row<'a>(rows: &'a [Row], config: &str) -> Option<&'a Row> {
     rows_of(rows, config).last().copied()
 }
 
-fn error_vs_time(path: &Path, rows: &[Row], configs: &[Config]) -> Result<bool, PlotError> {
-    let Some(xr) = log_range(rows.iter().map(|r| r.seconds)) else {
+/// A log-log chart of one line per configuration through its rungs.
+struct LineChart {
+    caption: &'static str,
+    x_desc: &'static str,
+    y_desc: &'static str,
+    x: fn(&Row) -> f64,
+    y: fn(&Row) -> f64,
+}
+
+/// RMSE against time (render, and denoise where a configuration
+/// denoises).
+const ERROR_VS_TIME: LineChart = LineChart {
+    caption: "RMSE vs time (log-log; lower left is better)",
+    x_desc: "render (+ denoise) time [s]",
+    y_desc: "RMSE",
+    x: |r| r.seconds,
+    y: |r| r.rmse,
+};
+
+/// relMSE × spp against spp: flat for independent samples.
+const RELMSE_SPP: LineChart = LineChart {
+    caption: "relMSE × spp vs spp (flat: error ∝ 1/spp)",
+    x_desc: "samples per pixel",
+    y_desc: "relMSE × spp",
+    x: |r| r.spp as f64,
+    y: |r| r.rel_mse * r.spp as f64,
+};
+
+fn line_chart(
+    path: &Path,
+    spec: &LineChart,
+    rows: &[Row],
+    configs: &[&Config],
+) -> Result<bool, PlotError> {
+    let mine: Vec<&Row> = rows
+        .iter()
+        .filter(|r| configs.iter().any(|c| c.name == r.config))
+        .collect();
+    let Some(xr) = log_range(mine.iter().map(|r| (spec.x)(r))) else {
         return Ok(false);
     };
-    let Some(yr) = log_range(rows.iter().map(|r| r.rmse)) else {
+    let Some(yr) = log_range(mine.iter().map(|r| (spec.y)(r))) else {
         return Ok(false);
     };
     png(path, |root| {
         let mut chart = ChartBuilder::on(&root)
-            .caption(
-                "RMSE vs render time (log-log; lower left is better)",
-                (FONT, 24),
-            )
+            .caption(spec.caption, (FONT, 24))
             .margin(16)
             .x_label_area_size(50)
             .y_label_area_size(80)
             .build_cartesian_2d(xr.log_scale(), yr.log_scale())?;
         chart
             .configure_mesh()
-            .x_desc("render time [s]")
-            .y_desc("RMSE")
+            .x_desc(spec.x_desc)
+            .y_desc(spec.y_desc)
             .label_style((FONT, 15))
             .axis_desc_style((FONT, 17))
             .draw()?;
         for (i, c) in configs.iter().enumerate() {
             let pts: Vec<(f64, f64)> = rows_of(rows, &c.name)
                 .iter()
-                .map(|r| (r.seconds, r.rmse))
+                .map(|r| ((spec.x)(r), (spec.y)(r)))
                 .filter(|&(t, e)| t > 0.0 && e > 0.0)
                 .collect();
             if pts.is_empty() {
@@ -211,8 +249,14 @@ pub(crate) fn write_all(
 ) -> Result<Vec<PathBuf>, PlotError> {
     ensure_font()?;
     let mut out = Vec::new();
+    let all: Vec<&Config> = configs.iter().collect();
     let p = dir.join("error-vs-time.png");
-    if error_vs_time(&p, rows, configs)? {
+    if line_chart(&p, &ERROR_VS_TIME, rows, &all)? {
+        out.push(p);
+    }
+    let compared: Vec<&Config> = super::convergence::compared(configs).collect();
+    let p = dir.join("relmse-spp.png");
+    if compared.len() >= 2 && line_chart(&p, &RELMSE_SPP, rows, &compared)? {
         out.push(p);
     }
 

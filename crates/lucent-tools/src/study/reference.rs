@@ -24,8 +24,8 @@ use lucent::render;
 use lucent::scene::Scene;
 use lucent::Error;
 
-/// The reference's seed is the study's seed plus this: far from the ladder's
-/// seeds (seed + 0 … seed + 30).
+/// The reference's seed is the study's seed plus this: another seed than
+/// the ladder's, so its noise is independent of the images it judges.
 pub const REFERENCE_SEED_OFFSET: u64 = 1_000_003;
 
 /// How the reference image was made.
@@ -159,7 +159,7 @@ pub(super) fn reference(
     let (film, stats) = render::render(
         &ref_scene,
         accel,
-        &render_opts(s, s.reference_spp, ref_seed, s.reference, s.progress),
+        &render_opts(s, s.reference_spp, ref_seed, s.reference, None, s.progress),
     )
     .map_err(runtime)?;
     film.write_exr_and_preview(&path, ToneMap::Filmic, 0.0)

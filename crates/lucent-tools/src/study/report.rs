@@ -10,18 +10,14 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use super::compare::{ladder_of, time_sentence};
 use super::config::{self, Axis, Config};
+use super::convergence;
 use super::metrics::time_to_reach;
 use super::results::Row;
 use super::{ReferenceInfo, Settings};
 use lucent::film::atomic_write;
 use lucent::scene::Scene;
-
-fn ladder_of<'a>(rows: &'a [Row], config: &str) -> Vec<&'a Row> {
-    let mut v: Vec<&Row> = rows.iter().filter(|r| r.config == config).collect();
-    v.sort_by_key(|r| r.spp);
-    v
-}
 
 /// The command line that reproduces the study.
 pub(crate) fn command_line(s: &Settings) -> String {
@@ -66,6 +62,16 @@ fn fmt_opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
     v.map(f).unwrap_or_else(|| "—".into())
 }
 
+/// What a run made besides the rows, for its report.
+pub struct Made<'a> {
+    pub reference: &'a ReferenceInfo,
+    pub plots: &'a [PathBuf],
+    /// Why there is no denoised curve, if there is none.
+    pub no_denoise: Option<&'a str>,
+    /// How long this run took.
+    pub seconds: f64,
+}
+
 /// Writes `DIR/report.md`; returns its path, or why it could not be written
 /// (`cannot write PATH: …`).
 pub fn write(
@@ -73,10 +79,14 @@ pub fn write(
     scene: &Scene,
     configs: &[Config],
     rows: &[Row],
-    reference: &ReferenceInfo,
-    plots: &[PathBuf],
-    run_seconds: f64,
+    made: &Made,
 ) -> Result<PathBuf, lucent::Error> {
+    let Made {
+        reference,
+        plots,
+        no_denoise,
+        seconds: run_seconds,
+    } = *made;
     let path = s.out_dir.join("report.md");
     let name = s
         .scene
@@ -88,10 +98,21 @@ pub fn write(
     writeln!(r, "# Accuracy vs time: {name}\n").unwrap();
     writeln!(r, "Reproduce with:\n\n    {}\n", command_line(s)).unwrap();
     setup_section(&mut r, s, scene, configs, reference, run_seconds);
+    if let Some(why) = no_denoise {
+        writeln!(
+            r,
+            "**No denoised curve:** Open Image Denoise is unavailable ({why}).\n"
+        )
+        .unwrap();
+    }
     let pixels = (w as f64) * (h as f64);
     results_table(&mut r, configs, rows, pixels);
+    convergence::table(&mut r, configs, rows);
     writeln!(r, "## Headlines\n").unwrap();
-    for h in headlines(configs, rows, pixels) {
+    for h in headlines(configs, rows, pixels)
+        .into_iter()
+        .chain(convergence::headlines(configs, rows))
+    {
         writeln!(r, "- {h}").unwrap();
     }
     writeln!(r).unwrap();
@@ -135,7 +156,8 @@ fn setup_section(
         .collect();
     writeln!(
         r,
-        "- Sample-count ladder {} (progressive: rung j adds a chunk with seed base + j; times are cumulative wall time).",
+        "- Sample-count ladder {} (progressive: rung j adds the next range of samples of the one seed, as a farm's parts split them; \
+         times are cumulative wall time, with the denoise of that rung's image for a denoising configuration).",
         spps.join(", ")
     )
     .unwrap();
@@ -232,35 +254,6 @@ fn results_table(r: &mut String, configs: &[Config], rows: &[Row], pixels: f64) 
         "\n\"—\" in *time to baseline RMSE*: the ladder never got that low (noise or bias).\n"
     )
     .unwrap();
-}
-
-/// How much less time `a` needs than `b` to reach `b`'s final RMSE.
-fn time_sentence(rows: &[Row], a: &str, a_label: &str, b: &str, b_label: &str) -> Option<String> {
-    let (la, lb) = (ladder_of(rows, a), ladder_of(rows, b));
-    let (a_last, b_last) = (la.last()?, lb.last()?);
-    let pts: Vec<(f64, f64)> = la.iter().map(|x| (x.seconds, x.rmse)).collect();
-    Some(match time_to_reach(&pts, b_last.rmse) {
-        Some(t) if t > 0.0 => {
-            let ratio = b_last.seconds / t;
-            format!(
-                "{a_label} reaches the RMSE of {b_label} at {} spp ({:.3e}, {:.3} s) in {:.3} s: {}.",
-                b_last.spp,
-                b_last.rmse,
-                b_last.seconds,
-                t,
-                if ratio >= 1.0 {
-                    format!("{ratio:.2}× less time")
-                } else {
-                    format!("{:.2}× more time", 1.0 / ratio)
-                }
-            )
-        }
-        _ => format!(
-            "{a_label} never reaches the RMSE of {b_label} at {} spp ({:.3e}) within its ladder \
-             (its own final RMSE: {:.3e} at {} spp, {:.3} s).",
-            b_last.spp, b_last.rmse, a_last.rmse, a_last.spp, a_last.seconds
-        ),
-    })
 }
 
 fn bias_text(r: &Row) -> String {

@@ -15,7 +15,7 @@ use lucent::film::atomic_write;
 pub const MAX_SECONDS: f64 = 3.2e7;
 
 pub const HEADER: &str =
-    "config,axis,value,backend,integrator,spp,seconds,rmse,relmse,bias,bias_stderr,fireflies";
+    "config,axis,value,backend,integrator,spp,seconds,rmse,relmse,bias,bias_stderr,fireflies,denoise_seconds";
 
 /// Why a results file cannot be read, written or appended to.
 #[derive(Debug, thiserror::Error)]
@@ -61,20 +61,24 @@ pub struct Row {
     pub backend: String,
     pub integrator: String,
     pub spp: u32,
-    /// Wall-clock render time of all samples up to this count.
+    /// Wall-clock time of the image: the render of all samples up to this
+    /// count, plus its denoise when the configuration denoises.
     pub seconds: f64,
     pub rmse: f64,
     pub rel_mse: f64,
     pub bias: f64,
     pub bias_stderr: f64,
     pub fireflies: u64,
+    /// The share of `seconds` spent denoising this rung's image (0 when
+    /// the configuration does not denoise).
+    pub denoise_seconds: f64,
 }
 
 impl Row {
     fn to_line(&self) -> String {
         // `{}` prints the shortest decimal that reads back to the same f64.
         format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
             self.config,
             self.axis,
             self.value,
@@ -86,13 +90,14 @@ impl Row {
             self.rel_mse,
             self.bias,
             self.bias_stderr,
-            self.fireflies
+            self.fireflies,
+            self.denoise_seconds
         )
     }
 
     fn parse(line: &str) -> Option<Row> {
         let f: Vec<&str> = line.split(',').collect();
-        if f.len() != 12 {
+        if f.len() != 13 {
             return None;
         }
         let row = Row {
@@ -108,6 +113,7 @@ impl Row {
             bias: f[9].parse().ok()?,
             bias_stderr: f[10].parse().ok()?,
             fireflies: f[11].parse().ok()?,
+            denoise_seconds: f[12].parse().ok()?,
         };
         // a row no run writes (seconds of 1e308, a NaN error) is dropped
         // like a torn one, so no plot is asked to span it
@@ -117,9 +123,12 @@ impl Row {
             row.rel_mse,
             row.bias,
             row.bias_stderr,
+            row.denoise_seconds,
         ];
-        (measures.iter().all(|v| v.is_finite()) && (0.0..=MAX_SECONDS).contains(&row.seconds))
-            .then_some(row)
+        (measures.iter().all(|v| v.is_finite())
+            && (0.0..=MAX_SECONDS).contains(&row.seconds)
+            && (0.0..=row.seconds).contains(&row.denoise_seconds))
+        .then_some(row)
     }
 }
 
@@ -241,6 +250,7 @@ mod tests {
             bias: -0.000123456789,
             bias_stderr: 2.5e-5,
             fireflies: 7,
+            denoise_seconds: 0.05,
         }
     }
 

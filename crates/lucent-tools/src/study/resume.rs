@@ -1,46 +1,28 @@
 //! Resuming a study: nothing already rendered is rendered again.
 //!
-//! The running mean after each rung of a configuration's ladder is kept in
-//! `DIR/state/<config>-<spp>.exr` (only the last finished rung's, also
+//! The running mean after each rung of a configuration's ladder
+//! ([`Running`]) is kept in `DIR/state/<config>-<spp>.exr`, with
+//! `-albedo` and `-normal` guides when it denoises (only the last finished rung's, also
 //! after the last rung, so a rerun with a larger `max_spp` extends the
 //! ladder); a configuration resumes after the last rung whose CSV row and
 //! running mean both exist and below which every row exists. Rows are
 //! only resumed under the settings that made them ([`check_results_key`]).
 
-use std::path::{Path, PathBuf};
-
 use super::config::{self, Config};
-use super::input_file::{read_film, read_text};
+use super::input_file::read_text;
 use super::reference::ReferenceInfo;
 use super::results::Results;
+use super::running::Running;
 use super::runtime;
 use super::settings::Settings;
-use lucent::film::{self, Film};
+use lucent::film;
 use lucent::scene::Scene;
 use lucent::Error;
 
-/// A configuration name as a file name: "radius=table:16" → "radius_table_16".
-pub fn slug(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
-}
-
-/// Where the running mean of `config` after `spp` samples is kept.
-pub(super) fn state_path(dir: &Path, config: &str, spp: u32) -> PathBuf {
-    dir.join("state")
-        .join(format!("{}-{spp}.exr", slug(config)))
-}
-
 /// Rows in `results.csv` are only comparable (and only resumable) under the
 /// settings that made them: the same reference (which covers the scene,
-/// resolution and reference settings), base seed and firefly factor. They
+/// resolution and reference settings), base seed, firefly factor and
+/// ladder ([`LADDER`]). They
 /// are recorded in `DIR/results.key` next to the CSV; a directory holding
 /// rows made under other settings is refused rather than mixed. Thread
 /// count, ladder length and the axis filter may change between runs.
@@ -84,10 +66,14 @@ pub(super) fn check_results_key(
     Ok(())
 }
 
+/// How the ladder's rungs are rendered: each extends the sample range of
+/// one seed (rows of a ladder that reseeded every rung are not mixed in).
+const LADDER: &str = "ranges";
+
 /// The line `results.key` holds for these settings.
 fn results_key(s: &Settings, reference_hash: u64, seed: u64, scene: &Scene) -> String {
     format!(
-        "reference={reference_hash:016x} seed={seed} firefly_k={} resolution={}x{}\n",
+        "reference={reference_hash:016x} seed={seed} firefly_k={} resolution={}x{} ladder={LADDER}\n",
         s.firefly_k, scene.camera.width, scene.camera.height
     )
 }
@@ -119,8 +105,8 @@ pub(super) struct Job<'c> {
     pub(super) scene: Scene,
     /// Index of the first rung to render.
     pub(super) start: usize,
-    /// The running mean after rung `start - 1` and its cumulative seconds.
-    pub(super) acc: Option<(Film, f64)>,
+    /// The running mean after rung `start - 1`.
+    pub(super) acc: Option<Running>,
 }
 
 /// The configurations with rungs left to render, each with its resume
@@ -144,10 +130,12 @@ pub(super) fn jobs<'c>(
             let Some(row) = results.get(&c.name, n) else {
                 break;
             };
-            let (w, h) = (scene.camera.width, scene.camera.height);
-            if let Ok(Some(f)) = read_film(&state_path(&s.out_dir, &c.name, n), w, h) {
+            let size = (scene.camera.width, scene.camera.height);
+            let render_seconds = row.seconds - row.denoise_seconds;
+            if let Some(r) = Running::load(&s.out_dir, &c.name, n, size, c.denoise, render_seconds)
+            {
                 start = j + 1;
-                acc = Some((f, row.seconds));
+                acc = Some(r);
             }
         }
         let scene = config::apply(scene, &c.overrides).map_err(|e| Error::Input(e.to_string()))?;

@@ -37,6 +37,13 @@ pub struct DenoiseOptions {
     /// Denoise the guides first and tell OIDN they are clean (`cleanAux`);
     /// otherwise OIDN takes them as noisy.
     pub prefilter_guides: bool,
+    /// Denoise each light layer (light paths, light groups) too, with the
+    /// beauty's guides (`--denoise-layers`).
+    pub layers: bool,
+    /// OIDN's `maxMemoryMB`: about this much scratch memory per filter,
+    /// which OIDN keeps by denoising the image in overlapping tiles (None:
+    /// OIDN's own choice).
+    pub max_memory_mb: Option<u32>,
 }
 
 impl DenoiseOptions {
@@ -47,6 +54,8 @@ impl DenoiseOptions {
         DenoiseOptions {
             threads,
             prefilter_guides: true,
+            layers: false,
+            max_memory_mb: None,
         }
     }
 }
@@ -54,34 +63,53 @@ impl DenoiseOptions {
 /// The denoised beauty: non-negative and finite (OIDN's rare negative or
 /// non-finite outputs become 0).
 pub fn denoise(input: &DenoiseInput, opts: &DenoiseOptions) -> Result<Vec<Vec3>, Error> {
+    let mut out = denoise_with(input, &[], opts)?;
+    Ok(out.swap_remove(0))
+}
+
+/// The beauty and each image of `more` (the frame's light layers, of its
+/// size) denoised with the same guides, prefiltered once: the beauty
+/// first, then `more` in order; each non-negative and finite.
+pub fn denoise_with(
+    input: &DenoiseInput,
+    more: &[&[Vec3]],
+    opts: &DenoiseOptions,
+) -> Result<Vec<Vec<Vec3>>, Error> {
     check(input)?;
+    for (i, img) in more.iter().enumerate() {
+        check_image(&format!("light layer {i}"), img, input)?;
+    }
     let api = api()?;
     let device = Device::new(api, opts.threads)?;
     let (mut albedo, mut normal) = (input.albedo.to_vec(), input.normal.to_vec());
-    let mut out = vec![Vec3::ZERO; input.color.len()];
     let size = (input.width as usize, input.height as usize);
     if opts.prefilter_guides {
         for (name, guide) in [("albedo", &mut albedo), ("normal", &mut normal)] {
-            let f = device.filter()?;
+            let f = device.filter_capped(opts.max_memory_mb)?;
             let p = guide.as_mut_ptr().cast::<c_void>();
             f.image(name, p, size);
             f.image("output", p, size);
             device.run(&f, "prefiltering a guide")?;
         }
     }
-    let f = device.filter()?;
-    f.image("color", input.color.as_ptr().cast_mut().cast(), size);
-    f.image("albedo", albedo.as_mut_ptr().cast(), size);
-    f.image("normal", normal.as_mut_ptr().cast(), size);
-    f.image("output", out.as_mut_ptr().cast(), size);
-    f.flag("hdr", true);
-    f.flag("cleanAux", opts.prefilter_guides);
-    device.run(&f, "denoising")?;
-    drop(f);
-    for p in &mut out {
-        *p = sanitized(*p);
+    let mut outs = Vec::with_capacity(1 + more.len());
+    for color in std::iter::once(input.color).chain(more.iter().copied()) {
+        let mut out = vec![Vec3::ZERO; color.len()];
+        let f = device.filter_capped(opts.max_memory_mb)?;
+        f.image("color", color.as_ptr().cast_mut().cast(), size);
+        f.image("albedo", albedo.as_mut_ptr().cast(), size);
+        f.image("normal", normal.as_mut_ptr().cast(), size);
+        f.image("output", out.as_mut_ptr().cast(), size);
+        f.flag("hdr", true);
+        f.flag("cleanAux", opts.prefilter_guides);
+        device.run(&f, "denoising")?;
+        drop(f);
+        for p in &mut out {
+            *p = sanitized(*p);
+        }
+        outs.push(out);
     }
-    Ok(out)
+    Ok(outs)
 }
 
 /// A pixel of OIDN's output made non-negative and finite: a negative or
@@ -104,21 +132,28 @@ fn check(input: &DenoiseInput) -> Result<(), Error> {
         ("albedo", input.albedo),
         ("normal", input.normal),
     ] {
-        if img.len() != n {
-            return Err(Error::Input(format!(
-                "the {name} has {} pixels, not the {}×{} = {n} of the frame",
-                img.len(),
-                input.width,
-                input.height
-            )));
-        }
-        if let Some(i) = img.iter().position(|p| !p.is_finite()) {
-            let (x, y) = (i % input.width as usize, i / input.width as usize);
-            return Err(Error::Input(format!(
-                "the {name} is not finite at pixel ({x}, {y}): {}",
-                img[i]
-            )));
-        }
+        check_image(name, img, input)?;
+    }
+    Ok(())
+}
+
+/// One image of the frame's size, finite.
+fn check_image(name: &str, img: &[Vec3], input: &DenoiseInput) -> Result<(), Error> {
+    let n = input.width as usize * input.height as usize;
+    if img.len() != n {
+        return Err(Error::Input(format!(
+            "the {name} has {} pixels, not the {}×{} = {n} of the frame",
+            img.len(),
+            input.width,
+            input.height
+        )));
+    }
+    if let Some(i) = img.iter().position(|p| !p.is_finite()) {
+        let (x, y) = (i % input.width as usize, i / input.width as usize);
+        return Err(Error::Input(format!(
+            "the {name} is not finite at pixel ({x}, {y}): {}",
+            img[i]
+        )));
     }
     Ok(())
 }
@@ -156,6 +191,16 @@ impl Device {
             (OIDN_ERROR_NONE, _) => Ok(()),
             (code, msg) => Err(failure(what, code, &msg)),
         }
+    }
+
+    /// A new `RT` filter on this device, its scratch memory capped at
+    /// `max_memory_mb` when that is given.
+    fn filter_capped(&self, max_memory_mb: Option<u32>) -> Result<Filter<'_>, Error> {
+        let f = self.filter()?;
+        if let Some(mb) = max_memory_mb {
+            f.int("maxMemoryMB", i32::try_from(mb).unwrap_or(i32::MAX));
+        }
+        Ok(f)
     }
 
     /// A new `RT` filter on this device.
@@ -224,6 +269,12 @@ impl Filter<'_> {
         let key = CString::new(name).expect("no NUL");
         // SAFETY: a live filter; a NUL-terminated name.
         unsafe { (self.device.api.set_filter_bool)(self.raw, key.as_ptr(), on) };
+    }
+
+    fn int(&self, name: &str, v: i32) {
+        let key = CString::new(name).expect("no NUL");
+        // SAFETY: a live filter; a NUL-terminated name.
+        unsafe { (self.device.api.set_filter_int)(self.raw, key.as_ptr(), v) };
     }
 }
 

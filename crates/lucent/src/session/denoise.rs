@@ -1,9 +1,10 @@
 //! Denoised frames as the commands write them (docs/output.md,
 //! "Denoising"): `render --denoise` and `merge --denoise` add the layer
 //! from the frame's layers in memory ([`stage_denoised`]); `lucent denoise`
-//! reads a finished frame back and adds it there ([`denoise_file`]). Both
-//! hand OIDN the same float beauty and guides, so a frame denoised after a
-//! merge is the frame denoised by the single render. The PNG preview shows
+//! reads a finished frame back and adds it there ([`denoise_file`]); with
+//! `--denoise-layers` each light layer too, as `denoised_<layer>`. Both
+//! hand OIDN the same float beauty, layers and guides, so a frame denoised
+//! after a merge is the frame denoised by the single render. The PNG preview shows
 //! the denoised beauty; every file appears or none does.
 
 use std::path::Path;
@@ -13,12 +14,14 @@ use exr::meta::attribute::Text;
 use exr::prelude::{AnyChannel, AnyChannels, FlatSamples, SmallVec};
 
 use super::output::{check_exr_output, check_not_an_input};
-use crate::denoise::frame::{denoise_layers, layer_of, GUIDES, LAYER};
-use crate::denoise::{denoise, DenoiseInput, DenoiseOptions};
+use crate::denoise::filter::denoise_with;
+use crate::denoise::frame::{denoise_layers, layer_name, layer_of, named_layer, GUIDES, LAYER};
+use crate::denoise::{DenoiseInput, DenoiseOptions};
 use crate::error::{Error, InputError};
 use crate::film::exr_attributes::FrameHeader;
 use crate::film::exr_layers::{stage_frame, stage_image, AnyImage, OutputOptions, Preview, Window};
 use crate::film::layers::{Coverage, Layer};
+use crate::film::passes::LIGHT_PATHS;
 use crate::film::{commit_all, preview_path, Film, Staged};
 use crate::geometry::Vec3;
 
@@ -35,9 +38,9 @@ pub(crate) fn stage_denoised(
     out: &OutputOptions,
     opts: &DenoiseOptions,
 ) -> Result<Vec<Staged>, Error> {
-    let (clean, layer) = denoise_layers(film, layers, opts)?;
+    let (clean, denoised) = denoise_layers(film, layers, opts)?;
     let mut all = layers.to_vec();
-    all.push(layer);
+    all.extend(denoised);
     let frame_only = OutputOptions {
         preview: None,
         ..*out
@@ -90,8 +93,18 @@ pub fn denoise_file(
     let guide =
         |(layer, ch): (&str, [&str; 3])| planes(input, &image, ch.map(|c| format!("{layer}.{c}")));
     let (albedo, normal) = (guide(GUIDES[0])?, guide(GUIDES[1])?);
+    let light = if opts.layers {
+        light_layers(&image)
+    } else {
+        Vec::new()
+    };
+    let images = light
+        .iter()
+        .map(|l| planes(input, &image, ["R", "G", "B"].map(|c| format!("{l}.{c}"))))
+        .collect::<Result<Vec<_>, _>>()?;
+    let more: Vec<&[Vec3]> = images.iter().map(Vec::as_slice).collect();
     let start = Instant::now();
-    let clean = denoise(
+    let mut outs = denoise_with(
         &DenoiseInput {
             width: w as u32,
             height: h as u32,
@@ -99,10 +112,16 @@ pub fn denoise_file(
             albedo: &albedo,
             normal: &normal,
         },
+        &more,
         opts,
-    )?;
+    )?
+    .into_iter();
     let seconds = start.elapsed().as_secs_f64();
+    let clean = outs.next().expect("the beauty comes first");
     put_layer(&mut image, &layer_of(&clean));
+    for (l, p) in light.iter().zip(outs) {
+        put_layer(&mut image, &named_layer(layer_name(l), &p));
+    }
     let film = Film {
         width: w as u32,
         height: h as u32,
@@ -156,6 +175,32 @@ fn planes<S: AsRef<str>>(path: &Path, image: &AnyImage, names: [S; 3]) -> Result
         *p = Vec3::from(v);
     }
     Ok(out)
+}
+
+/// The frame's light layers with `R`, `G`, `B` channels, in name order:
+/// the light paths and the light groups (`RGBA_<group>`), the layers a
+/// render's `--denoise-layers` denoises.
+fn light_layers(image: &AnyImage) -> Vec<String> {
+    let names: Vec<String> = image
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    let mut out: Vec<String> = names
+        .iter()
+        .filter_map(|n| n.strip_suffix(".R"))
+        .filter(|l| LIGHT_PATHS.iter().any(|p| p.name() == *l) || l.starts_with("RGBA_"))
+        .filter(|l| {
+            ["G", "B"]
+                .iter()
+                .all(|c| names.contains(&format!("{l}.{c}")))
+        })
+        .map(String::from)
+        .collect();
+    out.sort();
+    out
 }
 
 /// Bad input in `path`, in `field`.
