@@ -54,6 +54,10 @@
 //! hole: a flight whose ray meets no boundary at all has no bounded medium
 //! around it, so the walk ends there with zero radiance (counted in
 //! [`Counters::walks_escaped`]) instead of scattering through infinite space.
+//!
+//! **Cost.** A flight shorter than the distance from its origin to the
+//! nearest surface needs no ray query (`docs/bssrdf.md` §7, "The walk's
+//! cost"): the samples are the same, with far fewer queries deep inside.
 
 use super::aov::{Event, Recorder};
 use super::diffuse_boundary::DiffuseBoundary;
