@@ -1,9 +1,11 @@
-//! Per-pixel variance of one sample of the path integrator, and where it
-//! sits in the image, for docs/accuracy.md ("Smooth sphere"):
+//! Per-pixel variance of one sample of an integrator (the path tracer unless
+//! `--integrator randomwalk`), and where it sits in the image, for
+//! docs/accuracy.md ("Smooth sphere"):
 //!
 //!     cargo run --release --example pixel_variance -- SCENE.toml \
 //!         [--width N] [--spp N] [--seed N] [--axes A] [--specular BOOL] \
-//!         [--reference REF.exr] [--map OUT.exr] [--image OUT.exr] [--threads N]
+//!         [--reference REF.exr] [--map OUT.exr] [--image OUT.exr] [--threads N] \
+//!         [--integrator path|randomwalk]
 //!
 //! Renders every pixel with `--spp` samples exactly as `lucent render`
 //! does (the same random streams), but keeps each pixel's sample variance
@@ -82,6 +84,11 @@ fn main() {
     let spp: u32 = arg(&args, "--spp").unwrap_or(256);
     let seed: u64 = arg(&args, "--seed").unwrap_or(1);
     let threads: usize = arg(&args, "--threads").unwrap_or(2);
+    let integrator = match arg::<String>(&args, "--integrator").as_deref() {
+        None | Some("path") => IntegratorKind::Path,
+        Some("randomwalk") => IntegratorKind::RandomWalk,
+        Some(other) => die(&format!("--integrator: {other} is not path or randomwalk")),
+    };
     // any estimator option, as `lucent render` takes it (`--axes normal`)
     let mut ov = Assignments::default();
     for row in &OPTIONS {
@@ -131,7 +138,7 @@ fn main() {
                             let mut rng = SampleRng::for_sample(key, s as u64);
                             let [jx, jy] = rng.uniform2_packed();
                             let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                            let l = IntegratorKind::Path.radiance::<_, NoClock>(
+                            let l = integrator.radiance::<_, NoClock>(
                                 &ctx,
                                 ray,
                                 &mut rng,

@@ -537,8 +537,12 @@ fn walk_scene(mesh: Mesh) -> Scene {
 /// there and counted as capped: started at the centre of a sphere of
 /// optical radius 10⁴ of a medium that absorbs nothing, a walk needs ~10⁸
 /// events to reach the boundary (its distance grows like √N mean free
-/// paths), so every one of them stops at the cap, after exactly that many
-/// flight queries, and is neither escaped nor lost uncounted.
+/// paths), so every one of them stops at the cap and is neither escaped
+/// nor lost uncounted. Within the 10⁻² radii it wanders from the centre,
+/// every flight is far shorter than the distance to the surface, so the
+/// walk asks the accelerator nothing (`randomwalk::walk`: flights within
+/// the distance bound need no query); with the bounds off, it asks once
+/// per event.
 ///
 /// [`MAX_WALK_EVENTS`]: lucent::integrator::randomwalk::MAX_WALK_EVENTS
 #[test]
@@ -567,10 +571,22 @@ fn walks_that_cannot_end_stop_at_the_cap_and_are_counted() {
         (c.walks_capped, c.walks_escaped, c.nonfinite),
         (walks, 0, 0)
     );
-    assert_eq!(
-        c.effect_rays[Effect::Walk as usize],
-        walks * MAX_WALK_EVENTS as u64
+    assert_eq!(c.effect_rays[Effect::Walk as usize], 0);
+    let mut unbounded = Context::new(&s, a.as_ref());
+    unbounded.without_distance_bounds();
+    let mut c = Counters::default();
+    let mut rng = SampleRng::new(3, 0, 0);
+    let ray = lucent::geometry::Ray::new(Vec3::ZERO, Vec3::Z);
+    let end = walk(
+        &unbounded,
+        &m,
+        Boundary::Dielectric(1.0),
+        ray,
+        &mut rng,
+        &mut c,
     );
+    assert!(end.is_none() && c.walks_capped == 1);
+    assert_eq!(c.effect_rays[Effect::Walk as usize], MAX_WALK_EVENTS as u64);
 }
 
 /// Closed icospheres never lose a walk (`walks_escaped == 0`), on every
@@ -901,5 +917,86 @@ fn the_walk_reflects_inside_the_diffuse_boundary_in_the_mirror_direction() {
         }
         // every walk reflected at least once (x = 1 first); several more often
         assert!(reflected > 64, "{reflected} reflections in 64 walks");
+    }
+}
+
+/// Each sample's radiance under the random walk (bits) and the walk's
+/// flight queries, `spp` samples of every pixel, with the walk's distance
+/// bounds as the context builds them or switched off.
+fn walk_samples(scene: &Scene, backend: Backend, bounds: bool, spp: u64) -> (Vec<[u32; 3]>, u64) {
+    use lucent::integrator::path::Scratch;
+    use lucent::integrator::{Context, NoClock};
+    use lucent::sampling::{Draw, SampleRng};
+    let accel = accel::build(&scene.meshes, backend).unwrap();
+    let mut ctx = Context::new(scene, accel.as_ref());
+    if !bounds {
+        ctx.without_distance_bounds();
+    }
+    let (mut scratch, mut counters) = (Scratch::default(), Counters::default());
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let mut out = Vec::new();
+    for pixel in 0..(w * h) as u64 {
+        for s in 0..spp {
+            let mut rng = SampleRng::new(7, pixel, s);
+            let [jx, jy] = rng.uniform2_packed();
+            let (x, y) = ((pixel % w as u64) as f32, (pixel / w as u64) as f32);
+            let ray = scene.camera.ray(x + jx, y + jy);
+            let l = IntegratorKind::RandomWalk.radiance::<_, NoClock>(
+                &ctx,
+                ray,
+                &mut rng,
+                &mut scratch,
+                &mut counters,
+                &mut lucent::integrator::aov::NoAov,
+            );
+            out.push(l.to_array().map(f32::to_bits));
+        }
+    }
+    (out, counters.effect_rays[Effect::Walk as usize])
+}
+
+/// A flight shorter than the distance bound at its origin scatters without
+/// a query (`randomwalk::walk`, `geometry::distance`): that changes no
+/// sample, bit for bit, on the marble sphere (convex) and the marble bunny
+/// (not convex; its floor meets the grid), with both boundaries and on
+/// every backend, while it saves more than half of the walk's queries. A
+/// bound larger than the distance (the cells' half-diagonals left out of
+/// it) lets flights leave the body unseen: samples differ.
+#[test]
+fn distance_bounds_change_no_sample_bit_for_bit() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for name in ["smooth-sphere", "marble-bunny"] {
+        let mut scene = lucent::scene::load(&root.join(format!("scenes/{name}.toml"))).unwrap();
+        let c = &scene.camera;
+        scene.camera = Camera::new(c.look_from, c.look_at, c.up, c.fov_y, 16, 12);
+        for boundary in [
+            WalkBoundary::Dielectric,
+            WalkBoundary::Diffuse { exit_nee: true },
+        ] {
+            let mut s = scene.clone();
+            for m in s.materials.iter_mut() {
+                if let Material::Subsurface(ss) = m {
+                    let options = lucent::materials::EstimatorOptions {
+                        boundary,
+                        ..*ss.options()
+                    };
+                    *m = Material::Subsurface(Arc::new(ss.with_options(&options).unwrap()));
+                }
+            }
+            for backend in common::backends() {
+                let (on, q_on) = walk_samples(&s, backend, true, 2);
+                let (off, q_off) = walk_samples(&s, backend, false, 2);
+                let differ = on.iter().zip(&off).filter(|(a, b)| a != b).count();
+                println!(
+                    "{name} {boundary:?} {backend:?}: {q_on} queries with bounds, \
+                     {q_off} without, {differ} samples differ"
+                );
+                assert_eq!(differ, 0, "{name} {boundary:?} {backend:?}");
+                assert!(
+                    2 * q_on < q_off,
+                    "{name} {boundary:?} {backend:?}: {q_on} vs {q_off}"
+                );
+            }
+        }
     }
 }

@@ -1,7 +1,8 @@
 //! What an integrator reads while rendering ([`Context`]), built once per
 //! render: the scene, its accelerator, lights and plan, the per-mesh
-//! shading records, ray culling, the camera's footprint spread, and per
-//! subsurface mesh its curvatures and curvature-correction factors.
+//! shading records, ray culling, the camera's footprint spread, per
+//! subsurface mesh its curvatures and curvature-correction factors, and
+//! (built when a random walk first needs it) the scene's distance bounds.
 
 #[cfg(feature = "subsurface")]
 use super::control_variate;
@@ -12,6 +13,8 @@ use super::plan::Plan;
 use crate::accel::Accel;
 #[cfg(feature = "subsurface")]
 use crate::geometry::curvature::{MeshCurvature, TriangleCurvature};
+#[cfg(feature = "subsurface")]
+use crate::geometry::distance::DistanceGrid;
 use crate::lights::LightSet;
 use crate::scene::Scene;
 use crate::stats::Counters;
@@ -57,6 +60,10 @@ pub struct Context<'a> {
     /// factors ([`SubsurfaceCurvature`]); None for the others.
     #[cfg(feature = "subsurface")]
     pub curvature: Vec<Option<SubsurfaceCurvature>>,
+    /// The random walk's distance bounds ([`DistanceGrid`]), built at the
+    /// first walk: a render without one never pays for it.
+    #[cfg(feature = "subsurface")]
+    distance: std::sync::OnceLock<Option<DistanceGrid>>,
 }
 
 impl<'a> Context<'a> {
@@ -96,7 +103,42 @@ impl<'a> Context<'a> {
             ),
             #[cfg(feature = "subsurface")]
             curvature,
+            #[cfg(feature = "subsurface")]
+            distance: std::sync::OnceLock::new(),
         }
+    }
+
+    /// Switches the random walk's distance bounds off, so every flight
+    /// asks the accelerator (to compare: the pixels are the same either
+    /// way, `tests/physics/randomwalk.rs`).
+    #[cfg(feature = "subsurface")]
+    pub fn without_distance_bounds(&mut self) {
+        self.distance = std::sync::OnceLock::from(None);
+    }
+
+    /// The grid of lower bounds on the distance to the scene's triangles
+    /// over the subsurface objects (over every object in a scene without
+    /// one), built on first use (by the random walk, `super::randomwalk`).
+    #[cfg(feature = "subsurface")]
+    pub(crate) fn distance_grid(&self) -> Option<&DistanceGrid> {
+        self.distance
+            .get_or_init(|| {
+                let sss: Vec<usize> = (0..self.scene.meshes.len())
+                    .filter(|&i| self.curvature[i].is_some())
+                    .collect();
+                let domain: Vec<usize> = if sss.is_empty() {
+                    (0..self.scene.meshes.len()).collect()
+                } else {
+                    sss
+                };
+                let (mut lo, mut hi) = (glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY);
+                for (a, b) in domain.iter().filter_map(|&i| self.scene.meshes[i].bounds()) {
+                    lo = lo.min(a);
+                    hi = hi.max(b);
+                }
+                DistanceGrid::build(&self.scene.meshes, lo, hi)
+            })
+            .as_ref()
     }
 
     /// The curvatures of triangle `prim` of mesh `geom`

@@ -54,6 +54,10 @@
 //! hole: a flight whose ray meets no boundary at all has no bounded medium
 //! around it, so the walk ends there with zero radiance (counted in
 //! [`Counters::walks_escaped`]) instead of scattering through infinite space.
+//!
+//! **Cost.** A flight shorter than the distance from its origin to the
+//! nearest surface needs no ray query (`docs/bssrdf.md` §7, "The walk's
+//! cost"): the samples are the same, with far fewer queries deep inside.
 
 use super::aov::{Event, Recorder};
 use super::diffuse_boundary::DiffuseBoundary;
@@ -263,6 +267,16 @@ pub enum WalkEnd {
 /// normal of the triangle the flight was heading for, to that offset: the
 /// same margin every spawned ray keeps (a displacement ≤ 4·10⁻⁶ |p|, far
 /// below any mean free path the supported ranges allow).
+///
+/// **Flights without a query.** A flight shorter than the distance from
+/// its origin to the nearest surface (`clear_flight`: the bound of
+/// [`crate::geometry::distance`]) cannot meet the boundary, so it scatters
+/// without asking the accelerator: the walk's randoms, weights and points
+/// are the ones the query would have given. Such a point keeps twice the
+/// spawn margin from every surface, so the push above never moves it on a
+/// convex body; on another, only a far triangle whose plane passes within
+/// the margin could have (the bunny's samples are the same bit for bit,
+/// `tests/physics/randomwalk.rs`).
 pub fn walk(
     ctx: &Context,
     m: &Medium,
@@ -280,82 +294,144 @@ pub fn walk(
         if !(total > 0.0 && total.is_finite()) {
             return None;
         }
-        counters.ray(Effect::Walk);
-        // Inside a closed mesh every direction meets the boundary. No hit
-        // means the walk is in the open (through a hole of an open mesh, or
-        // on the wrong side of a single sheet): there is no bounded medium,
-        // and scattering on in an unbounded one would never end.
-        let Some(hit) = ctx.accel.intersect(&ray, 0.0, f32::INFINITY) else {
-            counters.walks_escaped += 1;
-            return None;
-        };
-        let t_max = hit.t as f64;
-
         // Hero channel by throughput; q sums to 1 over live channels.
         let q = beta.map(|b| b / total);
         let c = pick_channel(&q, rng.uniform_f64());
         let t = free_flight(sigma_t[c], rng.uniform_f64());
 
-        if t < t_max {
-            // A real scattering event at distance t.
-            let tr: [f64; 3] = std::array::from_fn(|k| (-sigma_t[k] * t).exp());
-            let pdf: f64 = (0..3).map(|k| q[k] * sigma_t[k] * tr[k]).sum();
-            if pdf.is_nan() || pdf <= 0.0 {
+        let p = if t < clear_flight(ctx, ray.o) {
+            ray.at(t as f32)
+        } else {
+            counters.ray(Effect::Walk);
+            // Inside a closed mesh every direction meets the boundary. No
+            // hit means the walk is in the open (through a hole of an open
+            // mesh, or on the wrong side of a single sheet): there is no
+            // bounded medium, and scattering on in an unbounded one would
+            // never end.
+            let Some(hit) = ctx.accel.intersect(&ray, 0.0, f32::INFINITY) else {
+                counters.walks_escaped += 1;
+                return None;
+            };
+            let t_max = hit.t as f64;
+            if t >= t_max {
+                transmit(&mut beta, &sigma_t, &q, t_max)?;
+                match at_boundary(ctx, boundary, &ray, &hit, rng) {
+                    Ok((end, weight)) => return Some((end, weight * throughput(&beta))),
+                    Err(next) => ray = next,
+                }
+                continue;
+            }
+            inside_point(ctx, &ray, &hit, t, t_max)
+        };
+
+        // A real scattering event at distance t.
+        scatter(&mut beta, m, &sigma_t, &q, t)?;
+        // The phase function is sampled exactly: its weight is 1.
+        ray = Ray::new(p, sample_hg(ray.d, m.g, rng.uniform2()));
+        if event >= WALK_RR_START {
+            let survive = beta.iter().copied().fold(0.0, f64::max).min(1.0);
+            if survive.is_nan() || survive <= 0.0 || rng.uniform_f64() >= survive {
                 return None;
             }
-            for k in 0..3 {
-                beta[k] *= m.sigma_s[k] * tr[k] / pdf;
-            }
-            let p = inside_point(ctx, &ray, &hit, t, t_max);
-            // The phase function is sampled exactly: its weight is 1.
-            let d = sample_hg(ray.d, m.g, rng.uniform2());
-            ray = Ray::new(p, d);
-            if event >= WALK_RR_START {
-                let survive = beta.iter().copied().fold(0.0, f64::max).min(1.0);
-                if survive.is_nan() || survive <= 0.0 || rng.uniform_f64() >= survive {
-                    return None;
-                }
-                beta = beta.map(|b| b / survive);
-            }
-            continue;
-        }
-
-        // The flight reached the boundary: probability e^{−σt t} per channel.
-        let tr: [f64; 3] = std::array::from_fn(|k| (-sigma_t[k] * t_max).exp());
-        let pdf: f64 = (0..3).map(|k| q[k] * tr[k]).sum();
-        if pdf.is_nan() || pdf <= 0.0 {
-            return None;
-        }
-        for k in 0..3 {
-            beta[k] *= tr[k] / pdf;
-        }
-        let w = || Vec3::new(beta[0] as f32, beta[1] as f32, beta[2] as f32);
-        match boundary {
-            Boundary::Dielectric(eta) => {
-                let (exit, next, weight) = cross_boundary(ctx, eta, &ray, &hit, rng);
-                if exit {
-                    return Some((WalkEnd::Refracted(next), w() * weight));
-                }
-                ray = next;
-            }
-            Boundary::Diffuse(b) => {
-                let si = ctx.interaction(&ray, &hit);
-                let n_out = if ray.d.dot(si.ng) > 0.0 {
-                    si.ng
-                } else {
-                    -si.ng
-                };
-                let mu_in = ray.d.dot(n_out);
-                if rng.uniform() >= b.reflect_in(mu_in) {
-                    return Some((WalkEnd::Exit { p: si.p, n_out }, w()));
-                }
-                let wi = reflect(-ray.d, n_out).normalize();
-                ray = si.spawn(wi, ctx.ray_epsilon);
-            }
+            beta = beta.map(|b| b / survive);
         }
     }
     counters.walks_capped += 1;
     None
+}
+
+/// How far a flight from `o` can go without meeting a surface: the
+/// scene's distance bound there ([`crate::geometry::distance`]) less twice
+/// the spawn margin of [`inside_point`] (once for the flight's own
+/// rounding, once for the accelerator's), or 0.
+#[inline]
+fn clear_flight(ctx: &Context, o: Vec3) -> f64 {
+    let Some(grid) = ctx.distance_grid() else {
+        return 0.0;
+    };
+    let d = grid.bound(o);
+    if d.is_nan() || d <= 0.0 {
+        return 0.0;
+    }
+    let margin = ctx.ray_epsilon.max((o.abs().max_element() + d) * 4e-6);
+    (d - 2.0 * margin) as f64
+}
+
+/// Weighs a flight that scattered at distance `t`: σs e^{−σt t} over the
+/// one-sample balance-heuristic pdf Σ_k q_k σt_k e^{−σt_k t}. None when
+/// that pdf is not positive (the walk ends).
+#[inline]
+fn scatter(
+    beta: &mut [f64; 3],
+    m: &Medium,
+    sigma_t: &[f64; 3],
+    q: &[f64; 3],
+    t: f64,
+) -> Option<()> {
+    let tr: [f64; 3] = std::array::from_fn(|k| (-sigma_t[k] * t).exp());
+    let pdf: f64 = (0..3).map(|k| q[k] * sigma_t[k] * tr[k]).sum();
+    if pdf.is_nan() || pdf <= 0.0 {
+        return None;
+    }
+    for k in 0..3 {
+        beta[k] *= m.sigma_s[k] * tr[k] / pdf;
+    }
+    Some(())
+}
+
+/// Weighs a flight that reached the boundary at `t_max`: probability
+/// e^{−σt t_max} per channel, over Σ_k q_k e^{−σt_k t_max}.
+#[inline]
+fn transmit(beta: &mut [f64; 3], sigma_t: &[f64; 3], q: &[f64; 3], t_max: f64) -> Option<()> {
+    let tr: [f64; 3] = std::array::from_fn(|k| (-sigma_t[k] * t_max).exp());
+    let pdf: f64 = (0..3).map(|k| q[k] * tr[k]).sum();
+    if pdf.is_nan() || pdf <= 0.0 {
+        return None;
+    }
+    for k in 0..3 {
+        beta[k] *= tr[k] / pdf;
+    }
+    Some(())
+}
+
+fn throughput(beta: &[f64; 3]) -> Vec3 {
+    Vec3::new(beta[0] as f32, beta[1] as f32, beta[2] as f32)
+}
+
+/// The boundary law at `hit`, reached from inside along `ray`: Ok with how
+/// the walk leaves and the crossing's weight, or Err with the ray
+/// reflected back in.
+fn at_boundary(
+    ctx: &Context,
+    boundary: Boundary,
+    ray: &Ray,
+    hit: &Hit,
+    rng: &mut SampleRng,
+) -> Result<(WalkEnd, f32), Ray> {
+    match boundary {
+        Boundary::Dielectric(eta) => {
+            let (exit, next, weight) = cross_boundary(ctx, eta, ray, hit, rng);
+            if exit {
+                Ok((WalkEnd::Refracted(next), weight))
+            } else {
+                Err(next)
+            }
+        }
+        Boundary::Diffuse(b) => {
+            let si = ctx.interaction(ray, hit);
+            let n_out = if ray.d.dot(si.ng) > 0.0 {
+                si.ng
+            } else {
+                -si.ng
+            };
+            let mu_in = ray.d.dot(n_out);
+            if rng.uniform() >= b.reflect_in(mu_in) {
+                return Ok((WalkEnd::Exit { p: si.p, n_out }, 1.0));
+            }
+            let wi = reflect(-ray.d, n_out).normalize();
+            Err(si.spawn(wi, ctx.ray_epsilon))
+        }
+    }
 }
 
 /// The scattering point at distance `t` < `t_max` along `ray`, whose flight
