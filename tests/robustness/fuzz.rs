@@ -725,6 +725,9 @@ const HOSTILE_VALUES: &[&str] = &[
     "mixture",
     "mis3",
     "mis",
+    "tabulated",
+    "burley",
+    "sobol",
     "randomwalk",
     "bvh",
     "clamp",
@@ -747,6 +750,12 @@ const OPTIONS: &[&str] = &[
     "--renormalize",
     "--exit-sw",
     "--specular",
+    "--profile",
+    "--regularize",
+    "--sampler",
+    "--control-variate",
+    "--probe-pair",
+    "--boundary",
     "-o",
 ];
 
