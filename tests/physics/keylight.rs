@@ -146,17 +146,18 @@ fn each_half_of_a_sphere_under_a_key_light_is_within_3_percent_of_the_random_wal
 /// carries the key light across the body: on the far half it returns
 /// more than 40 % of the walk's light in every channel, where the fit
 /// returns less than 35 % (at 4 × 256 spp, 48²: 0.71 / 0.64 / 0.56
-/// against 0.25 / 0.20 / 0.19; here 0.72 / 0.49 / 0.60 against
-/// 0.30 / 0.17 / 0.22), and the lit half stays within 20 % of the walk
-/// (−7…−8 % at 48², here −6…−13 %: the lit half's noise at these counts
-/// is ≈ 10 %). Rd weighed from the fit's shape fails the far bound;
+/// against 0.25 / 0.20 / 0.19; here 0.64 / 0.52 / 0.56 against
+/// 0.27 / 0.18 / 0.20), and the lit half stays within 20 % of the walk
+/// (−7…−8 % at 48², here −6…−9 %). At 32 spp a seed's far half of the
+/// fit read 0.47 of the walk: the far half is lit by few probes, so
+/// fewer samples make the test depend on the random numbers. Rd weighed from the fit's shape fails the far bound;
 /// truncating the table at the fit's Rmax (16 mm, short of the 20 mm
-/// diameter) does not (far 0.67 / 0.46 / 0.59). Four seeds of 32 spp at 24² per side (5.5 s).
+/// diameter) does not (far 0.67 / 0.46 / 0.59). Four seeds of 128 spp at 24² per side (3 s).
 #[test]
 fn the_tabulated_profile_carries_a_key_light_to_the_far_half() {
     let sides = |integrator, extra: &str| {
         let v: Vec<_> = (1..=4)
-            .map(|seed| halves(&run(&scene_with(32, seed, extra), integrator)))
+            .map(|seed| halves(&run(&scene_with(128, seed, extra), integrator)))
             .collect();
         mean_se(&v)
     };
@@ -173,7 +174,7 @@ fn the_tabulated_profile_carries_a_key_light_to_the_far_half() {
     for (c, &[lit, far, fit_far]) in rows.iter().enumerate() {
         assert!(far > 0.4, "ch{c}: tabulated far half {far:.3} of the walk");
         assert!(
-            fit_far < 0.4,
+            fit_far < 0.35,
             "ch{c}: fit far half {fit_far:.3} of the walk"
         );
         assert!(
