@@ -22,6 +22,15 @@ pub const ENV_VAR: &str = "LUCENT_OIDN";
 /// the development symlink.
 pub(crate) const LIB_NAMES: [&str; 2] = ["libOpenImageDenoise.so.2", "libOpenImageDenoise.so"];
 
+/// The library as `dynlib` opens it and its errors name it.
+const WANTED: crate::dynlib::Wanted = crate::dynlib::Wanted {
+    env_var: ENV_VAR,
+    names: &LIB_NAMES,
+    name: "Open Image Denoise",
+    kind: "Open Image Denoise 2",
+    install: "set LUCENT_OIDN to the path of libOpenImageDenoise.so.2, e.g. the one scripts/install-deps.sh unpacks into .cache/oidn/lib/",
+};
+
 /// The OIDN functions lucent calls, looked up in the loaded library. Each
 /// pointer stays valid as long as `_lib`, which lives in a `static` and so
 /// for the whole process.
@@ -62,21 +71,9 @@ pub struct Api {
 /// places it was looked for) and what is needed.
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
-    #[error("{}={path}: cannot load it ({problem})", ENV_VAR)]
-    CannotLoad { path: String, problem: String },
-    #[error(
-        "Open Image Denoise was not found: {tried} (set {} to the path of \
-         libOpenImageDenoise.so.2, e.g. the one scripts/install-deps.sh unpacks into \
-         .cache/oidn/lib/)",
-        ENV_VAR
-    )]
-    NotFound { tried: String },
-    #[error("{path} is not an Open Image Denoise 2 library: it has no {symbol} ({problem})")]
-    MissingSymbol {
-        path: String,
-        symbol: &'static str,
-        problem: String,
-    },
+    /// Not opened, or a function missing from it.
+    #[error(transparent)]
+    Open(#[from] crate::dynlib::OpenError),
     #[error("{path}: no CPU device: {message} ({})", error_name(*.code))]
     NoDevice {
         path: String,
@@ -127,39 +124,21 @@ pub fn report() -> String {
 }
 
 fn load() -> Result<Api, LoadError> {
-    let (lib, path) = crate::dynlib::open(ENV_VAR, &LIB_NAMES)?;
-    bind(lib, path)
-}
-
-impl From<crate::dynlib::OpenError> for LoadError {
-    fn from(e: crate::dynlib::OpenError) -> Self {
-        match e {
-            crate::dynlib::OpenError::CannotLoad { path, problem } => {
-                LoadError::CannotLoad { path, problem }
-            }
-            crate::dynlib::OpenError::NotFound { tried } => LoadError::NotFound { tried },
-        }
-    }
+    bind(crate::dynlib::open(&WANTED)?)
 }
 
 /// Looks every function up, then asks a CPU device for the version.
-fn bind(lib: libloading::Library, path: String) -> Result<Api, LoadError> {
+fn bind(lib: crate::dynlib::Opened) -> Result<Api, LoadError> {
     macro_rules! sym {
-        ($name:literal) => {{
+        ($name:literal) => {
             // SAFETY: the symbol, if present, is the OIDN function of that
             // name, whose C signature (oidn.h, 2.x) is the field's type; the
-            // pointer is copied out and kept together with `lib`, which is
-            // never unloaded.
-            let s = unsafe { lib.get(concat!($name, "\0").as_bytes()) }.map_err(|e| {
-                LoadError::MissingSymbol {
-                    path: path.clone(),
-                    symbol: $name,
-                    problem: e.to_string(),
-                }
-            })?;
-            *s
-        }};
+            // pointer is kept together with the library, which is never
+            // unloaded.
+            unsafe { lib.function(concat!($name, "\0")) }?
+        };
     }
+    let path = lib.path.clone();
     let mut api = Api {
         path: path.clone(),
         version: (0, 0, 0),
@@ -176,7 +155,7 @@ fn bind(lib: libloading::Library, path: String) -> Result<Api, LoadError> {
         set_filter_int: sym!("oidnSetFilterInt"),
         commit_filter: sym!("oidnCommitFilter"),
         execute_filter: sym!("oidnExecuteFilter"),
-        _lib: lib,
+        _lib: lib.lib,
     };
     // SAFETY: creating a device has no preconditions.
     let dev = unsafe { (api.new_device)(OIDN_DEVICE_TYPE_CPU) };
@@ -228,6 +207,13 @@ pub(crate) fn last_error(api: &Api, device: OIDNDevice) -> (OIDNError, String) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_install_advice_names_the_variable_looked_at() {
+        // the advice is a literal beside ENV_VAR: a renamed variable left
+        // in it would send users to set the wrong one
+        assert!(WANTED.install.contains(ENV_VAR), "{}", WANTED.install);
+    }
 
     #[test]
     fn only_oidn_2_passes_the_version_check() {

@@ -24,6 +24,15 @@ pub(crate) const ENV_VAR: &str = "LUCENT_EMBREE4";
 /// packages install, then the development symlink.
 pub(crate) const LIB_NAMES: [&str; 2] = ["libembree4.so.4", "libembree4.so"];
 
+/// The library as `dynlib` opens it and its errors name it.
+const WANTED: crate::dynlib::Wanted = crate::dynlib::Wanted {
+    env_var: ENV_VAR,
+    names: &LIB_NAMES,
+    name: "Embree 4",
+    kind: "Embree 4",
+    install: "Debian 13: `apt-get install libembree4-4`; or set LUCENT_EMBREE4 to the path of libembree4.so.4, e.g. the one scripts/install-deps.sh unpacks into .cache/embree4/",
+};
+
 /// The Embree 4 minor releases the binding was checked against.
 pub(crate) const KNOWN_MINORS: std::ops::RangeInclusive<u32> = 3..=4;
 
@@ -83,21 +92,9 @@ fn need() -> String {
 /// the places it was looked for) and what is needed.
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
-    #[error("{}={path}: cannot load it ({problem})", ENV_VAR)]
-    CannotLoad { path: String, problem: String },
-    #[error(
-        "Embree 4 was not found: {tried} (Debian 13: `apt-get install libembree4-4`; or \
-         set {} to the path of libembree4.so.4, e.g. the one \
-         scripts/install-deps.sh unpacks into .cache/embree4/)",
-        ENV_VAR
-    )]
-    NotFound { tried: String },
-    #[error("{path} is not an Embree 4 library: it has no {symbol} ({problem})")]
-    MissingSymbol {
-        path: String,
-        symbol: &'static str,
-        problem: String,
-    },
+    /// Not opened, or a function missing from it.
+    #[error(transparent)]
+    Open(#[from] crate::dynlib::OpenError),
     #[error("{path}: rtcNewDevice failed: {} ({code})", super::super::embree_shared::error_name(*.code))]
     NoDevice { path: String, code: RTCError },
     #[error("{path} is Embree {major}.{minor}.{patch}, not Embree 4: {}", need())]
@@ -182,39 +179,21 @@ pub fn api() -> Result<&'static Api, Error> {
 }
 
 fn load() -> Result<Api, LoadError> {
-    let (lib, path) = crate::dynlib::open(ENV_VAR, &LIB_NAMES)?;
-    bind(lib, path)
-}
-
-impl From<crate::dynlib::OpenError> for LoadError {
-    fn from(e: crate::dynlib::OpenError) -> Self {
-        match e {
-            crate::dynlib::OpenError::CannotLoad { path, problem } => {
-                LoadError::CannotLoad { path, problem }
-            }
-            crate::dynlib::OpenError::NotFound { tried } => LoadError::NotFound { tried },
-        }
-    }
+    bind(crate::dynlib::open(&WANTED)?)
 }
 
 /// Looks every function up, then asks the version before anything else.
-fn bind(lib: libloading::Library, path: String) -> Result<Api, LoadError> {
+fn bind(lib: crate::dynlib::Opened) -> Result<Api, LoadError> {
     macro_rules! sym {
-        ($name:literal) => {{
-            // SAFETY: the symbol, if present, is the Embree function of that
-            // name, whose C signature is the field's type (ffi.rs, checked
-            // against the headers); the pointer is copied out and kept
-            // together with `lib`, which is never unloaded.
-            let s = unsafe { lib.get(concat!($name, "\0").as_bytes()) }.map_err(|e| {
-                LoadError::MissingSymbol {
-                    path: path.clone(),
-                    symbol: $name,
-                    problem: e.to_string(),
-                }
-            })?;
-            *s
-        }};
+        ($name:literal) => {
+            // SAFETY: the symbol, if present, is the Embree function of
+            // that name, whose C signature is the field's type (ffi.rs,
+            // checked against the headers); the pointer is kept together
+            // with the library, which is never unloaded.
+            unsafe { lib.function(concat!($name, "\0")) }?
+        };
     }
+    let path = lib.path.clone();
     let mut api = Api {
         path: path.clone(),
         version: (0, 0, 0),
@@ -236,7 +215,7 @@ fn bind(lib: libloading::Library, path: String) -> Result<Api, LoadError> {
         commit_geometry: sym!("rtcCommitGeometry"),
         intersect1: sym!("rtcIntersect1"),
         occluded1: sym!("rtcOccluded1"),
-        _lib: lib,
+        _lib: lib.lib,
     };
     // rtcNewDevice, rtcGetDeviceProperty, rtcGetDeviceError and
     // rtcReleaseDevice have had these signatures since Embree 3.0, so they
@@ -279,6 +258,13 @@ fn bind(lib: libloading::Library, path: String) -> Result<Api, LoadError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_install_advice_names_the_variable_looked_at() {
+        // the advice is a literal beside ENV_VAR: a renamed variable left
+        // in it would send users to set the wrong one
+        assert!(WANTED.install.contains(ENV_VAR), "{}", WANTED.install);
+    }
 
     #[test]
     fn only_embree_4_3_and_4_4_pass_the_version_check() {
