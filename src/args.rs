@@ -1,11 +1,12 @@
 //! The render command's groups of options: how a frame is split into
-//! parts, checkpointed and resumed (docs/farm.md), and how its EXR is
-//! stored (docs/output.md).
+//! parts, checkpointed and resumed (docs/farm.md), how its EXR is stored
+//! (docs/output.md), and, with `merge`, how it is denoised.
 
 use std::path::PathBuf;
 
 use clap::ValueEnum;
 
+use lucent::denoise::DenoiseOptions;
 use lucent::film::cryptomatte;
 use lucent::film::exr_layers::{ExrCompression, Precision};
 use lucent::film::region::Region;
@@ -126,6 +127,39 @@ impl FileArgs {
             split: self.aov_split,
             cryptomatte_ranks: self.cryptomatte_ranks,
             transparent: self.transparent,
+        })
+    }
+}
+
+/// Denoising the frame `render` or `merge` writes (docs/output.md,
+/// "Denoising").
+#[derive(clap::Args)]
+pub(crate) struct FrameDenoiseArgs {
+    /// Also write the frame's beauty denoised by Open Image Denoise (the
+    /// layer `denoised`, which the PNG preview shows), guided by its albedo
+    /// and N passes (`render` adds them if not asked for). Frames only:
+    /// a split render is denoised after the merge (docs/output.md,
+    /// "Denoising").
+    #[arg(long)]
+    denoise: bool,
+    /// With --denoise, also each light path and light group layer, as
+    /// `denoised_<layer>`, with the beauty's guides.
+    #[arg(long, requires = "denoise")]
+    denoise_layers: bool,
+    /// With --denoise, OIDN's scratch memory cap in MB (it then
+    /// denoises in overlapping tiles; default: OIDN's own).
+    #[arg(long, requires = "denoise", value_name = "MB")]
+    denoise_memory: Option<u32>,
+}
+
+impl FrameDenoiseArgs {
+    /// What the flags ask of the denoiser on `threads`, or None without
+    /// --denoise.
+    pub(crate) fn options(&self, threads: Option<usize>) -> Option<DenoiseOptions> {
+        self.denoise.then(|| DenoiseOptions {
+            layers: self.denoise_layers,
+            max_memory_mb: self.denoise_memory,
+            ..DenoiseOptions::with_threads(threads)
         })
     }
 }

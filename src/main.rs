@@ -9,7 +9,6 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use lucent::accel::{self, Backend};
-use lucent::denoise::DenoiseOptions;
 use lucent::film::exr_layers::Preview;
 use lucent::film::passes::PassSet;
 use lucent::film::ToneMap;
@@ -25,7 +24,7 @@ use lucent::Error;
 mod args;
 mod denoise;
 mod values;
-use args::{FileArgs, SplitArgs};
+use args::{FileArgs, FrameDenoiseArgs, SplitArgs};
 use values::parse_aov;
 
 #[derive(Parser)]
@@ -149,20 +148,8 @@ enum Command {
         /// (docs/performance.md, "Per-effect statistics").
         #[arg(long)]
         stats: bool,
-        /// Also write the beauty denoised by Open Image Denoise (the layer
-        /// `denoised`, which the PNG preview shows), guided by the albedo
-        /// and N passes (added if not asked for). Frames only: denoise a
-        /// split render after the merge (docs/output.md, "Denoising").
-        #[arg(long)]
-        denoise: bool,
-        /// With --denoise, also each light path and light group layer, as
-        /// `denoised_<layer>`, with the beauty's guides.
-        #[arg(long, requires = "denoise")]
-        denoise_layers: bool,
-        /// With --denoise, OIDN's scratch memory cap in MB (it then
-        /// denoises in overlapping tiles; default: OIDN's own).
-        #[arg(long, requires = "denoise", value_name = "MB")]
-        denoise_memory: Option<u32>,
+        #[command(flatten)]
+        denoise: FrameDenoiseArgs,
         #[command(flatten)]
         subsurface: SubsurfaceArgs,
         #[command(flatten)]
@@ -196,19 +183,8 @@ enum Command {
         /// Without it such parts are refused.
         #[arg(long)]
         mixed_backends: bool,
-        /// Also write the merged frame's beauty denoised (the layer
-        /// `denoised`, which the PNG preview shows), from its albedo and N
-        /// passes (docs/output.md, "Denoising").
-        #[arg(long)]
-        denoise: bool,
-        /// With --denoise, also each light path and light group layer, as
-        /// `denoised_<layer>`, with the beauty's guides.
-        #[arg(long, requires = "denoise")]
-        denoise_layers: bool,
-        /// With --denoise, OIDN's scratch memory cap in MB (it then
-        /// denoises in overlapping tiles; default: OIDN's own).
-        #[arg(long, requires = "denoise", value_name = "MB")]
-        denoise_memory: Option<u32>,
+        #[command(flatten)]
+        denoise: FrameDenoiseArgs,
         /// The denoiser's threads, 1 to 1024 (default: all cores).
         #[arg(long, value_parser = lucent_tools::bench::parse_threads)]
         threads: Option<usize>,
@@ -376,8 +352,6 @@ fn main() -> ExitCode {
             explain,
             stats,
             denoise,
-            denoise_layers,
-            denoise_memory,
             subsurface,
             file,
             split,
@@ -426,11 +400,7 @@ fn main() -> ExitCode {
                         tonemap: tonemap.into(),
                         exposure,
                     },
-                    denoise: denoise.then(|| DenoiseOptions {
-                        layers: denoise_layers,
-                        max_memory_mb: denoise_memory,
-                        ..DenoiseOptions::with_threads(threads)
-                    }),
+                    denoise: denoise.options(threads),
                 };
                 run_render(&r, quiet)
             })
@@ -443,19 +413,13 @@ fn main() -> ExitCode {
             quiet,
             mixed_backends,
             denoise,
-            denoise_layers,
-            denoise_memory,
             threads,
         } => {
             let preview = Preview {
                 tonemap: tonemap.into(),
                 exposure,
             };
-            let d = denoise.then(|| DenoiseOptions {
-                layers: denoise_layers,
-                max_memory_mb: denoise_memory,
-                ..DenoiseOptions::with_threads(threads)
-            });
+            let d = denoise.options(threads);
             session::merge_parts(&parts, &output, preview, mixed_backends, d.as_ref()).map(|m| {
                 if !quiet {
                     tell!("{}", m.summary(&output));
