@@ -12,34 +12,26 @@
 use std::path::Path;
 use std::time::Instant;
 
-use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
 use lucent::denoise::{denoise, DenoiseInput, DenoiseOptions};
 use lucent::film::Film;
 use lucent::geometry::Vec3;
 use lucent_tools::study::metrics::compare;
 
+#[path = "../tests/common/exr_file.rs"]
+#[allow(dead_code)]
+mod exr_file;
+
 /// The channels `names` of the single-layer EXR at `path`, as pixels, and
 /// its size.
 fn read(path: &str, names: [&str; 3]) -> (Vec<Vec3>, u32, u32) {
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .unwrap_or_else(|e| panic!("{path}: {e}"));
+    let image = exr_file::first_layer(Path::new(path));
     let list = &image.layer_data.channel_data.list;
     let plane = |n: &str| -> Vec<f32> {
         let c = list
             .iter()
             .find(|c| c.name == *n)
             .unwrap_or_else(|| panic!("{path}: no {n}"));
-        match &c.sample_data {
-            FlatSamples::F32(v) => v.clone(),
-            FlatSamples::F16(v) => v.iter().map(|h| h.to_f32()).collect(),
-            FlatSamples::U32(v) => v.iter().map(|&u| u as f32).collect(),
-        }
+        exr_file::floats(&c.sample_data)
     };
     let [r, g, b] = names.map(plane);
     let px = (0..r.len()).map(|i| Vec3::new(r[i], g[i], b[i])).collect();

@@ -16,7 +16,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
 
-use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
+pub(crate) use crate::common::exr_file::channels;
+use exr::prelude::FlatSamples;
 use lucent::denoise::{denoise, DenoiseInput, DenoiseOptions};
 use lucent::geometry::Vec3;
 
@@ -103,28 +104,6 @@ fn frames() -> &'static Frames {
             reference,
         }
     })
-}
-
-/// Every channel of the EXR at `path`, as floats.
-pub(crate) fn channels(path: &Path) -> BTreeMap<String, Vec<f32>> {
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .unwrap();
-    let mut out = BTreeMap::new();
-    for c in &image.layer_data.channel_data.list {
-        let v = match &c.sample_data {
-            FlatSamples::F32(v) => v.clone(),
-            FlatSamples::F16(v) => v.iter().map(|h| h.to_f32()).collect(),
-            FlatSamples::U32(v) => v.iter().map(|&u| u as f32).collect(),
-        };
-        out.insert(c.name.to_string(), v);
-    }
-    out
 }
 
 /// The three channels `names` as pixels.
@@ -399,14 +378,7 @@ fn a_frame_with_nan_is_refused_naming_the_channel_and_pixel() {
     let f = frames();
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("nan.exr");
-    let mut image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(&f.noisy)
-        .unwrap();
+    let mut image = crate::common::exr_file::first_layer(&f.noisy);
     for c in image.layer_data.channel_data.list.iter_mut() {
         if c.name.to_string() == "G" {
             if let FlatSamples::F32(v) = &mut c.sample_data {

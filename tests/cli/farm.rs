@@ -6,6 +6,7 @@
 //! message naming the file and the problem, and nothing written.
 
 use crate::common;
+use crate::common::exr_file::all_layers_bits;
 
 use std::fs;
 use std::ops::Range;
@@ -313,32 +314,6 @@ fn refused(d: &Path, args: &[&str]) -> String {
     e
 }
 
-/// Every channel of every layer (of every file, for split passes) of the
-/// EXR at `path`: name and value bits.
-fn exr_channels(path: &Path) -> Vec<(String, Vec<u32>)> {
-    use exr::prelude::*;
-    let image = read_all_flat_layers_from_file(path).unwrap();
-    let mut v = Vec::new();
-    for layer in &image.layer_data {
-        let prefix = layer
-            .attributes
-            .layer_name
-            .as_ref()
-            .map(|n| format!("{n}."))
-            .unwrap_or_default();
-        for ch in &layer.channel_data.list {
-            let bits = match &ch.sample_data {
-                FlatSamples::F32(x) => x.iter().map(|f| f.to_bits()).collect(),
-                FlatSamples::F16(x) => x.iter().map(|f| f.to_bits() as u32).collect(),
-                FlatSamples::U32(x) => x.clone(),
-            };
-            v.push((format!("{prefix}{}", ch.name), bits));
-        }
-    }
-    v.sort();
-    v
-}
-
 /// Passes ride in parts: `--aov all` rendered as bands and as
 /// crops × sample ranges in separate processes merges to every channel of
 /// every layer of the uncut render (light paths, groups, data, IDs,
@@ -394,7 +369,10 @@ fn passes_split_and_merge_to_the_uncut_file() {
             assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
             for f in files {
                 let path = |p: &str| d.join(p.replace(".exr", &format!("{f}.exr")));
-                let (merged, uncut) = (exr_channels(&path(out)), exr_channels(&path("uncut.exr")));
+                let (merged, uncut) = (
+                    all_layers_bits(&path(out)),
+                    all_layers_bits(&path("uncut.exr")),
+                );
                 // not vacuous: channels that vary over the image (the
                 // beauty, the passes, Cryptomatte's ranks)
                 let lively = uncut

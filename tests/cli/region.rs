@@ -8,61 +8,9 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
+pub(crate) use crate::common::exr_file::Exr;
 
 const FIXTURE: &str = "tests/fixtures/marble-ball.toml";
-
-/// A flat EXR's display window (x0, y0, w, h), data window (x0, y0, w,
-/// h) and channels: name, then every sample's bits.
-pub(crate) struct Exr {
-    pub display: (i32, i32, usize, usize),
-    pub data: (i32, i32, usize, usize),
-    pub channels: Vec<(String, Vec<u32>)>,
-}
-
-impl Exr {
-    pub fn read(path: &Path) -> Exr {
-        let image = exr::prelude::read()
-            .no_deep_data()
-            .largest_resolution_level()
-            .all_channels()
-            .first_valid_layer()
-            .all_attributes()
-            .from_file(path)
-            .unwrap();
-        let dw = image.attributes.display_window;
-        let b = image.layer_data.absolute_bounds();
-        let channels = image
-            .layer_data
-            .channel_data
-            .list
-            .iter()
-            .map(|c| {
-                let bits = match &c.sample_data {
-                    FlatSamples::F32(v) => v.iter().map(|x| x.to_bits()).collect(),
-                    FlatSamples::F16(v) => v.iter().map(|x| x.to_bits() as u32).collect(),
-                    FlatSamples::U32(v) => v.clone(),
-                };
-                (c.name.to_string(), bits)
-            })
-            .collect();
-        Exr {
-            display: (dw.position.0, dw.position.1, dw.size.0, dw.size.1),
-            data: (b.position.0, b.position.1, b.size.0, b.size.1),
-            channels,
-        }
-    }
-
-    /// Channel `c`'s sample bits at frame pixel (x, y).
-    pub fn at(&self, c: usize, x: i32, y: i32) -> u32 {
-        let (x0, y0, w, _) = self.data;
-        self.channels[c].1[(y - y0) as usize * w + (x - x0) as usize]
-    }
-
-    pub fn names(&self) -> Vec<&str> {
-        self.channels.iter().map(|c| c.0.as_str()).collect()
-    }
-}
 
 fn lucent(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_lucent"))

@@ -6,6 +6,7 @@ use lucent::accel::Backend;
 use lucent::film::Film;
 
 pub mod brute;
+pub mod exr_file;
 pub mod scene;
 
 /// The backends this build has: our BVH always, Embree with the `embree`

@@ -13,6 +13,8 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::common::exr_file::all_layers_bits;
+
 /// A render that takes minutes: 256² pixels at 100 000 spp.
 const SCENE: &str =
     "[camera]\nlook_from = [0, 0, 3]\nlook_at = [0, 0, 0]\nresolution = [256, 256]\n\
@@ -122,25 +124,6 @@ fn passes_killed_and_resumed_are_bitwise_the_uninterrupted_ones() {
     killed_and_resumed(&["--aov", "all"]);
 }
 
-/// Every channel of every layer of the EXR at `path`: name and value bits.
-fn exr_channels(path: &Path) -> Vec<(String, Vec<u32>)> {
-    use exr::prelude::*;
-    let image = read_all_flat_layers_from_file(path).unwrap();
-    let mut v = Vec::new();
-    for layer in &image.layer_data {
-        for ch in &layer.channel_data.list {
-            let bits = match &ch.sample_data {
-                FlatSamples::F32(x) => x.iter().map(|f| f.to_bits()).collect(),
-                FlatSamples::F16(x) => x.iter().map(|f| f.to_bits() as u32).collect(),
-                FlatSamples::U32(x) => x.clone(),
-            };
-            v.push((ch.name.to_string(), bits));
-        }
-    }
-    v.sort();
-    v
-}
-
 fn killed_and_resumed(options: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
@@ -180,7 +163,7 @@ fn killed_and_resumed(options: &[&str]) {
     let length = start.elapsed().as_millis() as u32;
     // every channel bit for bit (the EXR's header also records the render
     // time)
-    let pixels = |p: &str| exr_channels(&d.join(p));
+    let pixels = |p: &str| all_layers_bits(&d.join(p));
     let whole = pixels("whole.exr");
     // RGBA, or every pass too; not vacuous: channels besides the beauty's
     // that vary over the image
@@ -295,7 +278,7 @@ fn a_signal_during_a_checkpoint_write_keeps_the_samples_and_resumes_bitwise() {
     };
     let (status, e) = finish(render("whole.exr", &[]), Duration::from_secs(300));
     assert_eq!(status, Some(0), "{e}");
-    let whole = exr_channels(&d.join("whole.exr"));
+    let whole = all_layers_bits(&d.join("whole.exr"));
     let mut caught = 0;
     for _ in 0..5 {
         let child = render("cut.exr", &["--checkpoint", "0.05"]);
@@ -328,7 +311,7 @@ fn a_signal_during_a_checkpoint_write_keeps_the_samples_and_resumes_bitwise() {
         );
         assert_eq!(status, Some(0), "{e}");
         assert!(
-            exr_channels(&d.join("cut.exr")) == whole,
+            all_layers_bits(&d.join("cut.exr")) == whole,
             "resumed image differs"
         );
         let left: Vec<String> = names(d)

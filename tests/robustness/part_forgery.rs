@@ -8,6 +8,8 @@ use std::path::Path;
 
 use exr::prelude::*;
 
+use crate::common::exr_file::first_layer;
+
 /// One EXR header attribute: name, type name, raw value.
 #[derive(Clone, Debug)]
 pub struct Attr {
@@ -173,14 +175,7 @@ pub fn edit_header(path: &Path, edit: impl FnOnce(&mut Parts)) {
 /// Rewrites the part at `path` through the `exr` crate with `edit` applied
 /// to channel `name`'s u32 samples (row by row in the part's region).
 pub fn edit_channel(path: &Path, name: &str, edit: impl FnOnce(&mut Vec<u32>)) {
-    let mut image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .unwrap();
+    let mut image = first_layer(path);
     let c = image
         .layer_data
         .channel_data
@@ -199,14 +194,7 @@ pub fn edit_channel(path: &Path, name: &str, edit: impl FnOnce(&mut Vec<u32>)) {
 /// with four words a pixel, `edit` changing them; `keep` says which of the
 /// words are then stored (`w0` first), so a forger can leave a gap.
 pub fn set_words(path: &Path, sum: &str, keep: [bool; 4], edit: impl FnOnce(&mut [Vec<u32>; 4])) {
-    let mut image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .unwrap();
+    let mut image = first_layer(path);
     let list = &mut image.layer_data.channel_data.list;
     let stored: Vec<Vec<u32>> = (0..4)
         .map_while(|j| {
