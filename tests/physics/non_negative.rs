@@ -4,7 +4,8 @@
 //! in every pixel and channel — the default estimators, and at 4 and 16
 //! spp the plane model at the camera vertex (`control_variate = true`,
 //! `integrator::control_variate`: a choice between mirrored probes, never
-//! a subtraction). Caught: an
+//! a subtraction), and at 4 spp the tabulated profile (`profile =
+//! "tabulated"`, whose densities come from a table). Caught: an
 //! additive control variate without a shadow ray, which goes below zero
 //! where the model surface is lit and the real one is in shadow.
 
@@ -80,6 +81,9 @@ fn negatives(path: &Path, spp: u32, options: &str) -> Vec<(String, usize, f32)> 
 
 /// The plane control variate, an option for every subsurface material.
 const CV: &str = "control_variate = true\n";
+/// The tabulated radial profile, another option for every subsurface
+/// material.
+const TABULATED: &str = "profile = \"tabulated\"\n";
 
 #[test]
 fn no_light_pass_of_a_shipped_subsurface_scene_goes_below_zero() {
@@ -93,7 +97,14 @@ fn no_light_pass_of_a_shipped_subsurface_scene_goes_below_zero() {
         if !text.contains("subsurface") {
             continue;
         }
-        let runs = [(1, ""), (4, ""), (16, ""), (4, CV), (16, CV)];
+        let runs = [
+            (1, ""),
+            (4, ""),
+            (16, ""),
+            (4, CV),
+            (16, CV),
+            (4, TABULATED),
+        ];
         for (spp, options) in runs {
             for n in negatives(&path, spp, options) {
                 bad.push(format!(
