@@ -12,121 +12,70 @@
 //! `scripts/albedo-table.sh` runs it. Deterministic for any thread count.
 
 use lucent_tools::halfspace::{albedo_from_reduced, generate, run, Batch, Entry, TableSettings};
+use lucent_tools::table_file::TableCommand;
 use std::fmt::Write as _;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let out = args
-        .iter()
-        .find(|a| !a.starts_with("--"))
-        .cloned()
-        .unwrap_or_else(|| "crates/lucent/src/bssrdf/albedo_table.csv".into());
+    let cmd = TableCommand::from_args("crates/lucent/src/bssrdf/albedo_table.csv");
     let mut s = TableSettings::default();
-    if args.iter().any(|a| a == "--similarity") {
+    if cmd.has("--similarity") {
         similarity(&s);
         return;
     }
-    if args.iter().any(|a| a == "--quick") {
+    if cmd.has("--quick") {
         s.walks_diffuse /= 20;
         s.walks_normal /= 20;
     }
-    let start = std::time::Instant::now();
-    let t = generate(&s, |m| {
-        eprintln!("{m} ({:.0} s)", start.elapsed().as_secs_f64())
-    });
-    let secs = start.elapsed().as_secs_f64();
-    let mut csv = String::new();
-    let h = |csv: &mut String, line: &str| writeln!(csv, "# {line}").unwrap();
-    h(
-        &mut csv,
+    let t = generate(&s, |m| cmd.progress(m));
+    let secs = cmd.seconds();
+    let header = [
         "lucent albedo table: total diffuse reflectance of a semi-infinite medium",
-    );
-    h(
-        &mut csv,
         "behind a smooth dielectric boundary (docs/bssrdf.md section 9).",
-    );
-    h(
-        &mut csv,
         "Made by `cargo run --release --example albedo_table` (lucent_tools::halfspace):",
-    );
-    h(
-        &mut csv,
         "the random walk's free flights, Henyey-Greenstein sampling (g = 0) and",
-    );
-    h(
-        &mut csv,
         "dielectric boundary in the half-space z < 0, all albedos from one set of",
-    );
-    h(
-        &mut csv,
         "walks (R(alpha) = E[alpha^n], n = scattering events before escape).",
-    );
-    h(
-        &mut csv,
         &format!(
             "seed {}, {} walks per eta with diffuse entry, {} with normal entry, cap {} events;",
             s.seed, s.walks_diffuse, s.walks_normal, s.cap
         ),
-    );
-    h(
-        &mut csv,
         &format!(
             "{:.3e} scattering events in {secs:.0} s.",
             t.walk_events as f64
         ),
-    );
-    h(
-        &mut csv,
         "Columns: eta = inside/outside index; x = sqrt(1 - alpha'), alpha' the",
-    );
-    h(
-        &mut csv,
         "reduced albedo; r_diffuse = fraction of the light entering from uniform",
-    );
-    h(
-        &mut csv,
         "radiance outside that leaves again (the A of the diffusion model);",
-    );
-    h(
-        &mut csv,
         "r_normal = the same for light entering along the normal; se_* = standard",
-    );
-    h(&mut csv, "errors. x = 0 is exact (R = 1).");
-    h(
-        &mut csv,
+        "errors. x = 0 is exact (R = 1).",
         &format!(
             "Measured errors: largest standard error {:.1e}; largest |linear interpolation",
             t.max_se
         ),
-    );
-    h(
-        &mut csv,
         &format!(
             "in x - simulated| at the x midpoints {:.1e} (x > 1/40), in eta at eta = {:?} {:.1e}",
             t.max_x_interp, s.eta_checks, t.max_eta_interp
         ),
-    );
-    h(
-        &mut csv,
         &format!(
             "(interpolating R/R_dipole, docs/bssrdf.md section 9); cap bias below {:.1e}.",
             t.max_cap_bound
         ),
-    );
-    writeln!(csv, "eta,x,r_diffuse,se_diffuse,r_normal,se_normal").unwrap();
+    ]
+    .map(String::from);
+    let mut rows = String::new();
     for r in &t.rows {
         writeln!(
-            csv,
+            rows,
             "{:.2},{:.4},{:.6},{:.6},{:.6},{:.6}",
             r.eta, r.x, r.r_diffuse, r.se_diffuse, r.r_normal, r.se_normal
         )
         .unwrap();
     }
-    std::fs::write(&out, csv).unwrap_or_else(|e| {
-        eprintln!("error: cannot write {out}: {e}");
-        std::process::exit(1)
-    });
-    eprintln!("wrote {out} in {secs:.0} s");
+    cmd.write(
+        &header,
+        "eta,x,r_diffuse,se_diffuse,r_normal,se_normal",
+        &rows,
+    );
 }
 
 /// R(α', η = 1.3) at g = 0.5 and 0.8 (single-scattering albedo from α')

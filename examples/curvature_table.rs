@@ -15,29 +15,22 @@
 
 use lucent::bssrdf::curvature_table::CurvatureTable;
 use lucent_tools::sphere_albedo::{escape, generate, Body, Settings};
+use lucent_tools::table_file::TableCommand;
 use std::fmt::Write as _;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let out = args
-        .iter()
-        .find(|a| !a.starts_with("--"))
-        .cloned()
-        .unwrap_or_else(|| "crates/lucent/src/bssrdf/curvature_table.csv".into());
+    let cmd = TableCommand::from_args("crates/lucent/src/bssrdf/curvature_table.csv");
     let mut s = Settings::default();
-    if args.iter().any(|a| a == "--check") {
+    if cmd.has("--check") {
         check(&s);
         return;
     }
-    if args.iter().any(|a| a == "--quick") {
+    if cmd.has("--quick") {
         s.walks_sphere /= 20;
         s.walks_slab /= 20;
     }
-    let start = std::time::Instant::now();
-    let t = generate(&s, |m| {
-        eprintln!("{m} ({:.0} s)", start.elapsed().as_secs_f64())
-    });
-    let secs = start.elapsed().as_secs_f64();
+    let t = generate(&s, |m| cmd.progress(m));
+    let secs = cmd.seconds();
     let max_se = t.nodes.iter().map(|n| n.se_h).fold(0.0, f64::max);
     // The error that matters downstream: of A_sphere = 1 − h (1 − A_slab).
     let max_se_a = t
@@ -45,8 +38,7 @@ fn main() {
         .iter()
         .map(|n| n.se_h * (1.0 - n.a_slab))
         .fold(0.0, f64::max);
-    let mut csv = String::new();
-    for line in [
+    let header = [
         "lucent curvature table: what a sphere absorbs against the half-space of the",
         "same medium, both behind a smooth dielectric boundary, under uniform light",
         "(docs/bssrdf.md section 10). Made by `cargo run --release --example",
@@ -62,22 +54,18 @@ fn main() {
         &format!(
             "Largest standard error: of h {max_se:.2e}, of A_sphere = 1 - h (1 - A_slab) {max_se_a:.2e}."
         ),
-    ] {
-        writeln!(csv, "# {line}").unwrap();
-    }
-    writeln!(csv, "eta,x,rho,h,se_h,a_sphere,a_slab").unwrap();
+    ]
+    .map(String::from);
+    let mut rows = String::new();
     for n in &t.nodes {
         writeln!(
-            csv,
+            rows,
             "{},{},{:.6},{:.6},{:.6},{:.6},{:.6}",
             n.eta, n.x, n.rho, n.h, n.se_h, n.a_sphere, n.a_slab
         )
         .unwrap();
     }
-    let tmp = format!("{out}.tmp");
-    std::fs::write(&tmp, csv).expect("write table");
-    std::fs::rename(&tmp, &out).expect("rename table");
-    eprintln!("wrote {out}");
+    cmd.write(&header, "eta,x,rho,h,se_h,a_sphere,a_slab", &rows);
 }
 
 /// Interpolation check (module docs): prints each point and the largest

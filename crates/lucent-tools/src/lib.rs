@@ -17,6 +17,8 @@
 //!   on a curved body (`docs/bssrdf.md` §10).
 //! - [`profile_table`]: the tabulated profile's generator — where light
 //!   entering the half-space leaves it, by distance (`docs/bssrdf.md` §10).
+//! - [`table_file`]: the command line and the CSV output the table
+//!   generators share.
 //! - [`plot`]: the PNG canvas, font, palette and log axes both draw with.
 //! - [`progress`]: a render's [`lucent::progress::Progress`] drawn as a bar
 //!   on stderr (indicatif).
@@ -37,3 +39,4 @@ pub mod sphere_albedo;
 pub mod sphere_transfer;
 #[cfg(feature = "subsurface")]
 pub mod study;
+pub mod table_file;
