@@ -20,6 +20,8 @@
 //! the far one.
 
 use lucent::film::Film;
+use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::Path;
 
 /// Which pixels belong to the body, and where it is.
@@ -145,17 +147,19 @@ fn stats(films: &[Film], mask: &[bool]) -> [(f64, f64); 3] {
 }
 
 /// One region's lines: both means and the relative difference per channel.
-fn print_region(name: &str, d: [(f64, f64); 3], w: [(f64, f64); 3]) {
+fn print_region(out: &mut String, name: &str, d: [(f64, f64); 3], w: [(f64, f64); 3]) {
     for c in 0..3 {
         let ((md, sd), (mw, sw)) = (d[c], w[c]);
         let rel = md / mw - 1.0;
         let se = (md / mw) * ((sd / md).powi(2) + (sw / mw).powi(2)).sqrt();
-        println!(
+        writeln!(
+            out,
             "{name:<6}  {}   {md:.6}   {mw:.6}   {:+6.2} ± {:.2}",
             ["r", "g", "b"][c],
             100.0 * rel,
             100.0 * se
-        );
+        )
+        .unwrap();
     }
 }
 
@@ -189,12 +193,23 @@ fn main() {
     }
     let body = Body::new(&walk, v[0], v[1], v[2]);
     let fourth = if body.r > 0.0 { "rim" } else { "top" };
-    println!("region  ch  diffusion    walk        diffusion/walk-1 [%]");
+    // the table is written at once, and a reader that stops early (a
+    // closed pipe) ends the program quietly
+    let mut out = String::new();
+    writeln!(
+        out,
+        "region  ch  diffusion    walk        diffusion/walk-1 [%]"
+    )
+    .unwrap();
     for name in ["lit", "far", fourth, "whole"] {
         let mask = body.region(name);
-        print_region(name, stats(&diff, &mask), stats(&walk, &mask));
+        print_region(&mut out, name, stats(&diff, &mask), stats(&walk, &mask));
     }
-    println!("band (x)          r        g        b   [diffusion/walk-1 %]");
+    writeln!(
+        out,
+        "band (x)          r        g        b   [diffusion/walk-1 %]"
+    )
+    .unwrap();
     for i in 0..8 {
         let mask = body.band(i);
         if mask.iter().filter(|&&m| m).count() < 2 {
@@ -206,6 +221,7 @@ fn main() {
             .collect();
         let lo = body.x0 + (body.x1 - body.x0) * i as f64 / 8.0;
         let hi = lo + (body.x1 - body.x0) / 8.0;
-        println!("[{lo:5.1}, {hi:5.1})  {}", rel.join("  "));
+        writeln!(out, "[{lo:5.1}, {hi:5.1})  {}", rel.join("  ")).unwrap();
     }
+    let _ = std::io::stdout().write_all(out.as_bytes());
 }
