@@ -209,6 +209,20 @@ impl ProbeSampler {
         }
     }
 
+    /// A curvature at and beyond which [`axis_probs`](Self::axis_probs)
+    /// no longer changes: ¼ each for T and B from κ·d =
+    /// [`TANGENT_PROB_FULL_AT`] under [`ProbeAxes::Curvature`] (rounded up
+    /// by 2⁻²⁰ so that κ·d ≥ 1 holds after the f32 rounding), 0 under the
+    /// rules that read no curvature; ∞ without an active channel.
+    pub fn saturated_curvature(&self) -> f32 {
+        match self.opts.axes {
+            ProbeAxes::Curvature => {
+                (TANGENT_PROB_FULL_AT / self.d_max * (1.0 + 2f64.powi(-20))) as f32
+            }
+            ProbeAxes::Normal | ProbeAxes::Mis3 => 0.0,
+        }
+    }
+
     /// Samples a probe for exit point `xo` with shading frame `frame`, where
     /// the surface's curvature is `curvature` (1/scene units; see
     /// [`axis_probs`](Self::axis_probs)) (pbrt-v4 `SampleSp`): a channel c, a
