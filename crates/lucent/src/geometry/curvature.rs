@@ -191,7 +191,11 @@ impl MeshCurvature {
     #[inline]
     pub fn axes_up_to(&self, prim: u32, xo: Vec3, saturated: f32) -> f32 {
         let k = self.exit(prim);
-        let Some(edges) = self.edges.as_ref().filter(|_| !(k >= saturated)) else {
+        if k >= saturated {
+            return k;
+        }
+        // (a NaN κ goes on to the search, as in `axes`)
+        let Some(edges) = self.edges.as_ref() else {
             return k;
         };
         // An edge at s ≥ (1/k)(1 + 2⁻²⁰) has fl(1/s) < k: the margin
