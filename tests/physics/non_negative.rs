@@ -79,6 +79,17 @@ fn negatives(path: &Path, spp: u32, options: &str) -> Vec<(String, usize, f32)> 
     found
 }
 
+/// The first mesh file the scene at `path` names that does not exist: the
+/// meshes `scripts/fetch-meshes.sh` fetches and the repository does not
+/// hold (the dragon); the committed ones are always there.
+fn missing_mesh(path: &Path, text: &str) -> Option<std::path::PathBuf> {
+    text.lines()
+        .filter_map(|l| l.trim_start().strip_prefix("file"))
+        .filter_map(|rest| rest.split('"').nth(1))
+        .map(|f| path.parent().unwrap().join(f))
+        .find(|f| !f.exists())
+}
+
 /// The plane control variate, an option for every subsurface material.
 const CV: &str = "control_variate = true\n";
 /// The tabulated radial profile, another option for every subsurface
@@ -95,6 +106,11 @@ fn no_light_pass_of_a_shipped_subsurface_scene_goes_below_zero() {
         }
         let text = std::fs::read_to_string(&path).unwrap();
         if !text.contains("subsurface") {
+            continue;
+        }
+        if let Some(mesh) = missing_mesh(&path, &text) {
+            // a fetched, uncommitted mesh (scenes/meshes/README.md)
+            eprintln!("{}: skipped, no {}", path.display(), mesh.display());
             continue;
         }
         let runs = [

@@ -104,6 +104,8 @@ pub struct ProbeSampler {
     /// [`planar_reflectance`](Self::planar_reflectance), computed once
     /// (the control variate reads it at every camera hit).
     planar: [f64; 3],
+    /// [`saturated_curvature`](Self::saturated_curvature), computed once.
+    saturated: f32,
 }
 
 impl ProbeSampler {
@@ -150,6 +152,12 @@ impl ProbeSampler {
             Some(dist) => scale[c] * dist.profile_mass(),
             None => 0.0,
         });
+        let saturated = match opts.axes {
+            ProbeAxes::Curvature => {
+                (TANGENT_PROB_FULL_AT / params.max_active_d() * (1.0 + 2f64.powi(-20))) as f32
+            }
+            ProbeAxes::Normal | ProbeAxes::Mis3 => 0.0,
+        };
         Ok(ProbeSampler {
             opts: *opts,
             scale,
@@ -160,6 +168,7 @@ impl ProbeSampler {
             d_max: params.max_active_d(),
             density,
             planar,
+            saturated,
         })
     }
 
@@ -207,6 +216,16 @@ impl ProbeSampler {
                 [e, e, 1.0 - 2.0 * e]
             }
         }
+    }
+
+    /// A curvature at and beyond which [`axis_probs`](Self::axis_probs)
+    /// no longer changes: ¼ each for T and B from κ·d =
+    /// [`TANGENT_PROB_FULL_AT`] under [`ProbeAxes::Curvature`] (rounded up
+    /// by 2⁻²⁰ so that κ·d ≥ 1 holds after the f32 rounding), 0 under the
+    /// rules that read no curvature; ∞ without an active channel.
+    #[inline]
+    pub fn saturated_curvature(&self) -> f32 {
+        self.saturated
     }
 
     /// Samples a probe for exit point `xo` with shading frame `frame`, where

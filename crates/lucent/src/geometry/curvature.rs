@@ -178,12 +178,37 @@ impl MeshCurvature {
     /// distance s < reach and that is larger ([`super::sharp_edges`]).
     #[inline]
     pub fn axes(&self, prim: u32, xo: Vec3) -> f32 {
+        self.axes_up_to(prim, xo, f32::INFINITY)
+    }
+
+    /// [`axes`](Self::axes) for a reader to which every curvature ≥
+    /// `saturated` is the same (the axis rule's ¼ beyond
+    /// `ProbeSampler::saturated_curvature`): the value itself where it is
+    /// below `saturated`, some value ≥ `saturated` otherwise. The edge
+    /// search then looks no farther than 1/κ(triangle), beyond which an
+    /// edge cannot raise κ, and stops at the first edge within
+    /// 1/`saturated`; none is made when the triangle's own κ saturates.
+    #[inline]
+    pub fn axes_up_to(&self, prim: u32, xo: Vec3, saturated: f32) -> f32 {
         let k = self.exit(prim);
-        let s = self
-            .edges
-            .as_ref()
-            .map_or(self.reach, |e| e.distance(xo, self.reach));
-        if s < self.reach {
+        if k >= saturated {
+            return k;
+        }
+        // (a NaN κ goes on to the search, as in `axes`)
+        let Some(edges) = self.edges.as_ref() else {
+            return k;
+        };
+        // An edge at s ≥ (1/k)(1 + 2⁻²⁰) has fl(1/s) < k: the margin
+        // covers the roundings of 1/k and 1/s (each ≤ 2⁻²⁴ relative).
+        let reach = if k > 0.0 {
+            self.reach.min(k.recip() * (1.0 + 2f32.powi(-20)))
+        } else {
+            self.reach
+        };
+        // 1/s > `saturated` for s ≤ enough, by the same margin.
+        let enough = saturated.recip() * (1.0 - 2f32.powi(-20));
+        let s = edges.nearest(xo, reach, enough).0;
+        if s < reach {
             k.max(1.0 / s)
         } else {
             k

@@ -163,34 +163,48 @@ impl SharpEdges {
     /// is nearer.
     #[inline]
     pub fn distance(&self, p: Vec3, reach: f32) -> f32 {
-        self.nearest(p, reach).0
+        self.nearest(p, reach, 0.0).0
     }
 
-    /// [`SharpEdges::distance`], and how many nodes the query opened (the
-    /// tree's quality, which tests bound: a badly split tree answers the
-    /// same, only slower).
-    pub fn nearest(&self, p: Vec3, reach: f32) -> (f32, usize) {
+    /// The distance from `p` to the nearest sharp edge, or `reach` if none
+    /// is nearer — or, once an edge within `enough` is found, that edge's
+    /// distance (≤ `enough`, not necessarily the nearest); and how many
+    /// nodes the query opened (the tree's quality, which tests bound: a
+    /// badly split tree answers the same, only slower). The nearer child
+    /// is opened first, so the bound tightens early.
+    pub fn nearest(&self, p: Vec3, reach: f32, enough: f32) -> (f32, usize) {
         let mut best = reach;
-        let mut stack = [0u32; 64];
+        // (node, its box's distance from p), the nearer child on top
+        let mut stack = [(0u32, 0.0f32); 64];
         let mut top = 1;
         let mut opened = 0;
-        while top > 0 {
+        while top > 0 && best > enough {
             top -= 1;
-            opened += 1;
-            let node = self.nodes[stack[top] as usize];
-            if point_box_distance(p, node.lo, node.hi) >= best {
+            let (at, near) = stack[top];
+            if near >= best {
                 continue;
             }
+            opened += 1;
+            let node = self.nodes[at as usize];
             if node.count > 0 {
                 let (a, b) = (node.first as usize, (node.first + node.count) as usize);
                 for s in &self.segments[a..b] {
                     best = best.min(point_segment_distance(p, *s));
                 }
-            } else {
-                // Median splits: depth ≤ log2(segments) + 1, far below 63.
-                stack[top] = node.first;
-                stack[top + 1] = node.first + 1;
-                top += 2;
+                continue;
+            }
+            let child = |i: u32| {
+                let c = &self.nodes[i as usize];
+                (i, point_box_distance(p, c.lo, c.hi))
+            };
+            let (l, r) = (child(node.first), child(node.first + 1));
+            let (far, near) = if l.1 <= r.1 { (r, l) } else { (l, r) };
+            // Median splits: depth ≤ log2(segments) + 1, far below 63.
+            for c in [far, near] {
+                if c.1 < best {
+                    stack[top] = c;
+                    top += 1;
+                }
             }
         }
         (best, opened)
@@ -406,7 +420,7 @@ mod tests {
             let tree = SharpEdges::from_segments(segs).unwrap();
             let queries = 1000;
             let opened: usize = (0..queries)
-                .map(|_| tree.nearest((v() * 2.0 - 1.0) * size + offset, 0.02).1)
+                .map(|_| tree.nearest((v() * 2.0 - 1.0) * size + offset, 0.02, 0.0).1)
                 .sum();
             let mean = opened as f64 / queries as f64;
             println!(

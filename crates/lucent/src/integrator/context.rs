@@ -180,8 +180,23 @@ impl<'a> Context<'a> {
     #[cfg(feature = "subsurface")]
     #[inline]
     pub fn axes_curvature(&self, geom: u32, prim: u32, xo: crate::geometry::Vec3) -> f32 {
+        self.axes_curvature_up_to(geom, prim, xo, f32::INFINITY)
+    }
+
+    /// [`Context::axes_curvature`] for a reader to which every curvature
+    /// ≥ `saturated` is the same
+    /// ([`crate::geometry::curvature::MeshCurvature::axes_up_to`]).
+    #[cfg(feature = "subsurface")]
+    #[inline]
+    pub fn axes_curvature_up_to(
+        &self,
+        geom: u32,
+        prim: u32,
+        xo: crate::geometry::Vec3,
+        saturated: f32,
+    ) -> f32 {
         match &self.curvature[geom as usize] {
-            Some(c) => c.mesh.axes(prim, xo),
+            Some(c) => c.mesh.axes_up_to(prim, xo, saturated),
             None => {
                 crate::geometry::curvature::exit_curvature(&self.scene.meshes[geom as usize], prim)
             }

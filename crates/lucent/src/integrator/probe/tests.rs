@@ -873,6 +873,71 @@ fn light_across_a_sharp_edge_is_found_by_one_probe_in_a_few() {
     assert!(rel_tri > 200.0, "{rel_tri}");
 }
 
+#[test]
+fn the_bounded_edge_search_gives_the_axes_the_full_search_gives() {
+    // Flat-shaded bodies with sharp edges everywhere (an icosahedron and
+    // a box, κ(triangle) their 1/R floor), queried anywhere within reach
+    // of them. `axes` looks no farther than 1/κ(triangle): it must equal
+    // max(κ, 1/s) over the brute-force nearest edge s (a cut nearer than
+    // 1/κ misses edges that raise κ). `axes_up_to` stops at the first
+    // edge within the saturation distance: the axis probabilities must be
+    // the same bit for bit (a stop beyond it picks a farther edge's
+    // smaller κ).
+    let opts = ProbeOptions::default();
+    assert_eq!(opts.axes, ProbeAxes::Curvature);
+    let s = ProbeSampler::new(&params_for(&opts, 1.0), &opts).unwrap();
+    let (rmax, saturated) = (s.rmax() as f32, s.saturated_curvature());
+    let flat = |m: Mesh| Mesh::new(m.positions()[..m.vertex_count()].to_vec(), m.indices, None);
+    let mut ico = flat(crate::scene::shapes::sphere(0));
+    ico.transform(|p| p * 2.5, |n| n);
+    let mut slab = flat(crate::scene::shapes::cuboid());
+    slab.transform(|p| p * Vec3::new(3.0, 0.4, 1.5), |n| n);
+    let mut rng = Rng::from_key(5);
+    let (mut saturating, mut beyond) = (0, 0);
+    for mesh in [ico, slab] {
+        let edges = crate::geometry::sharp_edges::sharp_edges(&mesh);
+        assert!(edges.len() >= 12);
+        let cache = MeshCurvature::new(&mesh, rmax);
+        let extent = mesh.bounds().unwrap().1.abs().max_element() + rmax;
+        for i in 0..4000 {
+            let mut v3 = || Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - 1.0;
+            // every other point within 2d of an edge, where the search may stop
+            let p = if i % 2 == 0 {
+                let [a, b] = edges[i / 2 % edges.len()];
+                let t = v3().x * 0.5 + 0.5;
+                a + t * (b - a) + v3().normalize_or_zero() * (v3().y + 1.0)
+            } else {
+                v3() * extent
+            };
+            let prim = ((rng.uniform() * mesh.triangle_count() as f32) as u32)
+                .min(mesh.triangle_count() as u32 - 1);
+            let brute = edges
+                .iter()
+                .map(|&[a, b]| {
+                    let ab = b - a;
+                    let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+                    (p - (a + t * ab)).length()
+                })
+                .fold(rmax, f32::min);
+            let k = cache.exit(prim);
+            let want = if brute < rmax { k.max(1.0 / brute) } else { k };
+            let full = cache.axes(prim, p);
+            assert_eq!(full, want, "p {p} prim {prim}: s {brute}");
+            let bounded = cache.axes_up_to(prim, p, saturated);
+            assert_eq!(
+                s.axis_probs(bounded),
+                s.axis_probs(full),
+                "p {p} prim {prim}"
+            );
+            saturating += (full >= saturated) as usize;
+            beyond += (full == k && brute < rmax) as usize;
+        }
+    }
+    // both cuts are exercised: points where the search may stop early, and
+    // points whose nearest edge lies beyond 1/κ(triangle) but within reach
+    assert!(saturating > 1000 && beyond > 100, "{saturating} {beyond}");
+}
+
 /// A closed thin wedge (triangular prism): faces z = ±x·tan(angle/2)
 /// for 0 ≤ x ≤ `len` meeting at the edge x = z = 0, |y| ≤ `half_width`.
 fn wedge(angle_deg: f32, len: f32, half_width: f32) -> Mesh {

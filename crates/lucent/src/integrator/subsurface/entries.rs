@@ -97,7 +97,9 @@ pub(super) fn entries<'s, R: Recorder>(
     }
     // The probe axes also see sharp edges near xo (`sharp_edges`); level
     // of detail above and the curvature correction read the triangle's.
-    let kappa = ctx.axes_curvature(si.geom, si.prim, si.p);
+    // Only the axis probabilities read it: no search beyond their ¼.
+    let saturated = ss.probe().saturated_curvature();
+    let kappa = ctx.axes_curvature_up_to(si.geom, si.prim, si.p, saturated);
     let pair = ss.probe_pair() && hit.depth < ctx.pair_depth;
     // The plane model chooses between a probe and its mirror; the pair
     // traces both, so there it has nothing to choose.
