@@ -3,7 +3,7 @@
 //! emitters and environment in light groups, at 1, 4 and 16 spp, is ≥ 0
 //! in every pixel and channel — the default estimators, and at 4 and 16
 //! spp the plane model at the camera vertex (`control_variate = true`,
-//! `integrator::control_variate`: a choice between mirrored probes, never
+//! `probe_pair = false`, `integrator::control_variate`: a choice between mirrored probes, never
 //! a subtraction). Caught: an
 //! additive control variate without a shadow ray, which goes below zero
 //! where the model surface is lit and the real one is in shadow.
@@ -79,7 +79,7 @@ fn negatives(path: &Path, spp: u32, options: &str) -> Vec<(String, usize, f32)> 
 }
 
 /// The plane control variate, an option for every subsurface material.
-const CV: &str = "control_variate = true\n";
+const CV: &str = "control_variate = true\nprobe_pair = false\n";
 
 #[test]
 fn no_light_pass_of_a_shipped_subsurface_scene_goes_below_zero() {
