@@ -97,7 +97,7 @@ fn diffusion(coat: &str, exit: &str, active: &[&str], inactive: &[&str]) -> Valu
     json!({
         "subsurface": [{"method": "level-of-detail"}, {
             "method": "diffusion", "axes": "curvature", "channel": "mis",
-            "radius": "analytic", "pair_depth": 0, "control_variate_depth": 0,
+            "radius": "analytic", "pair_depth": 1, "control_variate_depth": 0,
             "curvature_correction": true
         }],
         "coat": {"method": coat},
@@ -255,15 +255,16 @@ fn the_variance_reduction_is_planned_as_the_material_asks_and_the_lights_allow()
             .unwrap()
             .clone()
     };
+    // (one probe: with the pair the model has nothing to choose)
     let env = load(&format!(
-        "[environment]\nradiance = [0.5, 0.5, 0.5]\n{KETCHUP}control_variate = true\n{BALL_SAUCE}"
+        "[environment]\nradiance = [0.5, 0.5, 0.5]\n{KETCHUP}control_variate = true\nprobe_pair = false\n{BALL_SAUCE}"
     ));
     let d = diffusion_of(&env);
     assert_eq!(d["control_variate_depth"], 0, "{d}");
     let why = d["reason"].as_str().unwrap();
     assert!(why.contains("no area light"), "{why}");
     let lit = load(&format!(
-        "{LAMP}{KETCHUP}control_variate = true\n{BALL_SAUCE}"
+        "{LAMP}{KETCHUP}control_variate = true\nprobe_pair = false\n{BALL_SAUCE}"
     ));
     let d = diffusion_of(&lit);
     assert_eq!(d["control_variate_depth"], 1, "{d}");
@@ -287,7 +288,7 @@ fn the_variance_reduction_is_planned_as_the_material_asks_and_the_lights_allow()
             && why.contains("no control variate (control_variate = false)"),
         "{why}"
     );
-    let neither = load(&format!("{LAMP}{KETCHUP}{BALL_SAUCE}"));
+    let neither = load(&format!("{LAMP}{KETCHUP}probe_pair = false\n{BALL_SAUCE}"));
     let d = diffusion_of(&neither);
     assert_eq!(
         (&d["pair_depth"], &d["control_variate_depth"]),
@@ -322,7 +323,7 @@ fn rough_coat_cosine_exit_and_no_specular() {
 #[test]
 fn options_away_from_their_defaults_are_listed_by_the_table() {
     let s = load(&format!(
-        "{LAMP}{KETCHUP}axes = \"mis3\"\nprobe_pair = true\nrenormalize = false\n{BALL_SAUCE}"
+        "{LAMP}{KETCHUP}axes = \"mis3\"\nprobe_pair = false\nrenormalize = false\n{BALL_SAUCE}"
     ));
     let p = plan_of(&s, IntegratorKind::Path, PassSet::EMPTY);
     let sauce = p.materials.iter().find(|m| m.name == "sauce").unwrap();
@@ -336,7 +337,7 @@ fn options_away_from_their_defaults_are_listed_by_the_table() {
         named,
         [
             ("axes", "mis3", "curvature"),
-            ("probe_pair", "true", "false")
+            ("probe_pair", "false", "true")
         ]
     );
     let text = lucent::integrator::plan::text::render(&p);

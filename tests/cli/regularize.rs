@@ -2,7 +2,7 @@
 //! for bit: `tests/fixtures/smooth-bunny-region.exr` is a region of
 //! scenes/smooth-bunny.toml rendered with the mirror coat everywhere and
 //! the pseudo-random stream and the plane control variate (the commands
-//! below, `--accel bvh`, `--sampler random`, `--control-variate true`), where the default regularized coat changes most pixels
+//! below, `--accel bvh`, `--sampler random`, `--control-variate true`, `--probe-pair false`), where the default regularized coat changes most pixels
 //! (docs/bssrdf.md §6, "Regularized coat"); the journal (2026-12-07, "The
 //! regularized coat") says which build made it.
 //!
@@ -44,6 +44,8 @@ fn render(extra: &[&str]) -> Exr {
             "random",
             "--control-variate",
             "true",
+            "--probe-pair",
+            "false",
             "-q",
         ])
         .arg("-o")

@@ -97,12 +97,12 @@ fn a_part_names_its_options_as_the_scene_format_does() {
     let mut r = request(out.clone(), 0..1, None);
     r.overrides.push(option("axes").unwrap(), "MIS3").unwrap();
     r.overrides
-        .push(option("probe-pair").unwrap(), "true")
+        .push(option("probe-pair").unwrap(), "false")
         .unwrap();
     session::run(&r).unwrap();
     let (h, _) = part::read(&out).unwrap();
     assert_eq!(
         h.identity.options,
-        "accel=bvh integrator=path sampler=sobol axes=mis3 probe_pair=true"
+        "accel=bvh integrator=path sampler=sobol axes=mis3 probe_pair=false"
     );
 }

@@ -494,10 +494,10 @@ fn the_variance_axis_varies_the_camera_vertex_estimator_and_keeps_the_rest() {
     };
     assert_eq!(
         variance_rows(""),
-        ["control-variate", "pair", "pair+control-variate"]
+        ["none", "control-variate", "pair+control-variate"]
     );
     assert_eq!(
-        variance_rows("probe_pair = true\ncontrol_variate = false\n"),
-        ["none", "control-variate", "pair+control-variate"]
+        variance_rows("probe_pair = false\n"),
+        ["control-variate", "pair", "pair+control-variate"]
     );
 }

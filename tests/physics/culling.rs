@@ -216,7 +216,11 @@ fn samples(
 /// while it answers a good share of the queries.
 #[test]
 fn culling_changes_no_sample_bit_for_bit() {
-    for marble in ["", "probe_pair = true", "control_variate = true"] {
+    for marble in [
+        "",
+        "probe_pair = false",
+        "control_variate = true\nprobe_pair = false",
+    ] {
         let scene = scene(marble);
         for backend in backends() {
             let (on, rays_on, culled) = samples(&scene, backend, true);

@@ -16,8 +16,10 @@
 //! Caught: the smooth coat's caustic on the bunny (light the coat mirrors
 //! from one part of the body into the lamp, found only through the entry
 //! lobe's direction) when the coat is not regularized after a
-//! non-specular vertex (`regularize = 0`), or regularized too little to be
-//! light-sampled (`regularize = 0.2`); docs/accuracy.md, "Real meshes".
+//! non-specular vertex (`regularize = 0`: 691× and 0.28 → 1.10 with the
+//! default pair at the camera vertex); docs/accuracy.md, "Real meshes".
+//! `regularize = 0.2` (a narrow lobe still sampled by the coat) passes
+//! with the pair: 192× and flat.
 //! The test profile is optimized (`[profile.test]`), so the suite runs it
 //! in a few seconds.
 
@@ -165,9 +167,12 @@ fn no_sample_outweighs_its_pixel_and_the_error_is_flat_in_spp_on_real_meshes() {
 }
 
 /// The bound on one sample against its pixel's others: above what the
-/// default gives on the three scenes, below the caustic's (the figures
-/// for each `regularize` are in docs/journal.md, 2026-12-07).
-const MAX_RATIO: f64 = 150.0;
+/// default gives on the three scenes, below the caustic's. The largest
+/// sample of a render is itself noisy: on the bunny the default gives
+/// 270×, 36× and 73× with the runs' seeds at 3, 13 and 23, one plain probe
+/// 96×, 213× and 70×, the mirror coat (`regularize = 0`) 691× at 3
+/// (docs/journal.md, 2026-12-07 and 2026-12-08).
+const MAX_RATIO: f64 = 400.0;
 /// How much relMSE×spp may grow from FEW to SPP samples: each figure is a
 /// mean over a few hundred pixels of squared differences, a few per cent
 /// of noise each; the caustic doubles it.

@@ -30,6 +30,8 @@ mod lod;
 #[cfg(feature = "subsurface")]
 mod non_negative;
 #[cfg(feature = "subsurface")]
+mod pair_on_meshes;
+#[cfg(feature = "subsurface")]
 mod params_edges;
 #[cfg(feature = "subsurface")]
 mod probe_pair;

@@ -3,9 +3,10 @@
 //! emitters and environment in light groups, at 1, 4 and 16 spp, is ≥ 0
 //! in every pixel and channel — the default estimators, and at 4 and 16
 //! spp the plane model at the camera vertex (`control_variate = true`,
-//! `integrator::control_variate`: a choice between mirrored probes, never
-//! a subtraction), and at 4 spp the tabulated profile (`profile =
-//! "tabulated"`, whose densities come from a table). Caught: an
+//! `probe_pair = false`, `integrator::control_variate`: a choice between
+//! mirrored probes, never a subtraction), and at 4 spp the tabulated
+//! profile (`profile = "tabulated"`, whose densities come from a table).
+//! Caught: an
 //! additive control variate without a shadow ray, which goes below zero
 //! where the model surface is lit and the real one is in shadow.
 
@@ -91,7 +92,7 @@ fn missing_mesh(path: &Path, text: &str) -> Option<std::path::PathBuf> {
 }
 
 /// The plane control variate, an option for every subsurface material.
-const CV: &str = "control_variate = true\n";
+const CV: &str = "control_variate = true\nprobe_pair = false\n";
 /// The tabulated radial profile, another option for every subsurface
 /// material.
 const TABULATED: &str = "profile = \"tabulated\"\n";

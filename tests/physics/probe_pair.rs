@@ -141,7 +141,7 @@ fn lit_body_variance_ratio(
 fn the_pair_keeps_the_mean_and_cuts_the_lit_bodys_variance() {
     // (the control variate off in both: the pair alone against one probe)
     let pair = scene("control_variate = false\nprobe_pair = true");
-    let one = scene("control_variate = false");
+    let one = scene("control_variate = false\nprobe_pair = false");
     let ratio = lit_body_variance_ratio(&pair, &one, "pair");
     assert!(
         ratio < 0.6,
@@ -162,11 +162,13 @@ fn the_control_variate_keeps_the_mean_and_cuts_the_lit_bodys_variance() {
         .unwrap();
     assert_eq!(
         (ss.control_variate(), ss.probe_pair()),
-        (false, false),
-        "one plain probe is the default"
+        (false, true),
+        "the pair, without the control variate, is the default"
     );
-    let cv = scene("control_variate = true");
-    let ratio = lit_body_variance_ratio(&cv, &default, "control variate");
+    // (the pair off in both: the control variate alone against one probe)
+    let one = scene("probe_pair = false");
+    let cv = scene("control_variate = true\nprobe_pair = false");
+    let ratio = lit_body_variance_ratio(&cv, &one, "control variate");
     assert!(
         ratio < 0.7,
         "the control variate's variance is {ratio:.3} of one probe's"
@@ -278,8 +280,9 @@ fn the_control_variate_is_drawn_only_at_the_camera_vertex_under_an_area_light() 
         }
         pixels.map(|(x, y)| pixel_stats(&ctx, x, y, 64))
     };
-    let lit_on = scene("control_variate = true");
-    let lit_off = scene("control_variate = false");
+    // one probe: with the pair the model has nothing to choose
+    let lit_on = scene("control_variate = true\nprobe_pair = false");
+    let lit_off = scene("control_variate = false\nprobe_pair = false");
     assert_ne!(
         samples(&lit_on, None),
         samples(&lit_off, None),
@@ -297,8 +300,8 @@ fn the_control_variate_is_drawn_only_at_the_camera_vertex_under_an_area_light() 
         lucent::scene::load_str(&text, Path::new("no_area_light.toml")).unwrap()
     };
     let (dark_on, dark_off) = (
-        dark("control_variate = true"),
-        dark("control_variate = false"),
+        dark("control_variate = true\nprobe_pair = false"),
+        dark("control_variate = false\nprobe_pair = false"),
     );
     assert!(
         !Context::new(

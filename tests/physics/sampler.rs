@@ -100,7 +100,8 @@ fn render_with(scene: &Scene, sampler: SamplerKind, threads: usize, spp: u32) ->
 /// The `random` sampler's pixels are the pseudo-random stream's: pinned
 /// bits of a subsurface scene with a floor, a light and an environment,
 /// its coat a mirror at every vertex (`regularize = 0`) and the plane
-/// control variate at the camera vertex (the journal,
+/// control variate at the camera vertex, one probe (`probe_pair = false`;
+/// the journal,
 /// 2026-12-07, "Low-discrepancy sampling: …", says how they were
 /// checked). Catches any change to the stream's draws: their order, the
 /// probe's or the light's layout, the camera's.
@@ -109,7 +110,8 @@ fn random_sampler_pixels_are_the_streams() {
     let mut scene = marble_ball();
     let mirror = Assignments::default()
         .with("regularize", 0)
-        .with("control_variate", true);
+        .with("control_variate", true)
+        .with("probe_pair", false);
     mirror.apply_all(&mut scene.materials).unwrap();
     let film = render_with(&scene, SamplerKind::Random, 2, 4);
     let hash = bits(&film).iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {

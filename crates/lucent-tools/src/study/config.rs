@@ -384,11 +384,11 @@ pub fn matrix(
         m.base.clone().with("lod", LodMode::Off.name()),
     );
     // The variance reduction at the camera vertex, each choice other than
-    // the scene's (the default: one plain probe); the quick
-    // study keeps the pair.
+    // the scene's (the default: the pair); the quick study keeps one
+    // plain probe or the pair, whichever the scene does not use.
     let own = scene_variance(scene);
     let variance: &[(&str, bool, bool)] = if quick {
-        &[("pair", false, true)]
+        &[("none", false, false), ("pair", false, true)]
     } else {
         &[
             ("none", false, false),

@@ -63,7 +63,7 @@ impl Default for EstimatorOptions {
             lod: LodMode::Auto,
             lod_threshold: DEFAULT_THRESHOLD,
             control_variate: false,
-            probe_pair: false,
+            probe_pair: true,
             regularize: DEFAULT_REGULARIZE,
         }
     }
