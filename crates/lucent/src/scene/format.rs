@@ -279,6 +279,9 @@ pub struct MaterialDef {
     pub bump: Option<Spanned<String>>,
     /// The height, in scene units, of a bump texel of value 1.
     pub bump_scale: Option<Spanned<f64>>,
+    /// A texture's name: the roughness of a conductor, rough dielectric,
+    /// plastic coat or subsurface coat (times `roughness`, if given).
+    pub roughness_texture: Option<Spanned<String>>,
     pub eta: Option<Spanned<f64>>,
     // subsurface: parameters (one of three forms)
     pub preset: Option<Spanned<String>>,
@@ -338,6 +341,10 @@ impl MaterialDef {
         add("normal_map", self.normal_map.as_ref().map(|x| x.span()));
         add("bump", self.bump.as_ref().map(|x| x.span()));
         add("bump_scale", self.bump_scale.as_ref().map(|x| x.span()));
+        add(
+            "roughness_texture",
+            self.roughness_texture.as_ref().map(|x| x.span()),
+        );
         add("dmfp_texture", self.dmfp_texture.as_ref().map(|x| x.span()));
         add("metal", self.metal.as_ref().map(|x| x.span()));
         add("n", self.n.as_ref().map(|x| x.span()));
