@@ -431,6 +431,10 @@ pub struct ShapeDef {
     /// `obj`: compute smooth (area-weighted) vertex normals when the file
     /// has none.
     pub smooth: Option<Spanned<bool>>,
+    /// `obj` taking its materials from its MTL: what the `map_Bump` /
+    /// `bump` images are, `"height"` (the MTL format's meaning, the
+    /// default) or `"normal"` (what some exporters write there).
+    pub map_bump: Option<Spanned<String>>,
     /// `sphere`: icosphere subdivision level.
     pub subdivisions: Option<Spanned<u32>>,
     /// The material's name. Required.
@@ -454,6 +458,9 @@ impl ShapeDef {
         }
         if let Some(x) = &self.smooth {
             v.push(("smooth", x.span()));
+        }
+        if let Some(x) = &self.map_bump {
+            v.push(("map_bump", x.span()));
         }
         if let Some(x) = &self.subdivisions {
             v.push(("subdivisions", x.span()));
