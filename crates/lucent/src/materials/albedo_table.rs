@@ -3,7 +3,7 @@
 //! Ē = 2 ∫₀¹ E(μ) μ dμ: what the multiple-scattering compensation of a
 //! microfacet lobe reads (Kelemen & Szirmay-Kalos 2001; Kulla & Conty
 //! 2017). The same node layout as the coat's table (`docs/bssrdf.md`
-//! §12.7). Tables are built once per process for each lobe ([`shared`])
+//! §12.7). Tables are built once per process for each lobe (`shared`)
 //! and blended between fixed roughness steps where a texture gives the
 //! roughness ([`AlbedoTable::lerp`], [`super::roughness_steps`]).
 
