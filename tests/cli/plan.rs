@@ -167,13 +167,7 @@ fn sphere_spot_and_distant_lights_are_light_sampled() {
     let p = plan_of(&s, IntegratorKind::Path, PassSet::EMPTY);
     assert_eq!(p.direct_lighting.method, "next-event estimation");
     let r = &p.direct_lighting.reason;
-    // The 5 W spot in a millimetre scene outshines 1 W/m² of sun over the
-    // scene's few square millimetres: the pick is by power, and says so.
-    assert!(
-        r.contains("lights[0] distant p=0.000, lights[1] spot p=1.000")
-            && r.contains("in proportion to its power"),
-        "{r}"
-    );
+    assert!(r.contains("lights[0] distant, lights[1] spot"), "{r}");
     // With one, both are said.
     let s = load(&format!("{LAMP}{SPHERE_ENV}{lights}"));
     let r = plan_of(&s, IntegratorKind::Path, PassSet::EMPTY)

@@ -388,37 +388,3 @@ fn a_sphere_light_on_a_subsurface_object_matches_an_emitting_mesh_sphere() {
         );
     }
 }
-
-/// The mistake: the `[[lights]]` picked uniformly (or by a pmf the
-/// weights do not divide by). A sphere light of 1 % of another's power
-/// beside it: the plane's mean is still the sum of their irradiances, and
-/// picking by power leaves the pixels nearly as quiet as the strong light
-/// alone gives them (cone sampling of one sphere is almost noiseless),
-/// where a uniform pick makes half the samples the weak light's and the
-/// pixel mean's relative standard error about 7·10⁻³. With independent
-/// random numbers: the default sequence stratifies the pick over a
-/// pixel's samples, which hides most of a uniform pick's noise.
-#[test]
-fn a_weak_light_beside_a_strong_one_takes_few_samples() {
-    let strong = "[[lights]]\ntype = \"sphere\"\nposition = [1, 2, 0]\nradius = 0.3\nradiance = [10, 10, 10]\n";
-    let weak = "[[lights]]\ntype = \"sphere\"\nposition = [-1, 2, 0]\nradius = 0.3\nradiance = [0.1, 0.1, 0.1]\n";
-    // both at d = √5, cos α = 2/√5
-    let e = |l: f64| PI * l * 0.09 / D2 * COS_A;
-    let both = plane_under(&format!("{strong}{weak}"), 64);
-    assert_irradiance(&both, [e(10.1); 3], "strong and weak");
-    let rel = |scene: &Scene| {
-        let a = accel::build(&scene.meshes, Backend::default_available()).unwrap();
-        let opts = RenderOptions {
-            sampler: Some(lucent::sampling::SamplerKind::Random),
-            ..Default::default()
-        };
-        let film = render(scene, a.as_ref(), &opts).unwrap().0;
-        let (m, se) = common::mean_se(&film);
-        se[1] / m[1]
-    };
-    let (two, one) = (rel(&both), rel(&plane_under(strong, 64)));
-    assert!(
-        two < 3.0 * one + 5e-4,
-        "relative standard error {two} with the weak light, {one} without"
-    );
-}

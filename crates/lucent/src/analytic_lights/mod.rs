@@ -7,7 +7,6 @@
 
 pub mod cone;
 pub mod distant;
-pub mod pick;
 pub mod sample;
 pub mod sphere;
 pub mod spot;
@@ -15,7 +14,6 @@ pub mod units;
 
 pub use cone::Cone;
 pub use distant::DistantLight;
-pub use pick::LightPick;
 pub use sample::DirSample;
 pub use sphere::SphereLight;
 pub use spot::Spot;

@@ -1,7 +1,5 @@
 //! Next-event estimation of the `[[lights]]` (sphere, spot, distant): one
-//! light picked in proportion to its power
-//! ([`crate::analytic_lights::LightPick`]), one direction sampled in the
-//! cone it subtends
+//! light picked uniformly, one direction sampled in the cone it subtends
 //! and a shadow ray to it, weighted by the power heuristic against sampling
 //! the vertex's lobe (Veach 1997, §9.2); and the matching weight of their
 //! light found by a lobe-sampled ray: one crossing a sphere light, or one
@@ -19,10 +17,10 @@ use crate::film::passes::Pass;
 use crate::geometry::{Ray, Vec3};
 use crate::sampling::{power, Draw, SampleRng};
 
-/// The probability of picking light `i`.
+/// The probability of picking each light.
 #[inline(always)]
-fn pick_pmf(ctx: &Context, i: usize) -> f32 {
-    ctx.light_pick.pmf(i)
+fn pick_pmf(ctx: &Context) -> f32 {
+    1.0 / ctx.scene.lights.len() as f32
 }
 
 /// Samples the lights at `v` (three randoms), timed as [`Effect::Direct`],
@@ -58,7 +56,7 @@ pub(crate) fn analytic_light(
 ) -> (Vec3, u32) {
     let lights = &ctx.scene.lights;
     let (u_pick, [u0, u1]) = rng.choice_and_point();
-    let i = ctx.light_pick.index(u_pick);
+    let i = ((u_pick * lights.len() as f32) as usize).min(lights.len() - 1);
     let Some(s) = lights[i].sample(v.p, [u0, u1]) else {
         return (Vec3::ZERO, i as u32);
     };
@@ -80,24 +78,19 @@ pub(crate) fn analytic_light(
     ) {
         return (Vec3::ZERO, i as u32);
     }
-    let pmf = pick_pmf(ctx, i);
+    let pmf = pick_pmf(ctx);
     let w = power(pmf * s.pdf, pdf_lobe);
     (f * s.weight * (wi.z.abs() * w / pmf), i as u32)
 }
 
-/// The MIS weight of light `i` found by a ray the lobe at `prev` sampled,
+/// The MIS weight of light found by a ray the lobe at `prev` sampled,
 /// against the light sample taken there (`pdf_light`: the light's density
 /// of the direction, before picking); 1 after the camera or a specular
 /// bounce.
 #[inline(always)]
-fn weight(
-    ctx: &Context,
-    prev: Option<PrevVertex>,
-    i: usize,
-    pdf_light: impl Fn(Vec3) -> f32,
-) -> f32 {
+fn weight(ctx: &Context, prev: Option<PrevVertex>, pdf_light: impl Fn(Vec3) -> f32) -> f32 {
     match prev {
-        Some(p) => power(p.pdf, pick_pmf(ctx, i) * pdf_light(p.p)),
+        Some(p) => power(p.pdf, pick_pmf(ctx) * pdf_light(p.p)),
         None => 1.0,
     }
 }
@@ -123,7 +116,7 @@ pub(crate) fn found<R: Recorder>(
                     continue;
                 }
                 let le = s.radiance_towards(-ray.d.normalize());
-                (le, weight(ctx, path.prev, i, |p| s.pdf(p)), Pass::Emission)
+                (le, weight(ctx, path.prev, |p| s.pdf(p)), Pass::Emission)
             }
             Light::Distant(d) => {
                 // a transparent film leaves the sky seen directly out,
@@ -132,7 +125,7 @@ pub(crate) fn found<R: Recorder>(
                 let Some((le, pdf)) = seen.then(|| d.escaped(ray.d.normalize())).flatten() else {
                     continue;
                 };
-                (le, weight(ctx, path.prev, i, |_| pdf), Pass::Background)
+                (le, weight(ctx, path.prev, |_| pdf), Pass::Background)
             }
         };
         let c = path.beta * le * w;

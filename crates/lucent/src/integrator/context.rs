@@ -34,8 +34,6 @@ pub struct Context<'a> {
     pub scene: &'a Scene,
     pub accel: &'a dyn Accel,
     pub lights: LightSet,
-    /// Which of the `[[lights]]` a vertex samples.
-    pub light_pick: crate::analytic_lights::LightPick,
     pub plan: Plan,
     /// Minimum offset for spawned rays, from the scene's size.
     pub ray_epsilon: f32,
@@ -90,7 +88,6 @@ impl<'a> Context<'a> {
             accel,
             culling: culling::Culling::new(&scene.meshes, extent, ray_epsilon),
             lights: LightSet::new(scene),
-            light_pick: light_pick(scene),
             plan: Plan::new(scene),
             ray_epsilon,
             shading,
@@ -289,13 +286,6 @@ fn subsurface_curvatures(scene: &Scene) -> Vec<Option<SubsurfaceCurvature>> {
             _ => None,
         })
         .collect()
-}
-
-/// The pick among the scene's `[[lights]]`, by power over its bounding
-/// sphere.
-pub(crate) fn light_pick(scene: &Scene) -> crate::analytic_lights::LightPick {
-    let (lo, hi) = scene_bounds(scene);
-    crate::analytic_lights::LightPick::new(&scene.lights, 0.5 * (hi - lo).length())
 }
 
 fn scene_bounds(scene: &Scene) -> (glam::Vec3, glam::Vec3) {

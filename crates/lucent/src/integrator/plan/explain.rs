@@ -172,20 +172,18 @@ fn direct_lighting(scene: &Scene, flags: &Plan) -> Choice {
 
 /// What is done for the `[[lights]]`.
 fn analytic_lights(scene: &Scene) -> String {
-    let pick = crate::integrator::context::light_pick(scene);
     let kinds: Vec<String> = scene
         .lights
         .iter()
         .enumerate()
-        .map(|(i, l)| format!("lights[{i}] {} p={:.3}", l.kind(), pick.pmf(i)))
+        .map(|(i, l)| format!("lights[{i}] {}", l.kind()))
         .collect();
     format!(
-        "{} light(s) of [[lights]] ({}): one picked with probability p in proportion to its \
-         power (a distant light's irradiance over the scene's bounding disk), a direction \
-         sampled in the cone it subtends and a shadow ray per non-specular vertex \
-         (subsurface entry points and coats included), MIS with lobe sampling; rays crossing \
-         a sphere or spot light and rays escaping inside a distant light's cone find its \
-         light (a distant light of angle 0 is a delta, only sampled)",
+        "{} light(s) of [[lights]] ({}): one picked uniformly, a direction sampled in the \
+         cone it subtends and a shadow ray per non-specular vertex (subsurface entry points \
+         and coats included), MIS with lobe sampling; rays crossing a sphere or spot light \
+         and rays escaping inside a distant light's cone find its light (a distant light of \
+         angle 0 is a delta, only sampled)",
         kinds.len(),
         kinds.join(", ")
     )
