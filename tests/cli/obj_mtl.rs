@@ -110,3 +110,96 @@ fn bad_mtl_input_exits_2_naming_file_and_line() {
         assert!(film.is_none(), "output written for {mtl}");
     }
 }
+
+/// Renders the two-part OBJ (its `usemtl tex` part under `tex_mtl`) with
+/// a grey ramp `h.png` beside it, the shape's `shape_keys` and the scene's
+/// `extra` tables, under a light from the side: exit code, stderr, frame.
+fn render_bumped(
+    tex_mtl: &str,
+    shape_keys: &str,
+    extra: &str,
+) -> (Option<i32>, String, Option<Film>) {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("two.obj"), OBJ).unwrap();
+    std::fs::write(
+        d.join("two.mtl"),
+        format!("newmtl red\nKd 1 1 1\nnewmtl tex\n{tex_mtl}"),
+    )
+    .unwrap();
+    image::RgbImage::from_fn(4, 1, |x, _| image::Rgb([(x * 85) as u8; 3]))
+        .save(d.join("h.png"))
+        .unwrap();
+    let scene = format!(
+        "{VIEW}[[lights]]\ntype = \"distant\"\ndirection = [-1, 0, -1]\nirradiance = [2, 2, 2]\n\
+         {extra}[[shapes]]\ntype = \"obj\"\nfile = \"two.obj\"\n{shape_keys}"
+    );
+    let path = d.join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = d.join("out.exr");
+    let res = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["render", "--quiet"])
+        .arg(&path)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .expect("run lucent");
+    let film = out.exists().then(|| Film::read_exr(&out).unwrap());
+    (
+        res.status.code(),
+        String::from_utf8_lossy(&res.stderr).into_owned(),
+        film,
+    )
+}
+
+/// The scene material `tex` reading `h.png` (linear) with `keys`.
+fn scene_tex(keys: &str) -> String {
+    format!(
+        "[textures.h]\nfile = \"h.png\"\ncolor_space = \"linear\"\n\
+         [materials.tex]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]\n{keys}\n"
+    )
+}
+
+/// `map_Bump` is a height map whose `-bm` is the bump scale: it renders
+/// bit for bit as the scene material with `bump` and `bump_scale`, and
+/// not as the flat one. With the shape's `map_bump = "normal"` the same
+/// image is a normal map, as the scene's `normal_map`. Caught: `map_Bump`
+/// read as a normal map by default (or as a height map under
+/// `"normal"`), `-bm` dropped.
+#[test]
+fn map_bump_is_a_height_map_scaled_by_bm_or_a_normal_map_when_asked() {
+    let frame = |mtl: &str, shape: &str, extra: &str| {
+        let (code, stderr, film) = render_bumped(mtl, shape, extra);
+        assert_eq!(code, Some(0), "{stderr}");
+        film.unwrap().pixels
+    };
+    let height = frame("Kd 1 1 1\nmap_Bump -bm 0.3 h.png\n", "", "");
+    let want = frame("", "", &scene_tex("bump = \"h\"\nbump_scale = 0.3"));
+    assert!(height == want, "map_Bump -bm 0.3 is not bump_scale = 0.3");
+    let flat = frame("Kd 1 1 1\n", "", "");
+    assert!(height != flat, "map_Bump changed nothing");
+    let normal = frame("Kd 1 1 1\nmap_Bump h.png\n", "map_bump = \"normal\"\n", "");
+    let want = frame("", "", &scene_tex("normal_map = \"h\""));
+    assert!(normal == want, "map_bump = \"normal\" is not normal_map");
+    assert!(normal != height);
+}
+
+/// A `-bm` without a finite number, and a `map_bump` that is neither
+/// kind: exit 2 naming the file, line and field, nothing written.
+#[test]
+fn a_bad_bump_multiplier_or_map_bump_exits_2() {
+    let (code, stderr, film) = render_bumped("map_Bump -bm x h.png\n", "", "");
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(film.is_none());
+    assert!(
+        stderr.contains("two.mtl:4") && stderr.contains("`-bm`"),
+        "{stderr}"
+    );
+    let (code, stderr, film) = render_bumped("map_Bump h.png\n", "map_bump = \"nrm\"\n", "");
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(film.is_none());
+    assert!(
+        stderr.contains("scene.toml:") && stderr.contains("field `shapes[0].map_bump`"),
+        "{stderr}"
+    );
+}

@@ -169,6 +169,50 @@ fn unusable_textures_exit_2_naming_file_line_field_and_reason() {
     }
 }
 
+/// A roughness texture that cannot be used: declared sRGB (a roughness
+/// is data), unknown, or on a material without a roughness. Exit 2 naming
+/// the file, line and field, nothing written.
+#[test]
+fn unusable_roughness_textures_exit_2_naming_file_line_field_and_reason() {
+    let conductor = |tex: &str, keys: &str| {
+        format!(
+            "{CAM}[textures.t]\n{tex}\n[materials.m]\ntype = \"conductor\"\n\
+             metal = \"gold\"\n{keys}\n[[shapes]]\ntype = \"quad\"\nmaterial = \"m\"\n"
+        )
+    };
+    let linear = "file = \"a.png\"\ncolor_space = \"linear\"";
+    let rows = [
+        (
+            conductor("file = \"a.png\"", "roughness_texture = \"t\""),
+            "materials.m.roughness_texture",
+            "a roughness is data: give it color_space = \"linear\"",
+        ),
+        (
+            conductor(linear, "roughness_texture = \"rough\""),
+            "materials.m.roughness_texture",
+            "unknown texture \"rough\" (defined: t)",
+        ),
+        (
+            scene(linear, "albedo = [1, 1, 1]\nroughness_texture = \"t\""),
+            "materials.m.roughness_texture",
+            "`roughness_texture` does not apply to type \"diffuse\"",
+        ),
+    ];
+    for (scene, field, fragment) in rows {
+        let (code, stderr, written) = render(&scene, &[], |d| png(&d.join("a.png"), 2, 2));
+        assert_eq!(code, Some(2), "{fragment:?}: {stderr}");
+        assert!(
+            stderr.contains(fragment),
+            "stderr lacks {fragment:?}: {stderr}"
+        );
+        assert!(
+            stderr.contains("scene.toml:") && stderr.contains(&format!("field `{field}`")),
+            "no line or field {field}: {stderr}"
+        );
+        assert!(!written, "output written for {fragment:?}");
+    }
+}
+
 /// An OBJ without texture coordinates under a textured material: exit 2
 /// naming the OBJ file and the shape's field.
 #[test]

@@ -37,6 +37,7 @@ mod params_edges;
 mod probe_pair;
 #[cfg(feature = "subsurface")]
 mod randomwalk;
+mod roughness_textures;
 #[cfg(feature = "subsurface")]
 mod sampler;
 #[cfg(feature = "subsurface")]

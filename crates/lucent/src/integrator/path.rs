@@ -107,7 +107,7 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
 ) -> Vec3 {
     let mut l = Vec3::ZERO;
     let mut path = start;
-    let mut point = PointMaterial::None;
+    let mut point = PointMaterial::default();
     let max_depth = ctx.scene.settings.max_depth;
     for depth in start.depth..=max_depth {
         st.rng.start_bounce(depth);
@@ -290,15 +290,16 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
                 }
                 (base, _) => {
                     let at = At { si: &r.si, ..*at };
-                    textured_base::<R, T, S>(ctx, base, &at, path, st, subsurface, point)
+                    match (&t.roughness, r.roughness) {
+                        (Some(map), Some(rough)) => rough_base::<R, T, S>(
+                            ctx, base, map, rough, &at, path, st, subsurface, point,
+                        ),
+                        _ => textured_base::<R, T, S>(ctx, base, &at, path, st, subsurface, point),
+                    }
                 }
             }
         }
-        Material::Dielectric { eta } => {
-            let (next, e) = dielectric_bounce(ctx, *eta, at.si, at.wo, &mut path.beta, st.rng);
-            path.from = ctx.leaving_towards(at.si, next.d);
-            Scatter::Continue(next, e)
-        }
+        Material::Dielectric { eta } => smooth_dielectric(ctx, *eta, at, path, st.rng),
         Material::RoughDielectric(d) => super::glossy::rough_dielectric(ctx, d, at, path, st.rng),
         Material::Conductor(c) => super::glossy::conductor(ctx, c, at, path, st.rec),
         Material::Plastic(p) => super::glossy::plastic(ctx, p, at, path, st.rng, st.rec),
@@ -334,7 +335,7 @@ fn subsurface_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
 
 /// The textured subsurface material `t` (base `ss`) with the parameters
 /// its textures give at the hit (`r`), kept in `point`; `ss` itself
-/// where they give no medium (`docs/bssrdf.md` §13).
+/// where they give no medium and no roughness (`docs/bssrdf.md` §13).
 #[cfg(feature = "subsurface")]
 #[inline(never)]
 fn at_point<'s>(
@@ -343,13 +344,74 @@ fn at_point<'s>(
     r: &super::texturing::Resolved,
     point: &'s mut PointMaterial,
 ) -> &'s crate::materials::Subsurface {
-    let params = match &t.medium {
-        Some(m) => m.params_at(ss.params(), r.albedo, r.dmfp),
-        None => *ss.params(),
+    let medium = match &t.medium {
+        Some(m) if r.albedo.is_some() || r.dmfp.is_some() => {
+            ss.at_point(m.params_at(ss.params(), r.albedo, r.dmfp))
+        }
+        _ => None,
     };
-    match ss.at_point(params) {
-        Some(p) => point.insert(p),
-        None => ss,
+    let coat = t
+        .roughness
+        .as_ref()
+        .and_then(|map| map.steps.as_ref())
+        .zip(r.roughness);
+    match (medium, coat) {
+        (m, Some((steps, rough))) => {
+            let p = m.unwrap_or_else(|| ss.clone());
+            point
+                .subsurface
+                .insert(p.with_point_coat(rough, steps, ss.least_coat()))
+        }
+        (Some(p), None) => point.subsurface.insert(p),
+        (None, None) => ss,
+    }
+}
+
+/// A smooth dielectric of index `eta` hit at `at`: reflection or
+/// refraction, continuing the path.
+fn smooth_dielectric<'s>(
+    ctx: &Context,
+    eta: f32,
+    at: &At,
+    path: &mut Branch,
+    rng: &mut crate::sampling::SampleRng,
+) -> Scatter<'s> {
+    let (next, e) = dielectric_bounce(ctx, eta, at.si, at.wo, &mut path.beta, rng);
+    path.from = ctx.leaving_towards(at.si, next.d);
+    Scatter::Continue(next, e)
+}
+
+/// The glossy `base` of a textured material at `at` with the roughness
+/// `rough` its map gives there (the material kept in `point`); a rough
+/// dielectric below the smooth threshold is the smooth interface. A base
+/// the loader gives no roughness map is scattered as it is.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn rough_base<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
+    ctx: &'s Context,
+    base: &'s Material,
+    map: &crate::materials::RoughnessMap,
+    rough: f32,
+    at: &At,
+    path: &mut Branch,
+    st: &mut PathState<R>,
+    subsurface: &mut S,
+    point: &'s mut PointMaterial,
+) -> Scatter<'s> {
+    match (base, &map.steps) {
+        (Material::Conductor(c), Some(steps)) => {
+            let c = point.conductor.insert(c.at_roughness(rough, steps));
+            super::glossy::conductor(ctx, c, at, path, st.rec)
+        }
+        (Material::Plastic(p), Some(steps)) => {
+            let p = point.plastic.insert(p.at_roughness(rough, steps));
+            super::glossy::plastic(ctx, p, at, path, st.rng, st.rec)
+        }
+        (Material::RoughDielectric(d), _) => match d.at_roughness(rough) {
+            Some(d) => super::glossy::rough_dielectric(ctx, &d, at, path, st.rng),
+            None => smooth_dielectric(ctx, d.eta, at, path, st.rng),
+        },
+        _ => textured_base::<R, T, S>(ctx, base, at, path, st, subsurface, point),
     }
 }
 

@@ -30,9 +30,16 @@ pub(crate) struct SubsurfaceHit<'h, 's> {
 }
 
 /// Where the bounce loop keeps, while a hit's scattering is in use, the
-/// subsurface material with the parameters a textured one has at that hit
-/// (`docs/bssrdf.md` §13): one per path, replaced at each such hit.
-pub(crate) type PointMaterial = Option<Subsurface>;
+/// material with the parameters a textured one has at that hit
+/// (`docs/bssrdf.md` §13): one of each kind per path, replaced at each
+/// such hit.
+#[derive(Default)]
+pub(crate) struct PointMaterial {
+    #[cfg(feature = "subsurface")]
+    pub(crate) subsurface: Option<Subsurface>,
+    pub(crate) conductor: Option<crate::materials::Conductor>,
+    pub(crate) plastic: Option<crate::materials::Plastic>,
+}
 
 /// An estimator of light transport through subsurface objects. The bounce
 /// loop is generic over it, so each implementation gets its own

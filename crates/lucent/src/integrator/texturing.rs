@@ -2,7 +2,7 @@
 //! corners at the hit's barycentrics), the footprint in UV units, and the
 //! parameters the textures give there: the shading normal of a normal map
 //! or a bump map,
-//! the albedo, a subsurface medium's length factor
+//! the albedo, a subsurface medium's length factor, the roughness
 //! (`docs/scene-format.md`, "Textures").
 //!
 //! The footprint is the path's ray cone width w at the hit
@@ -28,6 +28,8 @@ pub(crate) struct Resolved {
     /// Read by subsurface materials only.
     #[cfg_attr(not(feature = "subsurface"), allow(dead_code))]
     pub(crate) dmfp: Option<Vec3>,
+    /// The roughness of a glossy base or a coat.
+    pub(crate) roughness: Option<f32>,
 }
 
 /// The parameters of `t` at `si` (barycentrics `bary`), seen along `wo`
@@ -46,6 +48,7 @@ pub(crate) fn resolve(
             si: *si,
             albedo: None,
             dmfp: None,
+            roughness: None,
         };
     };
     let uv = tri.at(bary);
@@ -60,6 +63,7 @@ pub(crate) fn resolve(
         si,
         albedo: t.albedo.as_ref().map(|a| a.eval(uv, w)),
         dmfp: t.dmfp.as_ref().map(|a| a.eval(uv, w)),
+        roughness: t.roughness.as_ref().map(|r| r.at(uv, w)),
     }
 }
 

@@ -13,11 +13,13 @@
 //! surface is a mirror. Directions are local, z = the shading normal on
 //! wo's side (the material is two-sided).
 
-use super::albedo_table::AlbedoTable;
+use super::albedo_table::{shared, AlbedoTable, TableKey};
 use super::microfacet::{alpha_from_roughness, reflect, Ggx, SMOOTH_ALPHA};
+use super::roughness_steps::RoughnessSteps;
 use crate::geometry::Vec3;
 use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf};
 use std::f32::consts::FRAC_1_PI;
+use std::sync::Arc;
 
 /// Points of the albedo quadrature: in x = −ln(1 − r²) over [0,
 /// `TAIL_X`] (r the radius on the unit disk of visible-normal sampling),
@@ -43,6 +45,8 @@ pub struct Conductor {
     pub eta: Vec3,
     pub k: Vec3,
     pub roughness: f32,
+    /// F̄, the cosine-weighted mean of F per channel.
+    mean_f: Vec3,
     rough: Option<RoughLobe>,
 }
 
@@ -55,28 +59,65 @@ struct RoughLobe {
     ms: Vec3,
 }
 
+impl RoughLobe {
+    /// The lobe of width `alpha` whose F = 1 albedo is `albedo`, for a
+    /// metal of mean Fresnel `f`.
+    fn new(alpha: f32, albedo: AlbedoTable, f: Vec3) -> Self {
+        let e = albedo.mean();
+        let ms = if 1.0 - e > 1e-6 {
+            f * f * e / (Vec3::ONE - f * (1.0 - e)) * (FRAC_1_PI / (1.0 - e))
+        } else {
+            Vec3::ZERO
+        };
+        RoughLobe {
+            ggx: Ggx { alpha },
+            albedo,
+            ms,
+        }
+    }
+}
+
 impl Conductor {
     /// The conductor of index η + ik and `roughness` ∈ [0, 1].
     pub fn new(eta: Vec3, k: Vec3, roughness: f32) -> Self {
         let alpha = alpha_from_roughness(roughness);
-        let rough = (alpha >= SMOOTH_ALPHA).then(|| {
-            let ggx = Ggx { alpha };
-            let albedo = AlbedoTable::new(|mu| single_scattering_albedo(ggx, mu));
-            let e = albedo.mean();
-            let ms = if 1.0 - e > 1e-6 {
-                let f = mean_fresnel(eta, k);
-                f * f * e / (Vec3::ONE - f * (1.0 - e)) * (FRAC_1_PI / (1.0 - e))
-            } else {
-                Vec3::ZERO
-            };
-            RoughLobe { ggx, albedo, ms }
-        });
+        let mean_f = mean_fresnel(eta, k);
+        let rough =
+            (alpha >= SMOOTH_ALPHA).then(|| RoughLobe::new(alpha, *Self::table(roughness), mean_f));
         Conductor {
             eta,
             k,
             roughness,
+            mean_f,
             rough,
         }
+    }
+
+    /// The same metal at `roughness` ∈ [0, 1], its albedo blended from the
+    /// tables of `steps` (a point of a roughness texture).
+    pub fn at_roughness(&self, roughness: f32, steps: &RoughnessSteps) -> Self {
+        let alpha = alpha_from_roughness(roughness);
+        let rough = (alpha >= SMOOTH_ALPHA)
+            .then(|| RoughLobe::new(alpha, steps.at(roughness), self.mean_f));
+        Conductor {
+            roughness,
+            rough,
+            ..*self
+        }
+    }
+
+    /// The F = 1 albedo table of the lobe of `roughness` (≥ the smooth
+    /// threshold), built once per process.
+    pub fn table(roughness: f32) -> Arc<AlbedoTable> {
+        let ggx = Ggx {
+            alpha: alpha_from_roughness(roughness),
+        };
+        let key = TableKey::Conductor {
+            alpha: ggx.alpha.to_bits(),
+        };
+        shared(key, || {
+            AlbedoTable::new(|mu| single_scattering_albedo(ggx, mu))
+        })
     }
 
     /// A mirror: sampled by [`Conductor::mirror`], not by a lobe.

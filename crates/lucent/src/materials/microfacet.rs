@@ -12,12 +12,12 @@
 //!
 //! This file depends only on geometry, sampling and Fresnel: no ray queries.
 
-use super::albedo_table::AlbedoTable;
+use super::albedo_table::{shared, AlbedoTable, TableKey};
 use crate::fresnel;
 use crate::geometry::Vec3;
 use crate::sampling::concentric_disk;
 use std::f32::consts::PI;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// Below this α the interface is treated as smooth (pbrt-v4's threshold).
 pub const SMOOTH_ALPHA: f32 = 1e-3;
@@ -114,8 +114,9 @@ pub struct RoughCoat {
     pub ggx: Ggx,
     pub eta: f32,
     /// E(μ) and its cosine-weighted mean Ē, the coat's albedo under
-    /// uniform light; shared by every coat of the same α and η.
-    albedo: Arc<AlbedoTable>,
+    /// uniform light: the shared table of this α and η, or a blend of the
+    /// tables at the roughness steps around it ([`RoughCoat::with_table`]).
+    albedo: AlbedoTable,
 }
 
 impl PartialEq for RoughCoat {
@@ -128,17 +129,32 @@ impl RoughCoat {
     /// The coat of width `alpha` (≥ [`SMOOTH_ALPHA`]) and index `eta`, with
     /// its albedo table.
     pub fn new(alpha: f32, eta: f32) -> Self {
-        // Sampling the coat, which the quadrature does, never reads the
-        // table: an empty one stands in while it is built.
-        let bare = RoughCoat {
+        Self::with_table(alpha, eta, *Self::table(alpha, eta))
+    }
+
+    /// The coat of width `alpha` and index `eta` whose albedo is `albedo`
+    /// (a blend of the tables of nearby roughnesses).
+    pub fn with_table(alpha: f32, eta: f32, albedo: AlbedoTable) -> Self {
+        RoughCoat {
             ggx: Ggx { alpha },
             eta,
-            albedo: Arc::default(),
+            albedo,
+        }
+    }
+
+    /// The albedo table of the coat of width `alpha` and index `eta`,
+    /// built once per process.
+    pub fn table(alpha: f32, eta: f32) -> Arc<AlbedoTable> {
+        let key = TableKey::Coat {
+            alpha: alpha.to_bits(),
+            eta: eta.to_bits(),
         };
-        let albedo = shared_table((alpha.to_bits(), eta.to_bits()), || {
+        // Sampling the coat, which the quadrature does, never reads the
+        // table: an empty one stands in while it is built.
+        let bare = Self::with_table(alpha, eta, AlbedoTable::default());
+        shared(key, || {
             AlbedoTable::new(|mu| bare.albedo_quadrature(mu, QUADRATURE_SIDE))
-        });
-        RoughCoat { albedo, ..bare }
+        })
     }
 
     /// E(μo) by an n × n midpoint rule over the sampling square.
@@ -204,26 +220,6 @@ impl RoughCoat {
         let w = fresnel::dielectric(cos_om, self.eta) * self.ggx.g2(wo, wi) / g1;
         Some((wi, w, pdf))
     }
-}
-
-/// The bits of a coat's α and η.
-type CoatKey = (u32, u32);
-
-/// The albedo table of the coat whose α and η have the bits `key`, built
-/// the first time a process asks for it: a table costs a quarter of a
-/// million samples of the coat, and materials of one coat, a material's
-/// regularized coat and a material rebuilt with other estimator options
-/// all ask for the same.
-fn shared_table(key: CoatKey, build: impl FnOnce() -> AlbedoTable) -> Arc<AlbedoTable> {
-    static TABLES: Mutex<Vec<(CoatKey, Arc<AlbedoTable>)>> = Mutex::new(Vec::new());
-    // A panic elsewhere while the lock was held leaves only whole entries.
-    let mut tables = TABLES.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((_, t)) = tables.iter().find(|(k, _)| *k == key) {
-        return Arc::clone(t);
-    }
-    let table = Arc::new(build());
-    tables.push((key, Arc::clone(&table)));
-    table
 }
 
 /// The unit half vector of a reflection, ωh = (ωo + ωi)/|ωo + ωi|; None
@@ -501,8 +497,10 @@ mod tests {
         let b = RoughCoat::new(0.09, 1.3);
         let c = RoughCoat::new(0.09, 1.5);
         let d = RoughCoat::new(0.16, 1.3);
-        assert!(Arc::ptr_eq(&a.albedo, &b.albedo));
-        assert!(!Arc::ptr_eq(&a.albedo, &c.albedo) && !Arc::ptr_eq(&a.albedo, &d.albedo));
+        let table = |c: &RoughCoat| Arc::as_ptr(&RoughCoat::table(c.ggx.alpha, c.eta));
+        assert_eq!(table(&a), table(&b));
+        assert!(table(&a) != table(&c) && table(&a) != table(&d));
+        assert_ne!(a.albedo, c.albedo);
         assert!(
             c.mean_albedo() > a.mean_albedo(),
             "a higher index reflects more"

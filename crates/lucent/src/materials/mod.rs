@@ -17,6 +17,7 @@ pub mod metals;
 pub mod microfacet;
 pub mod plastic;
 pub mod rough_dielectric;
+pub mod roughness_steps;
 #[cfg(feature = "subsurface")]
 pub mod subsurface;
 pub mod textured;
@@ -34,7 +35,7 @@ pub use plastic::Plastic;
 pub use rough_dielectric::RoughDielectric;
 #[cfg(feature = "subsurface")]
 pub use subsurface::Subsurface;
-pub use textured::{Bump, TextureUse, Textured};
+pub use textured::{Bump, RoughnessMap, TextureUse, Textured};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {

@@ -12,8 +12,10 @@
 //! bounce loop picks it or the base ([`Plastic::mirror_probability`]).
 //! Directions are local, z = the shading normal on wo's side (two-sided).
 
+use super::albedo_table::AlbedoTable;
 use super::conductor::{weighted, GlossySample};
 use super::microfacet::{alpha_from_roughness, RoughCoat, SMOOTH_ALPHA};
+use super::roughness_steps::RoughnessSteps;
 use crate::fresnel;
 use crate::geometry::Vec3;
 use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf};
@@ -28,6 +30,8 @@ pub struct Plastic {
     coat: Option<RoughCoat>,
     /// Ē of the coat.
     mean: f32,
+    /// F̄ of the smooth coat of index η.
+    smooth_mean: f32,
 }
 
 impl Plastic {
@@ -36,9 +40,36 @@ impl Plastic {
     pub fn new(albedo: Vec3, eta: f32, roughness: f32) -> Self {
         let alpha = alpha_from_roughness(roughness);
         let coat = (alpha >= SMOOTH_ALPHA).then(|| RoughCoat::new(alpha, eta));
+        Self::with_coat(albedo, eta, roughness, coat, mean_fresnel(eta))
+    }
+
+    /// The same plastic at `roughness` ∈ [0, 1], its coat's albedo blended
+    /// from the tables of `steps` (a point of a roughness texture).
+    pub fn at_roughness(&self, roughness: f32, steps: &RoughnessSteps) -> Self {
+        let alpha = alpha_from_roughness(roughness);
+        let coat = (alpha >= SMOOTH_ALPHA)
+            .then(|| RoughCoat::with_table(alpha, self.eta, steps.at(roughness)));
+        Self::with_coat(self.albedo, self.eta, roughness, coat, self.smooth_mean)
+    }
+
+    /// The albedo table of the coat of `roughness` (≥ the smooth
+    /// threshold) and index `eta`, built once per process.
+    pub fn table(roughness: f32, eta: f32) -> std::sync::Arc<AlbedoTable> {
+        RoughCoat::table(alpha_from_roughness(roughness), eta)
+    }
+
+    /// The plastic with the coat `coat` (None: smooth, whose F̄ is
+    /// `smooth_mean`).
+    fn with_coat(
+        albedo: Vec3,
+        eta: f32,
+        roughness: f32,
+        coat: Option<RoughCoat>,
+        smooth_mean: f32,
+    ) -> Self {
         let mean = match &coat {
             Some(c) => c.mean_albedo(),
-            None => mean_fresnel(eta),
+            None => smooth_mean,
         };
         Plastic {
             albedo,
@@ -46,6 +77,7 @@ impl Plastic {
             roughness,
             coat,
             mean,
+            smooth_mean,
         }
     }
 

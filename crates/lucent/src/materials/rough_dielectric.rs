@@ -62,6 +62,14 @@ impl RoughDielectric {
         }
     }
 
+    /// The same interface at `roughness` (a point of a roughness
+    /// texture); None below the smooth threshold, where it is the smooth
+    /// interface.
+    pub fn at_roughness(&self, roughness: f32) -> Option<Self> {
+        (alpha_from_roughness(roughness) >= super::microfacet::SMOOTH_ALPHA)
+            .then(|| Self::new(self.eta, roughness))
+    }
+
     /// D_ωo(m): the density of visible normals, for either side of ωo.
     fn visible_density(&self, wo: Vec3, m: Vec3) -> f32 {
         self.ggx.g1(wo) / wo.z.abs() * self.ggx.d(m) * wo.dot(m).abs()

@@ -24,11 +24,12 @@
 //! weighted by the transmitted fraction (1 − Fr or 1 − E) and the reflected
 //! light is lost, for either roughness.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use super::estimator_options::{CurvatureMode, EstimatorOptions, WalkBoundary, OPTIONS};
 use super::lod::{LodMode, LodRule};
 use super::microfacet::{alpha_from_roughness, RoughCoat, SMOOTH_ALPHA};
+use super::roughness_steps::RoughnessSteps;
 use crate::bssrdf::curvature_correction::CurvatureCorrection;
 use crate::bssrdf::{sw_normalization, ProbeOptions, ProbeSampler, SubsurfaceParams};
 use crate::error::{Constraint, Param, ParamError};
@@ -48,6 +49,10 @@ pub struct Subsurface {
     /// The coat after a non-specular vertex, where `regularize` asks for
     /// one rougher than `coat` (`docs/bssrdf.md` §6, "Regularized coat").
     regularized: Option<Arc<RoughCoat>>,
+    /// The coat of roughness `regularize` (None when that is smooth), for
+    /// the points of a roughness texture smoother than it
+    /// ([`Self::least_coat`]).
+    least: OnceLock<Option<Arc<RoughCoat>>>,
     /// c = 1 − 2 FM1(1/η), Sw's normalization (for a rough coat, 1 − Ē).
     sw_c: f32,
     /// The correction, when the mode is on and the parameters record a
@@ -109,6 +114,7 @@ impl Subsurface {
             probe,
             coat,
             regularized,
+            least: OnceLock::new(),
             sw_c,
             curvature,
             lod,
@@ -162,10 +168,48 @@ impl Subsurface {
             probe,
             coat: self.coat.clone(),
             regularized: self.regularized.clone(),
+            least: self.least.clone(),
             sw_c: self.sw_c,
             curvature,
             lod,
         })
+    }
+
+    /// The material with its coat of `roughness` ∈ [0, 1] at one point of
+    /// a roughness texture (`docs/bssrdf.md` §13): the coat's albedo
+    /// blended from the tables of `steps`, the entry lobe's normalization
+    /// 1 − Ē from it, and after a non-specular vertex the coat `least`
+    /// (of roughness `regularize`, [`Self::least_coat`]) where that is
+    /// rougher; the medium and every other option kept.
+    pub(crate) fn with_point_coat(
+        mut self,
+        roughness: f32,
+        steps: &RoughnessSteps,
+        least: Option<&Arc<RoughCoat>>,
+    ) -> Self {
+        let alpha = alpha_from_roughness(roughness);
+        let eta = self.params.eta;
+        self.coat = (alpha >= SMOOTH_ALPHA)
+            .then(|| Arc::new(RoughCoat::with_table(alpha, eta, steps.at(roughness))));
+        self.regularized = least.filter(|c| c.ggx.alpha > alpha).cloned();
+        self.sw_c = match &self.coat {
+            Some(c) => 1.0 - c.mean_albedo(),
+            None => sw_normalization(eta),
+        };
+        self.options.roughness = roughness;
+        self
+    }
+
+    /// The coat of roughness `regularize` (None when that is smooth),
+    /// built the first time a point of a roughness texture asks.
+    pub(crate) fn least_coat(&self) -> Option<&Arc<RoughCoat>> {
+        self.least
+            .get_or_init(|| {
+                let alpha_min = alpha_from_roughness(self.options.regularize);
+                (alpha_min >= SMOOTH_ALPHA)
+                    .then(|| Arc::new(RoughCoat::new(alpha_min, self.params.eta)))
+            })
+            .as_ref()
     }
 
     /// The material with level-of-detail `mode` and footprint-to-Rmax

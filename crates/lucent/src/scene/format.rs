@@ -279,6 +279,9 @@ pub struct MaterialDef {
     pub bump: Option<Spanned<String>>,
     /// The height, in scene units, of a bump texel of value 1.
     pub bump_scale: Option<Spanned<f64>>,
+    /// A texture's name: the roughness of a conductor, rough dielectric,
+    /// plastic coat or subsurface coat (times `roughness`, if given).
+    pub roughness_texture: Option<Spanned<String>>,
     pub eta: Option<Spanned<f64>>,
     // subsurface: parameters (one of three forms)
     pub preset: Option<Spanned<String>>,
@@ -338,6 +341,10 @@ impl MaterialDef {
         add("normal_map", self.normal_map.as_ref().map(|x| x.span()));
         add("bump", self.bump.as_ref().map(|x| x.span()));
         add("bump_scale", self.bump_scale.as_ref().map(|x| x.span()));
+        add(
+            "roughness_texture",
+            self.roughness_texture.as_ref().map(|x| x.span()),
+        );
         add("dmfp_texture", self.dmfp_texture.as_ref().map(|x| x.span()));
         add("metal", self.metal.as_ref().map(|x| x.span()));
         add("n", self.n.as_ref().map(|x| x.span()));
@@ -424,6 +431,10 @@ pub struct ShapeDef {
     /// `obj`: compute smooth (area-weighted) vertex normals when the file
     /// has none.
     pub smooth: Option<Spanned<bool>>,
+    /// `obj` taking its materials from its MTL: what the `map_Bump` /
+    /// `bump` images are, `"height"` (the MTL format's meaning, the
+    /// default) or `"normal"` (what some exporters write there).
+    pub map_bump: Option<Spanned<String>>,
     /// `sphere`: icosphere subdivision level.
     pub subdivisions: Option<Spanned<u32>>,
     /// The material's name. Required.
@@ -447,6 +458,9 @@ impl ShapeDef {
         }
         if let Some(x) = &self.smooth {
             v.push(("smooth", x.span()));
+        }
+        if let Some(x) = &self.map_bump {
+            v.push(("map_bump", x.span()));
         }
         if let Some(x) = &self.subdivisions {
             v.push(("subdivisions", x.span()));

@@ -13,10 +13,15 @@ use crate::materials::{Conductor, Material, Plastic, RoughDielectric};
 /// The coat's index a plastic gets without `eta`.
 const PLASTIC_ETA: f32 = 1.5;
 
-/// `roughness` ∈ [0, 1] (0 without the key).
+/// `roughness` ∈ [0, 1]; without the key 0, or 1 with a
+/// `roughness_texture` (the key is a factor on it).
 fn roughness(cx: &Cx, field: &str, d: &MaterialDef) -> Res<f32> {
     let Some(r) = &d.roughness else {
-        return Ok(0.0);
+        return Ok(if d.roughness_texture.is_some() {
+            1.0
+        } else {
+            0.0
+        });
     };
     let f = format!("{field}.roughness");
     let x = cx.scalar(r, &f)?;
@@ -30,10 +35,11 @@ fn roughness(cx: &Cx, field: &str, d: &MaterialDef) -> Res<f32> {
     Ok(x)
 }
 
-/// A dielectric: smooth (the specular interface) unless `roughness` > 0.
+/// A dielectric: smooth (the specular interface) unless `roughness` > 0
+/// or a `roughness_texture` is given.
 pub(super) fn dielectric(cx: &Cx, field: &str, d: &MaterialDef, eta: f32) -> Res<Material> {
     let r = roughness(cx, field, d)?;
-    Ok(if r > 0.0 {
+    Ok(if r > 0.0 || d.roughness_texture.is_some() {
         Material::RoughDielectric(RoughDielectric::new(eta, r))
     } else {
         Material::Dielectric { eta }

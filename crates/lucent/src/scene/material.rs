@@ -46,6 +46,7 @@ const PARAMETER_KEYS: &[&str] = &[
     "albedo_source",
     "albedo_texture",
     "dmfp_texture",
+    "roughness_texture",
 ];
 
 /// The parameter forms, for messages.
@@ -97,7 +98,8 @@ pub(super) fn material(
             Ok(Material::Diffuse { albedo })
         }
         MaterialKind::Dielectric => {
-            cx.only_keys(&field, kind.name(), d.present_keys(), &["eta", "roughness"])?;
+            let keys = ["eta", "roughness", "roughness_texture"];
+            cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             let e = d.eta.as_ref().ok_or_else(|| missing("eta"))?;
             let eta = cx.positive(e, &format!("{field}.eta"))?;
             glossy_material::dielectric(cx, &field, d, eta)
@@ -108,6 +110,7 @@ pub(super) fn material(
                 "n",
                 "k",
                 "roughness",
+                "roughness_texture",
                 "normal_map",
                 "bump",
                 "bump_scale",
@@ -120,6 +123,7 @@ pub(super) fn material(
                 "albedo",
                 "eta",
                 "roughness",
+                "roughness_texture",
                 "normal_map",
                 "bump",
                 "bump_scale",
@@ -144,7 +148,12 @@ pub(super) fn material(
                 .collect();
             cx.only_keys(&field, kind.name(), d.present_keys(), &keys)?;
             let (params, recipe) = parameters(cx, &field, m, units_per_mm as f64)?;
-            let options = estimator_options(cx, &field, m)?;
+            let mut options = estimator_options(cx, &field, m)?;
+            // With a texture the coat's roughness is a factor on it, 1 by
+            // default.
+            if d.roughness.is_none() && d.roughness_texture.is_some() {
+                options.roughness = 1.0;
+            }
             let ss = Subsurface::from_options(params, &options)
                 .map_err(|e| locate_param(cx, &field, m, &e))?;
             check_rmax(cx, &field, m, &ss, units_per_mm, units_def)?;

@@ -21,7 +21,7 @@ use super::regular_file::read_regular_file;
 use super::{textures, Object};
 use crate::error::InputError;
 use crate::geometry::{Mesh, Vec3};
-use crate::materials::{Material, Plastic, TextureUse, Textured};
+use crate::materials::{Bump, Material, Plastic, TextureUse, Textured};
 use crate::texture::{ColorSpace, Texture, TextureRef, Wrap};
 
 /// The albedo of an MTL material without `Kd` or `map_Kd`.
@@ -34,8 +34,9 @@ pub(super) struct MtlMaterials {
     /// Added materials, numbered after the scene's own.
     pub materials: Vec<Material>,
     pub names: Vec<String>,
-    /// By MTL file and material name: the index in `materials`.
-    by_key: HashMap<(PathBuf, String), usize>,
+    /// By MTL file, material name and whether its `map_Bump` is a normal
+    /// map: the index in `materials`.
+    by_key: HashMap<(PathBuf, String, bool), usize>,
     textures: HashMap<(PathBuf, bool), Arc<Texture>>,
     /// What was read past or approximated, one line each.
     pub notes: Vec<String>,
@@ -68,7 +69,13 @@ pub(super) fn objects(
 ) -> Res<Vec<(Mesh, Object)>> {
     let field = format!("shapes[{i}]");
     let d = s.get_ref();
-    cx.only_keys(&field, "obj", d.present_type_keys(), &["file", "smooth"])?;
+    cx.only_keys(
+        &field,
+        "obj",
+        d.present_type_keys(),
+        &["file", "smooth", "map_bump"],
+    )?;
+    let bump_is_normal = bump_is_normal(cx, &field, d)?;
     let f = cx.required(&d.file, Some(s.span()), &format!("{field}.file"))?;
     let path = dir.join(f.get_ref());
     let text = read_regular_file(&path, MAX_OBJ_BYTES).map_err(|e| {
@@ -138,7 +145,7 @@ pub(super) fn objects(
         let (material, textured) = match scene.get(m.name.as_str()) {
             Some(&idx) => (idx, reads_textures[idx]),
             None => {
-                let idx = added(&mtl_path, m, out)?;
+                let idx = added(&mtl_path, m, bump_is_normal, out)?;
                 (scene_count + idx, out.materials[idx].reads_textures())
             }
         };
@@ -259,14 +266,37 @@ fn sub_mesh(mesh: &Mesh, tri_material: &[Option<u32>], k: u32) -> Mesh {
     part
 }
 
+/// Whether the OBJ shape `d` reads its MTL's `map_Bump` / `bump` images
+/// as normal maps: its `map_bump`, `"height"` (the default) or
+/// `"normal"`.
+fn bump_is_normal(cx: &Cx, field: &str, d: &ShapeDef) -> Res<bool> {
+    let Some(v) = &d.map_bump else {
+        return Ok(false);
+    };
+    match v.get_ref().as_str() {
+        "height" => Ok(false),
+        "normal" => Ok(true),
+        other => Err(cx.err(
+            v.span(),
+            &format!("{field}.map_bump"),
+            format!("expected \"height\" or \"normal\", found {}", quoted(other)),
+        )),
+    }
+}
+
 /// The index in `out.materials` of MTL material `m` of `mtl_path`, made on
-/// its first use.
-fn added(mtl_path: &Path, m: &MtlMaterial, out: &mut MtlMaterials) -> Result<usize, InputError> {
-    let key = (mtl_path.to_path_buf(), m.name.clone());
+/// its first use (`bump_is_normal`: its `map_Bump` read as a normal map).
+fn added(
+    mtl_path: &Path,
+    m: &MtlMaterial,
+    bump_is_normal: bool,
+    out: &mut MtlMaterials,
+) -> Result<usize, InputError> {
+    let key = (mtl_path.to_path_buf(), m.name.clone(), bump_is_normal);
     if let Some(&i) = out.by_key.get(&key) {
         return Ok(i);
     }
-    let material = material(mtl_path, m, out)?;
+    let material = material(mtl_path, m, bump_is_normal, out)?;
     out.materials.push(material);
     out.names.push(m.name.clone());
     out.by_key.insert(key, out.materials.len() - 1);
@@ -275,10 +305,13 @@ fn added(mtl_path: &Path, m: &MtlMaterial, out: &mut MtlMaterials) -> Result<usi
 
 /// The lucent material of MTL material `m`: diffuse (albedo `Kd`, or
 /// `map_Kd`), or plastic of roughness `Pr` / `Ns` when untextured; a
-/// normal map from `map_Bump` / `bump` / `norm`.
+/// normal map from `norm`, a height map from `map_Bump` / `bump` (its
+/// `-bm` the `bump_scale`), or a normal map from them where
+/// `bump_is_normal`.
 fn material(
     mtl_path: &Path,
     m: &MtlMaterial,
+    bump_is_normal: bool,
     out: &mut MtlMaterials,
 ) -> Result<Material, InputError> {
     let kd = m.kd.unwrap_or(Vec3::splat(DEFAULT_KD));
@@ -301,7 +334,43 @@ fn material(
         Ok::<_, InputError>(t)
     };
     let albedo = m.map_kd.as_ref().map(|f| texture(f, false)).transpose()?;
-    let normal = m.normal.as_ref().map(|f| texture(f, true)).transpose()?;
+    let mut notes = Vec::new();
+    let mut note = |what: &str| {
+        notes.push(format!(
+            "{}: material {}: {what}",
+            mtl_path.display(),
+            quoted(&m.name)
+        ))
+    };
+    // (the normal map's file and key, the height map's file and scale)
+    let (normal_file, bump_file) = match (&m.normal, &m.bump) {
+        (Some(n), b) => {
+            if b.is_some() {
+                note("`map_Bump` ignored: `norm` gives the normal");
+            }
+            (Some((n.clone(), "norm")), None)
+        }
+        (None, Some((f, line, bm))) if bump_is_normal => {
+            if *bm != 1.0 {
+                note("`-bm` ignored: `map_Bump` is read as a normal map");
+            }
+            (Some(((f.clone(), *line), "map_Bump")), None)
+        }
+        (None, Some((f, line, bm))) => (None, Some(((f.clone(), *line), *bm))),
+        (None, None) => (None, None),
+    };
+    let normal = normal_file
+        .as_ref()
+        .map(|(f, _)| texture(f, true))
+        .transpose()?;
+    let bump = match &bump_file {
+        Some((f, scale)) => Some(Bump {
+            texture: texture(f, true)?,
+            scale: *scale,
+        }),
+        None => None,
+    };
+    out.notes.append(&mut notes);
     let base = match (m.roughness, &albedo) {
         (Some(r), None) => Material::Plastic(Arc::new(Plastic::new(kd, 1.5, r))),
         (r, Some(_)) => {
@@ -323,23 +392,26 @@ fn material(
         }
         (None, None) => Material::Diffuse { albedo: kd },
     };
-    if albedo.is_none() && normal.is_none() {
+    if albedo.is_none() && normal.is_none() && bump.is_none() {
         return Ok(base);
     }
     let albedo = albedo.map(|texture| TextureRef {
         texture,
         scale: Vec3::ONE,
     });
-    let names = [("map_Kd", &m.map_kd), ("map_Bump", &m.normal)]
-        .into_iter()
-        .filter_map(|(key, f)| {
-            f.as_ref().map(|(file, _)| TextureUse {
-                key,
-                texture: file.clone(),
-            })
-        })
-        .collect();
-    Ok(Material::Textured(Arc::new(
-        Textured::new(base, albedo, normal).named(names),
-    )))
+    let names = [
+        m.map_kd.as_ref().map(|(f, _)| ("map_Kd", f)),
+        normal_file.as_ref().map(|((f, _), key)| (*key, f)),
+        bump_file.as_ref().map(|((f, _), _)| ("map_Bump", f)),
+    ]
+    .into_iter()
+    .flatten()
+    .map(|(key, f)| TextureUse {
+        key,
+        texture: f.clone(),
+    })
+    .collect();
+    let mut t = Textured::new(base, albedo, normal).named(names);
+    t.bump = bump;
+    Ok(Material::Textured(Arc::new(t)))
 }

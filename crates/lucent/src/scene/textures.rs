@@ -1,7 +1,7 @@
 //! `[textures.NAME]` → the scene's texture table (each image read once,
 //! shared by every material that names it), and the materials that name
-//! textures (`albedo_texture`, `normal_map`, a subsurface material's
-//! `dmfp_texture`) → [`Textured`] materials
+//! textures (`albedo_texture`, `normal_map`, `bump`, `roughness_texture`,
+//! a subsurface material's `dmfp_texture`) → [`Textured`] materials
 //! (`docs/scene-format.md`, "Textures").
 
 use std::collections::{BTreeMap, HashMap};
@@ -15,9 +15,10 @@ use super::regular_file::{open_regular, read_regular_bytes};
 #[cfg(feature = "subsurface")]
 use super::MAX_SUBSURFACE_RADIUS;
 use crate::geometry::Vec3;
+use crate::materials::roughness_steps::RoughnessSteps;
 #[cfg(feature = "subsurface")]
 use crate::materials::textured_medium::MediumRecipe;
-use crate::materials::{Bump, Material, TextureUse, Textured};
+use crate::materials::{Bump, Conductor, Material, Plastic, RoughnessMap, TextureUse, Textured};
 use crate::texture::file::{self, Format, TextureError};
 use crate::texture::{ColorSpace, Texture, TextureRef, Wrap};
 
@@ -148,7 +149,9 @@ pub(super) fn textured(
         return Ok(base);
     }
     let bump = bump(cx, &field, d, table)?;
-    if d.albedo_texture.is_none() && d.normal_map.is_none() && bump.is_none() {
+    let roughness = roughness(cx, &field, d, &base, table)?;
+    if d.albedo_texture.is_none() && d.normal_map.is_none() && bump.is_none() && roughness.is_none()
+    {
         return Ok(base);
     }
     let albedo = match &d.albedo_texture {
@@ -174,10 +177,59 @@ pub(super) fn textured(
         ("albedo_texture", &d.albedo_texture),
         ("normal_map", &d.normal_map),
         ("bump", &d.bump),
+        ("roughness_texture", &d.roughness_texture),
     ]);
     let mut t = Textured::new(base, albedo, normal).named(names);
     t.bump = bump;
+    t.roughness = roughness;
     Ok(Material::Textured(Arc::new(t)))
+}
+
+/// The roughness map of material `field` (table `d`, built as `base`):
+/// its `roughness_texture` (data) times the base's roughness, with the
+/// albedo tables of the steps it spans for a conductor, a plastic or a
+/// subsurface coat. The loader accepts the key on those and on a
+/// dielectric only.
+fn roughness(
+    cx: &Cx,
+    field: &str,
+    d: &MaterialDef,
+    base: &Material,
+    table: &Table,
+) -> Res<Option<RoughnessMap>> {
+    let Some(t) = &d.roughness_texture else {
+        return Ok(None);
+    };
+    let key = format!("{field}.roughness_texture");
+    let texture = data(cx, &key, t, table, "a roughness")?;
+    let (scale, steps) = match base {
+        Material::Conductor(c) => {
+            let (lo, hi) = RoughnessMap::range(&texture, c.roughness);
+            let steps = RoughnessSteps::new(lo, hi, Conductor::table);
+            (c.roughness, Some(steps))
+        }
+        Material::Plastic(p) => {
+            let (lo, hi) = RoughnessMap::range(&texture, p.roughness);
+            let eta = p.eta;
+            let steps = RoughnessSteps::new(lo, hi, |r| Plastic::table(r, eta));
+            (p.roughness, Some(steps))
+        }
+        #[cfg(feature = "subsurface")]
+        Material::Subsurface(ss) => {
+            let scale = ss.roughness();
+            let (lo, hi) = RoughnessMap::range(&texture, scale);
+            let eta = ss.eta();
+            let steps = RoughnessSteps::new(lo, hi, |r| Plastic::table(r, eta));
+            (scale, Some(steps))
+        }
+        Material::RoughDielectric(r) => (r.roughness, None),
+        _ => return Err(cx.err(t.span(), &key, "this material has no roughness")),
+    };
+    Ok(Some(RoughnessMap {
+        texture,
+        scale,
+        steps,
+    }))
 }
 
 /// The bump map of material `field` (table `d`): its `bump` texture
@@ -241,9 +293,10 @@ pub(super) fn subsurface(
     table: &Table,
 ) -> Res<Material> {
     let d = m.get_ref();
-    if d.albedo_texture.is_none() && d.dmfp_texture.is_none() {
+    if d.albedo_texture.is_none() && d.dmfp_texture.is_none() && d.roughness_texture.is_none() {
         return Ok(base);
     }
+    let roughness = roughness(cx, field, d, &base, table)?;
     let unit = |texture| TextureRef {
         texture,
         scale: Vec3::ONE,
@@ -266,6 +319,7 @@ pub(super) fn subsurface(
     let names = uses(&[
         ("albedo_texture", &d.albedo_texture),
         ("dmfp_texture", &d.dmfp_texture),
+        ("roughness_texture", &d.roughness_texture),
     ]);
     if let (Some(k), Some(v), Material::Subsurface(ss)) = (&dmfp, &d.dmfp_texture, &base) {
         let key = format!("{field}.dmfp_texture");
@@ -273,6 +327,7 @@ pub(super) fn subsurface(
     }
     let mut t = Textured::new(base, albedo, None).named(names);
     t.dmfp = dmfp;
+    t.roughness = roughness;
     t.medium = Some(recipe);
     Ok(Material::Textured(Arc::new(t)))
 }

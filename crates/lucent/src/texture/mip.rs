@@ -92,6 +92,18 @@ impl Texture {
             .fold(Vec3::splat(f32::NEG_INFINITY), |m, &t| m.max(t))
     }
 
+    /// The least and greatest mean of a texel's channels: bounds on what
+    /// a filtered lookup's channel mean can be.
+    pub fn mean_range(&self) -> (f32, f32) {
+        self.levels[0]
+            .texels
+            .iter()
+            .map(|t| (t.x + t.y + t.z) / 3.0)
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), m| {
+                (lo.min(m), hi.max(m))
+            })
+    }
+
     /// Bytes held by all levels.
     pub fn bytes(&self) -> usize {
         self.levels
