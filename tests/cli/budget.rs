@@ -95,8 +95,8 @@ fn explain_shows_the_choice_and_each_candidates_prediction() {
         "--explain=json",
     ]);
     let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
-    let marble = v["materials"].as_array().unwrap().iter();
-    let marble = marble.filter(|m| m["name"] == "marble").next().unwrap();
+    let mut materials = v["materials"].as_array().unwrap().iter();
+    let marble = materials.find(|m| m["name"] == "marble").unwrap();
     let budget = &marble["budget"];
     assert_eq!(budget["chosen"], "walk", "{budget}");
     assert_eq!(

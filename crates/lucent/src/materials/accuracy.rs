@@ -5,17 +5,15 @@
 //! (`crate::integrator::plan::budget`), the model it reads
 //! `crate::bssrdf::error_model` (`docs/bssrdf.md` §14).
 
-use super::estimator_options::OptionError;
-
 /// What a budget is written as, for messages.
-const EXPECTED: &str = "a fraction in (0, 1) such as 0.01, a percentage such as 1%, or \"off\"";
+pub const EXPECTED: &str = "a fraction in (0, 1) such as 0.01, a percentage such as 1%, or \"off\"";
 
 /// `s` as a budget: "off" (None), a fraction ("0.01") or a percentage
-/// ("1%", "1 %"), in (0, 1).
-pub fn parse(s: &str) -> Result<Option<f32>, OptionError> {
+/// ("1%", "1 %"), in (0, 1); None for anything else ([`EXPECTED`]).
+pub fn parse(s: &str) -> Option<Option<f32>> {
     let t = s.trim();
     if t.eq_ignore_ascii_case("off") {
-        return Ok(None);
+        return Some(None);
     }
     let (number, scale) = match t.strip_suffix('%') {
         Some(n) => (n.trim_end(), 0.01),
@@ -23,11 +21,8 @@ pub fn parse(s: &str) -> Result<Option<f32>, OptionError> {
     };
     let v = number.parse::<f64>().map(|v| v * scale);
     match v {
-        Ok(v) if v > 0.0 && v < 1.0 => Ok(Some(v as f32)),
-        _ => Err(OptionError::Expected {
-            expected: EXPECTED.into(),
-            found: s.into(),
-        }),
+        Ok(v) if v > 0.0 && v < 1.0 => Some(Some(v as f32)),
+        _ => None,
     }
 }
 
@@ -48,14 +43,14 @@ mod tests {
     /// means nothing accepted.
     #[test]
     fn percent_and_fraction_agree_and_out_of_range_is_refused() {
-        assert_eq!(parse("1%").unwrap(), Some(0.01));
-        assert_eq!(parse("0.01").unwrap(), Some(0.01));
-        assert_eq!(parse(" 2.5 % ").unwrap(), Some(0.025));
-        assert_eq!(parse("OFF").unwrap(), None);
+        assert_eq!(parse("1%"), Some(Some(0.01)));
+        assert_eq!(parse("0.01"), Some(Some(0.01)));
+        assert_eq!(parse(" 2.5 % "), Some(Some(0.025)));
+        assert_eq!(parse("OFF"), Some(None));
         for bad in ["0", "1", "100%", "-1%", "nan", "inf", "", "%", "1%%", "one"] {
-            assert!(parse(bad).is_err(), "{bad}");
+            assert_eq!(parse(bad), None, "{bad}");
         }
-        assert_eq!(parse(&name(Some(0.05))).unwrap(), Some(0.05));
-        assert_eq!(parse(&name(None)).unwrap(), None);
+        assert_eq!(parse(&name(Some(0.05))), Some(Some(0.05)));
+        assert_eq!(parse(&name(None)), Some(None));
     }
 }

@@ -496,7 +496,10 @@ pub static OPTIONS: [EstimatorOption; 17] = [
                       or the random walk) the error model predicts within it (off: the \
                       options as given)",
         set: |o, s| {
-            o.accuracy = super::accuracy::parse(s)?;
+            o.accuracy = super::accuracy::parse(s).ok_or_else(|| OptionError::Expected {
+                expected: super::accuracy::EXPECTED.into(),
+                found: s.into(),
+            })?;
             Ok(())
         },
         get: |o| super::accuracy::name(o.accuracy),

@@ -19,9 +19,7 @@ use super::state::PathState;
 use super::{Context, Effect};
 use crate::geometry::Vec3;
 
-/// The probe estimator of the diffusion BSSRDF ([`crate::bssrdf::probe`]);
-/// at a material the accuracy budget gave the random walk
-/// (`crate::integrator::plan::budget`), the walk.
+/// The probe estimator of the diffusion BSSRDF ([`crate::bssrdf::probe`]).
 pub(crate) struct Diffusion;
 
 impl SubsurfaceScatter for Diffusion {
@@ -35,9 +33,6 @@ impl SubsurfaceScatter for Diffusion {
         beta: &mut Vec3,
         st: &mut PathState<R>,
     ) -> Scatter<'s> {
-        if hit.ss.options().walk {
-            return super::randomwalk::RandomWalk.scatter(ctx, hit, beta, st);
-        }
         coat::scatter(ctx, hit, beta, st)
     }
 }
