@@ -531,7 +531,7 @@ fn run_explain(
     format: ExplainArg,
 ) -> Result<(), Error> {
     let mut scene = scene::load(scene_path)?;
-    session::overrides::apply(&subsurface.overrides(), &mut scene.materials)?;
+    session::overrides::apply(&subsurface.overrides(), &mut scene)?;
     session::apply_film(&mut scene, file);
     let passes = aov.unwrap_or(scene.output.aovs);
     let sampler = sampler.unwrap_or(scene.settings.sampler);

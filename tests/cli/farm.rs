@@ -501,6 +501,13 @@ fn bad_sets_of_parts_are_refused_naming_the_file_and_the_problem() {
     part(&["--tile", "0/2", "--radius", "uniform"], "opt.exr");
     let e = merge(&["opt.exr", "b.exr"]);
     assert!(e.contains("b.exr") && e.contains("lucent.options"), "{e}");
+    // another accuracy budget: another choice of estimator
+    part(&["--tile", "1/2", "--accuracy", "5%"], "budget.exr");
+    let e = merge(&["a.exr", "budget.exr"]);
+    assert!(
+        e.contains("budget.exr") && e.contains("lucent.options"),
+        "{e}"
+    );
     // another sampler: other images, refused by the options
     part(&["--tile", "1/2", "--sampler", "random"], "random.exr");
     let e = merge(&["a.exr", "random.exr"]);

@@ -9,6 +9,8 @@ mod common;
 #[cfg(feature = "subsurface")]
 mod aov;
 mod bench_cli;
+#[cfg(feature = "subsurface")]
+mod budget;
 mod cli;
 mod denoise;
 mod denoise_layers;

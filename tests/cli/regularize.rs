@@ -64,6 +64,9 @@ fn regularize_off_renders_todays_pixels_bit_for_bit() {
     let off = render(&["--regularize", "0"]);
     assert_eq!(off.data, fixture.data);
     assert_eq!(differing(&off, &fixture), 0, "regularize = 0");
+    // no accuracy budget is the same render (docs/bssrdf.md §14)
+    let no_budget = render(&["--regularize", "0", "--accuracy", "off"]);
+    assert_eq!(differing(&no_budget, &fixture), 0, "accuracy = off");
     // the region exercises the rule: the default changes its pixels
     let on = render(&[]);
     assert!(differing(&on, &fixture) > 0, "the default");

@@ -441,6 +441,27 @@ fn cases() -> Vec<Case> {
             Some("materials.skin.regularize"),
         ),
         case(
+            "subsurface accuracy of 1 or more",
+            format!("{CAM}{SSS}preset = \"skin1\"\naccuracy = 1.5\n"),
+            "expected a fraction in (0, 1)",
+            Some("accuracy"),
+            Some("materials.skin.accuracy"),
+        ),
+        case(
+            "subsurface accuracy nan",
+            format!("{CAM}{SSS}preset = \"skin1\"\naccuracy = nan\n"),
+            "found \"NaN\"",
+            Some("accuracy"),
+            Some("materials.skin.accuracy"),
+        ),
+        case(
+            "subsurface accuracy as text",
+            format!("{CAM}{SSS}preset = \"skin1\"\naccuracy = \"1%\"\n"),
+            "invalid type",
+            Some("accuracy"),
+            Some("materials.skin.accuracy"),
+        ),
+        case(
             "subsurface roughness not a number",
             format!("{CAM}{SSS}preset = \"skin1\"\nroughness = \"rough\"\n"),
             "invalid type: string \"rough\", expected f64",

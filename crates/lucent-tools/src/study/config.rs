@@ -477,10 +477,12 @@ fn sampler_and_denoise(m: &mut Matrix, quick: bool) {
 }
 
 /// `scene` with every subsurface material rebuilt with `ov` applied to its
-/// own options (its medium parameters unchanged).
+/// own options (its medium parameters unchanged), and the accuracy
+/// budgets' choices made.
 pub fn apply(scene: &Scene, ov: &Overrides) -> Result<Scene, ConfigError> {
     let mut out = scene.clone();
     ov.apply_all(&mut out.materials)?;
+    lucent::integrator::plan::budget::resolve(&mut out)?;
     Ok(out)
 }
 

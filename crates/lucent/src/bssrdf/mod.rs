@@ -20,6 +20,7 @@ pub mod curvature_correction;
 pub mod curvature_table;
 pub mod density;
 pub mod dipole;
+pub mod error_model;
 pub mod fresnel_moment;
 pub mod params;
 pub mod probe;

@@ -19,6 +19,8 @@ mod analytic_nee;
 pub mod aov;
 mod branch;
 #[cfg(feature = "subsurface")]
+mod budgeted;
+#[cfg(feature = "subsurface")]
 mod coated;
 pub mod context;
 #[cfg(feature = "subsurface")]

@@ -104,8 +104,9 @@ pub fn radiance<R: Recorder, T: Clock>(
     trace::<R, T, _>(ctx, camera_ray, &mut st, &mut RandomWalk)
 }
 
-/// The random walk as the bounce loop's estimator of subsurface hits.
-struct RandomWalk;
+/// The random walk as the bounce loop's estimator of subsurface hits (and
+/// the path integrator's at materials the accuracy budget gave the walk).
+pub(crate) struct RandomWalk;
 
 impl SubsurfaceScatter for RandomWalk {
     const EFFECT: Effect = Effect::Walk;

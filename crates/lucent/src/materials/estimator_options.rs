@@ -49,6 +49,12 @@ pub struct EstimatorOptions {
     /// The coat's least roughness once the path has scattered off a
     /// non-specular lobe (0: the coat as given everywhere).
     pub regularize: f32,
+    /// The accuracy budget (`super::accuracy`): the largest predicted
+    /// relative error allowed; None: the estimator as the options give it.
+    pub accuracy: Option<f32>,
+    /// The random walk estimates this material's hits in the path
+    /// integrator: set only by the budget's choice, never by a key.
+    pub walk: bool,
 }
 
 impl Default for EstimatorOptions {
@@ -65,6 +71,8 @@ impl Default for EstimatorOptions {
             control_variate: false,
             probe_pair: true,
             regularize: DEFAULT_REGULARIZE,
+            accuracy: None,
+            walk: false,
         }
     }
 }
@@ -255,7 +263,7 @@ fn number<T: std::str::FromStr>(s: &str) -> Result<T, OptionError> {
 
 /// Every option, in the order the EXR header and a part's identity list
 /// them.
-pub static OPTIONS: [EstimatorOption; 16] = [
+pub static OPTIONS: [EstimatorOption; 17] = [
     EstimatorOption {
         name: "radius",
         values: &["analytic", "mixture"],
@@ -475,6 +483,26 @@ pub static OPTIONS: [EstimatorOption; 16] = [
             Ok(())
         },
         get: |o| o.probe.profile.name().into(),
+    },
+    EstimatorOption {
+        name: "accuracy",
+        values: &[],
+        research: &[],
+        research_in_scenes: true,
+        flag: true,
+        description: "Accuracy budget: the largest predicted error of the object's image, as \
+                      a fraction (0.01) or per cent (1%); lucent picks per material the \
+                      cheapest estimator (diffusion with the Burley or the tabulated profile, \
+                      or the random walk) the error model predicts within it (off: the \
+                      options as given)",
+        set: |o, s| {
+            o.accuracy = super::accuracy::parse(s).ok_or_else(|| OptionError::Expected {
+                expected: super::accuracy::EXPECTED.into(),
+                found: s.into(),
+            })?;
+            Ok(())
+        },
+        get: |o| super::accuracy::name(o.accuracy),
     },
 ];
 

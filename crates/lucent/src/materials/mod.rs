@@ -4,6 +4,8 @@
 //! variant's scattering lives in its own file. Fresnel reflectance is [`crate::fresnel`], shared
 //! with the BSSRDF.
 
+#[cfg(feature = "subsurface")]
+pub mod accuracy;
 pub mod albedo_table;
 pub mod conductor;
 pub mod dielectric;

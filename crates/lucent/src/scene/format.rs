@@ -317,6 +317,8 @@ pub struct MaterialDef {
     pub regularize: Option<Spanned<f64>>,
     // subsurface: the diffusion profile's shape
     pub profile: Option<Spanned<String>>,
+    // subsurface: the accuracy budget
+    pub accuracy: Option<Spanned<f64>>,
     // conductor: a named metal, or its complex index n + ik per channel
     // (`roughness` above serves the conductor, plastic and dielectric too)
     pub metal: Option<Spanned<String>>,
@@ -374,6 +376,7 @@ impl MaterialDef {
         add("exit_sw", self.exit_sw.as_ref().map(|x| x.span()));
         add("specular", self.specular.as_ref().map(|x| x.span()));
         add("boundary", self.boundary.as_ref().map(|x| x.span()));
+        add("accuracy", self.accuracy.as_ref().map(|x| x.span()));
         add(
             "curvature_correction",
             self.curvature_correction.as_ref().map(|x| x.span()),

@@ -462,6 +462,7 @@ fn option_value(d: &MaterialDef, key: &str) -> Option<(String, std::ops::Range<u
         "control_variate" => b(&d.control_variate),
         "probe_pair" => b(&d.probe_pair),
         "regularize" => f(&d.regularize),
+        "accuracy" => f(&d.accuracy),
         "profile" => s(&d.profile),
         _ => None,
     }

@@ -1,9 +1,10 @@
 //! The command line's subsurface sampling options, applied to every
-//! subsurface material of a scene; a build without the `subsurface`
+//! subsurface material of a scene, and then the accuracy budgets' choices
+//! (`crate::integrator::plan::budget`); a build without the `subsurface`
 //! feature has none.
 
 use crate::error::Error;
-use crate::materials::Material;
+use crate::scene::Scene;
 
 /// Sampling options that replace every subsurface material's own, by
 /// name (`crate::materials::estimator_options`).
@@ -16,17 +17,19 @@ pub use crate::materials::estimator_options::Assignments as Overrides;
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Overrides;
 
-/// Applies `o` to every subsurface material of `materials`; returns the
-/// options as a part's identity records them (canonical names).
+/// Applies `o` to every subsurface material of `scene`, then makes the
+/// choice of every material with an accuracy budget; returns the options
+/// as a part's identity records them (canonical names).
 #[cfg(feature = "subsurface")]
-pub fn apply(o: &Overrides, materials: &mut [Material]) -> Result<String, Error> {
-    o.apply_all(materials).map_err(option_error)?;
+pub fn apply(o: &Overrides, scene: &mut Scene) -> Result<String, Error> {
+    o.apply_all(&mut scene.materials).map_err(option_error)?;
+    crate::integrator::plan::budget::resolve(scene).map_err(option_error)?;
     Ok(o.canonical())
 }
 
 /// No subsurface materials, nothing to apply.
 #[cfg(not(feature = "subsurface"))]
-pub fn apply(_: &Overrides, _: &mut [Material]) -> Result<String, Error> {
+pub fn apply(_: &Overrides, _: &mut Scene) -> Result<String, Error> {
     Ok(String::new())
 }
 

@@ -126,7 +126,7 @@ fn load(r: &Request) -> Result<(Scene, String, String), Error> {
     let mut scene = scene::load(&r.scene)?;
     let text = scene::load::read_regular_file(&r.scene, scene::load::MAX_SCENE_BYTES)
         .map_err(|e| InputError::new(&r.scene, format!("cannot read scene file: {e}")))?;
-    let options = overrides::apply(&r.overrides, &mut scene.materials)?;
+    let options = overrides::apply(&r.overrides, &mut scene)?;
     apply_film(&mut scene, &r.file);
     Ok((scene, text, options))
 }

@@ -313,6 +313,11 @@ fn traversal(scene: &Scene, opts: &PlanOptions) -> Choice {
             "random-walk integrator: no walk may slip out of a closed medium through \
              an edge that triangles share",
         ),
+        (_, Traversal::Watertight) if budget_walks(scene) => choice(
+            "watertight",
+            "an accuracy budget chose the random walk for some material: no walk may slip \
+             out of a closed medium through an edge that triangles share",
+        ),
         (_, Traversal::Watertight) => choice(
             "watertight",
             "asked for ([render] traversal): no ray slips through an edge that \
@@ -326,6 +331,21 @@ fn traversal(scene: &Scene, opts: &PlanOptions) -> Choice {
              is watertight either way",
         ),
     }
+}
+
+/// Whether an accuracy budget gave some material the random walk (which
+/// then made the traversal watertight, [`super::budget::resolve`]).
+fn budget_walks(scene: &Scene) -> bool {
+    #[cfg(feature = "subsurface")]
+    return scene.materials.iter().any(|m| match m.base() {
+        crate::materials::Material::Subsurface(ss) => ss.options().walk,
+        _ => false,
+    });
+    #[cfg(not(feature = "subsurface"))]
+    return {
+        let _ = scene;
+        false
+    };
 }
 
 /// The passes recorded besides the beauty.

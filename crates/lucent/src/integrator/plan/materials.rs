@@ -96,6 +96,12 @@ pub struct MaterialPlan {
     /// than their default, in the option table's order and names.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub options: Vec<OptionSetting>,
+    /// Subsurface materials with an accuracy budget: each object's
+    /// candidates, their predicted error and cost, and the choice
+    /// ([`super::budget`]).
+    #[cfg(feature = "subsurface")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget: Option<super::budget::BudgetPlan>,
 }
 
 /// An estimator option set away from its default
@@ -170,6 +176,8 @@ fn base_plan(scene: &Scene, i: usize, m: &Material) -> MaterialPlan {
         exit_lobe: None,
         channels: None,
         options: Vec::new(),
+        #[cfg(feature = "subsurface")]
+        budget: None,
     }
 }
 
@@ -234,8 +242,12 @@ pub(super) fn material_rows(scene: &Scene, opts: &PlanOptions, area_lights: bool
                 }];
             }
             #[cfg(feature = "subsurface")]
-            Material::Subsurface(ss) if walk => {
-                walk_material(ss, &mut mp);
+            Material::Subsurface(ss) if walk || ss.options().walk => {
+                let why = match walk {
+                    true => "--integrator randomwalk: the medium simulated event by event",
+                    false => "the accuracy budget's choice: the medium simulated event by event",
+                };
+                walk_material(ss, why, &mut mp);
                 mp.options = changed_options(ss);
                 if ss.boundary() == WalkBoundary::Dielectric && ss.params().medium.is_some() {
                     rows.specular_materials.push(mname.clone());
@@ -256,6 +268,10 @@ pub(super) fn material_rows(scene: &Scene, opts: &PlanOptions, area_lights: bool
                 }
             }
             _ => {}
+        }
+        #[cfg(feature = "subsurface")]
+        if !walk {
+            mp.budget = super::budget::decide(scene, i);
         }
         rows.materials.push(mp);
     }
@@ -443,9 +459,9 @@ fn diffusion_channels(active: [bool; 3]) -> Channels {
     )
 }
 
-/// A used subsurface material under the random walk.
+/// A used subsurface material under the random walk, and why.
 #[cfg(feature = "subsurface")]
-fn walk_material(ss: &Subsurface, mp: &mut MaterialPlan) {
+fn walk_material(ss: &Subsurface, why: &str, mp: &mut MaterialPlan) {
     let Some(medium) = ss.params().medium else {
         mp.subsurface = vec![SubsurfaceMethod::None {
             reason: "no medium recorded: the path ends there (a black surface)".into(),
@@ -454,7 +470,7 @@ fn walk_material(ss: &Subsurface, mp: &mut MaterialPlan) {
     };
     mp.subsurface = vec![SubsurfaceMethod::RandomWalk {
         boundary: ss.boundary().name().into(),
-        reason: "--integrator randomwalk: the medium simulated event by event".into(),
+        reason: why.into(),
     }];
     mp.coat = Some(match ss.boundary() {
         WalkBoundary::Dielectric => choice(

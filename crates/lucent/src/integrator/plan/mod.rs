@@ -14,6 +14,8 @@
 //! (`tests/cli/plan.rs`) check that the explanation says what the flags do
 //! and that a render honours it (no probe ray where it says none).
 
+#[cfg(feature = "subsurface")]
+pub mod budget;
 mod choice;
 pub mod explain;
 mod materials;

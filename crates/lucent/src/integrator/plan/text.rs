@@ -103,6 +103,10 @@ pub fn render(p: &Explanation) -> String {
                 ),
             }
         }
+        #[cfg(feature = "subsurface")]
+        if let Some(b) = &m.budget {
+            budget_rows(r, b);
+        }
         if let Some(c) = &m.coat {
             row(r, "coat", &c.method, &c.reason);
         }
@@ -130,4 +134,45 @@ pub fn render(p: &Explanation) -> String {
         }
     }
     out
+}
+
+/// A material's accuracy budget: the choice and why, then per object its
+/// size and each candidate's predicted error and cost.
+#[cfg(feature = "subsurface")]
+fn budget_rows(r: &mut String, b: &super::budget::BudgetPlan) {
+    row(
+        r,
+        "accuracy budget",
+        &b.chosen,
+        &format!(
+            "budget {:.1} %, {} light; {}",
+            100.0 * b.budget,
+            b.lighting,
+            b.reason
+        ),
+    );
+    for o in &b.objects {
+        let c: Vec<String> = o
+            .candidates
+            .iter()
+            .map(|c| format!("{} {:.1} % ×{:.2}", c.estimator, 100.0 * c.error, c.cost))
+            .collect();
+        let range = match o.candidates.iter().all(|c| c.in_range) {
+            true => String::new(),
+            false => {
+                "; beyond the measured sizes: the largest error measured is predicted".to_string()
+            }
+        };
+        row(
+            r,
+            "  object",
+            &o.object,
+            &format!(
+                "size {:.3} = {:.2} ℓd; predicted {}{range}",
+                o.size,
+                o.size_ld,
+                c.join(", ")
+            ),
+        );
+    }
 }

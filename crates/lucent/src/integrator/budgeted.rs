@@ -1,0 +1,56 @@
+//! The path integrator's estimator of subsurface hits: the diffusion
+//! BSSRDF's probes ([`super::subsurface`]), or the random walk
+//! ([`super::randomwalk`]) at a material the accuracy budget gave it
+//! (`crate::integrator::plan::budget`, `docs/bssrdf.md` §14). Without a
+//! budget no material walks, and every hit is diffusion's.
+
+use super::aov::Recorder;
+use super::path::trace;
+use super::randomwalk::RandomWalk;
+use super::scatter::{Scatter, SubsurfaceHit, SubsurfaceScatter};
+use super::state::{PathState, Scratch};
+use super::subsurface::Diffusion;
+use super::{Clock, Context, Counters, Effect};
+use crate::geometry::{Ray, Vec3};
+use crate::sampling::SampleRng;
+
+/// The radiance arriving along `camera_ray`: one sample of L, subsurface
+/// hits estimated as each material's choice says. Same contract as
+/// [`super::path::radiance`].
+pub fn radiance<R: Recorder, T: Clock>(
+    ctx: &Context,
+    camera_ray: Ray,
+    rng: &mut SampleRng,
+    scratch: &mut Scratch,
+    counters: &mut Counters,
+    rec: &mut R,
+) -> Vec3 {
+    let mut st = PathState {
+        rng,
+        scratch,
+        counters,
+        rec,
+    };
+    trace::<R, T, _>(ctx, camera_ray, &mut st, &mut Budgeted)
+}
+
+/// Diffusion, or the walk where the material's choice is the walk.
+struct Budgeted;
+
+impl SubsurfaceScatter for Budgeted {
+    const EFFECT: Effect = Effect::Probe;
+
+    #[inline(always)]
+    fn scatter<'s, R: Recorder>(
+        &mut self,
+        ctx: &'s Context,
+        hit: &SubsurfaceHit<'_, 's>,
+        beta: &mut Vec3,
+        st: &mut PathState<R>,
+    ) -> Scatter<'s> {
+        if hit.ss.options().walk {
+            return RandomWalk.scatter(ctx, hit, beta, st);
+        }
+        Diffusion.scatter(ctx, hit, beta, st)
+    }
+}
