@@ -45,6 +45,8 @@ mod state;
 #[cfg(feature = "subsurface")]
 mod subsurface;
 mod texturing;
+#[cfg(feature = "subsurface")]
+mod walk_nee;
 
 pub use crate::stats::{Counters, Effect, EFFECTS};
 pub use context::Context;

@@ -66,6 +66,7 @@ use super::lobe::{Lobe, SubsurfaceLobe, Vertex};
 use super::path::trace;
 use super::scatter::{Scatter, SubsurfaceHit, SubsurfaceScatter};
 use super::state::{PathState, Scratch};
+use super::walk_nee::WalkLight;
 use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
@@ -143,7 +144,7 @@ fn walk_hit<'s>(
     // "outside", so a mesh wound inside-out still works.
     let n_out = if si.front { si.ng } else { -si.ng };
     match ss.boundary() {
-        WalkBoundary::Dielectric => {
+        WalkBoundary::Dielectric { connect } => {
             let frame = Frame::from_normal(n_out);
             let s = dielectric::sample(ss.eta(), frame.to_local(wo), rng.uniform());
             *beta *= s.weight;
@@ -153,6 +154,9 @@ fn walk_hit<'s>(
             }
             let inside = si.spawn(wi, ctx.ray_epsilon);
             let law = Boundary::Dielectric(ss.eta());
+            if connect {
+                return connected_walk(ctx, &medium, ss.eta(), inside, beta, rng, counters);
+            }
             match walk(ctx, &medium, law, inside, rng, counters) {
                 Some((WalkEnd::Refracted(exit), w)) => {
                     *beta *= w;
@@ -173,6 +177,36 @@ fn walk_hit<'s>(
             rng,
             counters,
         ),
+    }
+}
+
+/// A walk through the smooth dielectric of index `eta` from `inside`,
+/// sampling the lights through the boundary at its scattering points
+/// ([`super::walk_nee`]); `beta` is the path's throughput on entry.
+fn connected_walk<'s>(
+    ctx: &Context,
+    medium: &Medium,
+    eta: f32,
+    inside: Ray,
+    beta: &mut Vec3,
+    rng: &mut SampleRng,
+    counters: &mut Counters,
+) -> Scatter<'s> {
+    let mut nl = WalkLight::new(eta);
+    let law = Boundary::Dielectric(eta);
+    let end = walk_lit(ctx, medium, law, inside, rng, counters, Some(&mut nl));
+    let light = *beta * throughput(&nl.light);
+    let exit = match end {
+        Some((WalkEnd::Refracted(exit), w)) => {
+            *beta *= w;
+            Some((exit, nl.exit))
+        }
+        _ => None,
+    };
+    Scatter::WalkLit {
+        light,
+        source: nl.source,
+        exit,
     }
 }
 
@@ -281,9 +315,25 @@ pub fn walk(
     ctx: &Context,
     m: &Medium,
     boundary: Boundary,
+    ray: Ray,
+    rng: &mut SampleRng,
+    counters: &mut Counters,
+) -> Option<(WalkEnd, Vec3)> {
+    walk_lit(ctx, m, boundary, ray, rng, counters, None)
+}
+
+/// [`walk`], and with `nee` (the smooth dielectric only) each scattering
+/// point samples the lights through the boundary ([`super::walk_nee`]),
+/// `nee` summing their light and recording the last scattering point
+/// before the walk leaves.
+fn walk_lit(
+    ctx: &Context,
+    m: &Medium,
+    boundary: Boundary,
     mut ray: Ray,
     rng: &mut SampleRng,
     counters: &mut Counters,
+    mut nee: Option<&mut WalkLight>,
 ) -> Option<(WalkEnd, Vec3)> {
     let sigma_t = m.sigma_t();
     let mut beta = [1.0f64; 3];
@@ -316,8 +366,18 @@ pub fn walk(
             if t >= t_max {
                 transmit(&mut beta, &sigma_t, &q, t_max)?;
                 match at_boundary(ctx, boundary, &ray, &hit, rng) {
-                    Ok((end, weight)) => return Some((end, weight * throughput(&beta))),
-                    Err(next) => ray = next,
+                    Ok((end, weight)) => {
+                        if let Some(nl) = nee.as_deref_mut() {
+                            nl.left(&hit);
+                        }
+                        return Some((end, weight * throughput(&beta)));
+                    }
+                    Err(next) => {
+                        if let Some(nl) = nee.as_deref_mut() {
+                            nl.reflected();
+                        }
+                        ray = next;
+                    }
                 }
                 continue;
             }
@@ -326,6 +386,9 @@ pub fn walk(
 
         // A real scattering event at distance t.
         scatter(&mut beta, m, &sigma_t, &q, t)?;
+        if let Some(nl) = nee.as_deref_mut() {
+            nl.at_scatter(ctx, m, p, ray.d, &beta, rng, counters);
+        }
         // The phase function is sampled exactly: its weight is 1.
         ray = Ray::new(p, sample_hg(ray.d, m.g, rng.uniform2()));
         if event >= WALK_RR_START {
