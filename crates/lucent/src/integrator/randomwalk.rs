@@ -41,10 +41,12 @@
 //! the full Fresnel interface, which is what those options approximate.
 //!
 //! **Light sampling.** Through the dielectric boundary light reaches the
-//! medium only by the walk refracting out and the path finding the light:
-//! a refracted direction is a delta, so no light can be sampled there, and
-//! small lights are noisy (relMSE×spp ≈ 87 on a 10 mm marble sphere under
-//! an 8 mm light, `docs/bssrdf.md` §7). Through the diffuse boundary the
+//! medium by the walk refracting out and the path finding the light: a
+//! refracted direction is a delta, so no light can be sampled at the exit,
+//! and small lights are noisy (`docs/bssrdf.md` §7). With `dielectric-nee`
+//! each scattering point also samples the lights through the boundary, by
+//! a refracted connection ([`super::walk_nee`]), and the walk's exits
+//! leave the paths the connection counts to it. Through the diffuse boundary the
 //! exit point is a path vertex with the exit lobe (`SubsurfaceLobe::WalkExit`),
 //! where the shared bounce loop samples the lights with MIS (≈ 0.5 on the
 //! same scene, for its own model, at the same cost per sample). Inside, Russian
@@ -194,6 +196,8 @@ fn connected_walk<'s>(
 ) -> Scatter<'s> {
     let mut nl = WalkLight::new(eta);
     let law = Boundary::Dielectric(eta);
+    // The connections' light is the walk's (in the walk's throughput), so
+    // the path's throughput on entry weighs it.
     let end = walk_lit(ctx, medium, law, inside, rng, counters, Some(&mut nl));
     let light = *beta * throughput(&nl.light);
     let exit = match end {

@@ -100,11 +100,13 @@ pub(crate) enum Scatter<'a> {
 }
 
 /// A walk's exit straight after a scattering point `x`, through the
-/// triangle (`geom`, `prim`): emission its refracted ray finds next may be
-/// the connection's to count ([`super::walk_nee`]).
+/// triangle (`geom`, `prim`) of a boundary of index `eta`: emission its
+/// refracted ray finds next may be the connection's to count
+/// ([`super::walk_nee`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Through {
     pub(crate) x: Vec3,
     pub(crate) geom: u32,
     pub(crate) prim: u32,
+    pub(crate) eta: f32,
 }

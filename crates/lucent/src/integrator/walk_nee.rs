@@ -3,10 +3,12 @@
 //! through the smooth boundary").
 //!
 //! At a scattering point x inside the medium a light point l is sampled
-//! by area, and the one refracted path x → y → l through the triangle the
-//! straight line x → l meets first is found: on that triangle's plane the
-//! refraction point is unique, the root of a monotone function of one
-//! variable in the plane of incidence ([`refraction_point`]). Its
+//! by area, and a refracted path x → y → l is found: on a triangle's plane
+//! the refraction point is unique, the root of a monotone function of one
+//! variable in the plane of incidence ([`refraction_point`]); the solve
+//! starts on the triangle the straight line x → l meets first and moves
+//! to the triangle the segment x → y meets until the point lies on the
+//! triangle it was solved on ([`facet`]). Its
 //! contribution is the phase function at x, the medium's transmittance
 //! over |x − y|, Fresnel transmittance times η² (radiance entering the
 //! denser medium), the light's emission and the generalized geometry term
@@ -14,7 +16,8 @@
 //!
 //! **Exact split.** The walk's own exits count emission found directly
 //! after a refraction that follows a scattering point x, except when the
-//! exit triangle is the one x → l meets first ([`covers`]): those paths
+//! exit triangle is the facet the connection finds for x and l
+//! ([`covers`]): those paths
 //! are the connection's, every other path (through another triangle,
 //! after internal reflections, from the entry point without scattering)
 //! stays the walk's. Each path is counted by one estimator, so the sum is
@@ -35,6 +38,9 @@ use crate::sampling::{Draw, SampleRng};
 /// quadratically from the straight line's guess; the bracket halves when a
 /// step leaves it.
 const SOLVE_STEPS: u32 = 60;
+
+/// Triangles a connection's solve may move through (see [`facet`]).
+const FACET_STEPS: u32 = 4;
 
 /// The light reaching a walk through its boundary: the sum of its
 /// connections' contributions and the last scattering point since the walk
@@ -100,6 +106,7 @@ impl WalkLight {
             x,
             geom: hit.geom,
             prim: hit.prim,
+            eta: self.eta,
         });
     }
 }
@@ -120,24 +127,51 @@ fn connect_probability(ctx: &Context, m: &Medium, x: Vec3) -> f64 {
     (-sigma * d).exp()
 }
 
-/// The surface the segment from `x` to `l` meets first: the interface of
-/// a connection from `x` to a light point `l`.
-fn interface(ctx: &Context, x: Vec3, l: Vec3, counters: &mut Counters) -> Option<Hit> {
+/// The facet of a connection from `x` to the light point `l` and the
+/// refraction point on it: starting from the triangle the segment x → l
+/// meets first, the refraction point is solved on the current triangle's
+/// plane; when the segment from x to that point meets another triangle
+/// first, the solve moves to that one, at most [`FACET_STEPS`] times. The
+/// same steps for the same x and l give the same facet, which is what
+/// [`covers`] relies on. Returns the triangle, y and its outward normal.
+fn facet(
+    ctx: &Context,
+    x: Vec3,
+    l: Vec3,
+    eta: f32,
+    counters: &mut Counters,
+) -> Option<(Hit, Vec3, Vec3)> {
     let to_l = l - x;
     let dist = to_l.length();
     if !(dist > 0.0) {
         return None;
     }
+    let w = to_l / dist;
     counters.ray(Effect::Walk);
-    ctx.accel.intersect(&Ray::new(x, to_l / dist), 0.0, dist)
+    let mut tri = ctx.accel.intersect(&Ray::new(x, w), 0.0, dist)?;
+    let mut p0 = x + w * tri.t;
+    for _ in 0..FACET_STEPS {
+        let ng = ctx.scene.meshes[tri.geom as usize].face_normals()[tri.prim as usize];
+        let n = if ng.dot(to_l) > 0.0 { ng } else { -ng };
+        let y = refraction_point(x, l, p0, n, eta)?;
+        let w1 = (y - x).normalize();
+        counters.ray(Effect::Walk);
+        let seen = ctx.accel.intersect(&Ray::new(x, w1), 0.0, f32::INFINITY)?;
+        if (seen.geom, seen.prim) == (tri.geom, tri.prim) {
+            return Some((tri, y, n));
+        }
+        (tri, p0) = (seen, x + w1 * seen.t);
+    }
+    None
 }
 
 /// Whether the walk's exit `t`, whose refracted ray found the emitter at
 /// `l` (a triangle the lights sample), is a path the connection counts:
-/// its exit triangle is the one the segment from its scattering point to
-/// `l` meets first.
+/// its exit triangle is the facet [`facet`] finds from its scattering
+/// point to `l`.
 pub(crate) fn covers(ctx: &Context, t: &Through, l: Vec3, counters: &mut Counters) -> bool {
-    interface(ctx, t.x, l, counters).is_some_and(|h| (h.geom, h.prim) == (t.geom, t.prim))
+    facet(ctx, t.x, l, t.eta, counters)
+        .is_some_and(|(h, _, _)| (h.geom, h.prim) == (t.geom, t.prim))
 }
 
 /// The in-scattered radiance at `x` (arriving along `d_in`) from one light
@@ -153,22 +187,12 @@ fn connect(
     counters: &mut Counters,
 ) -> Option<([f64; 3], u32)> {
     let ls = draw_light(ctx, rng)?;
-    let first = interface(ctx, x, ls.point, counters)?;
-    let ng = ctx.scene.meshes[first.geom as usize].face_normals()[first.prim as usize];
-    let n = if ng.dot(ls.point - x) > 0.0 { ng } else { -ng };
-    let p0 = x + (ls.point - x).normalize() * first.t;
-    let y = refraction_point(x, ls.point, p0, n, eta)?;
+    let (_, y, n) = facet(ctx, x, ls.point, eta, counters)?;
     let g = refracted_geometry(x, y, ls.point, n, eta, ls.normal);
     if !(g > 0.0) {
         return None;
     }
-    // The segment x → y must reach y on that triangle.
     let (w1, d1) = ((y - x).normalize(), (y - x).length());
-    counters.ray(Effect::Walk);
-    let seen = ctx.accel.intersect(&Ray::new(x, w1), 0.0, f32::INFINITY)?;
-    if (seen.geom, seen.prim) != (first.geom, first.prim) {
-        return None;
-    }
     counters.ray(Effect::Direct);
     let origin = offset_along(y, n, ctx.ray_epsilon);
     let light = ctx.leaving(ctx.lights.geom_of(ls.index), true);
