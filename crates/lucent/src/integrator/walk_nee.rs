@@ -121,7 +121,7 @@ fn connect_probability(ctx: &Context, m: &Medium, x: Vec3) -> f64 {
     };
     let d = grid.bound(x) as f64;
     let sigma = m.sigma_t().into_iter().fold(f64::INFINITY, f64::min);
-    if d.is_nan() || d <= 0.0 || !(sigma > 0.0) {
+    if d.is_nan() || d <= 0.0 || sigma.is_nan() || sigma <= 0.0 {
         return 1.0;
     }
     (-sigma * d).exp()
@@ -143,7 +143,7 @@ fn facet(
 ) -> Option<(Hit, Vec3, Vec3)> {
     let to_l = l - x;
     let dist = to_l.length();
-    if !(dist > 0.0) {
+    if dist.is_nan() || dist <= 0.0 {
         return None;
     }
     let w = to_l / dist;
@@ -189,7 +189,7 @@ fn connect(
     let ls = draw_light(ctx, rng)?;
     let (_, y, n) = facet(ctx, x, ls.point, eta, counters)?;
     let g = refracted_geometry(x, y, ls.point, n, eta, ls.normal);
-    if !(g > 0.0) {
+    if g.is_nan() || g <= 0.0 {
         return None;
     }
     let (w1, d1) = ((y - x).normalize(), (y - x).length());
