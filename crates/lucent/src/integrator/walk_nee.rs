@@ -8,7 +8,7 @@
 //! variable in the plane of incidence ([`refraction_point`]); the solve
 //! starts on the triangle the straight line x → l meets first and moves
 //! to the triangle the segment x → y meets until the point lies on the
-//! triangle it was solved on ([`facet`]). Its
+//! triangle it was solved on (`facet`). Its
 //! contribution is the phase function at x, the medium's transmittance
 //! over |x − y|, Fresnel transmittance times η² (radiance entering the
 //! denser medium), the light's emission and the generalized geometry term
@@ -17,7 +17,7 @@
 //! **Exact split.** The walk's own exits count emission found directly
 //! after a refraction that follows a scattering point x, except when the
 //! exit triangle is the facet the connection finds for x and l
-//! ([`covers`]): those paths
+//! (`covers`): those paths
 //! are the connection's, every other path (through another triangle,
 //! after internal reflections, from the entry point without scattering)
 //! stays the walk's. Each path is counted by one estimator, so the sum is
