@@ -485,7 +485,7 @@ fn cases() -> Vec<Case> {
         case(
             "subsurface unknown random-walk boundary",
             format!("{CAM}{SSS}preset = \"skin1\"\nboundary = \"lambertian\"\n"),
-            "expected \"dielectric\" or \"diffuse\", found \"lambertian\"",
+            "expected \"dielectric\", \"dielectric-nee\" or \"diffuse\", found \"lambertian\"",
             Some("lambertian"),
             Some("materials.skin.boundary"),
         ),
