@@ -506,7 +506,7 @@ fn cases() -> Vec<Case> {
         case(
             "subsurface unknown random-walk boundary",
             format!("{CAM}{SSS}preset = \"skin1\"\nboundary = \"lambertian\"\n"),
-            "expected \"dielectric\" or \"diffuse\", found \"lambertian\"",
+            "expected \"dielectric\", \"dielectric-nee\" or \"diffuse\", found \"lambertian\"",
             Some("lambertian"),
             Some("materials.skin.boundary"),
         ),
@@ -915,7 +915,7 @@ fn cli_exits_2_on_scene_errors_without_writing_output() {
         (
             format!("{CAM}{SSS}preset = \"skin1\"\nboundary = \"rough\"\n"),
             None,
-            "scene.toml:8: field `materials.skin.boundary`: expected \"dielectric\" or \"diffuse\"",
+            "scene.toml:8: field `materials.skin.boundary`: expected \"dielectric\", \"dielectric-nee\" or \"diffuse\"",
         ),
         (
             format!("{CAM}{SSS}preset = \"skin1\"\ncurvature_correction = 1\n"),

@@ -429,8 +429,8 @@ pub fn matrix(
         // a random-walk reference of the scene's boundary is the models'
         // difference.
         let other = match scene_boundary(scene) {
-            WalkBoundary::Dielectric => WalkBoundary::Diffuse { exit_nee: true },
-            WalkBoundary::Diffuse { .. } => WalkBoundary::Dielectric,
+            WalkBoundary::Dielectric { .. } => WalkBoundary::Diffuse { exit_nee: true },
+            WalkBoundary::Diffuse { .. } => WalkBoundary::DIELECTRIC,
         };
         m.add(
             Axis::Boundary,

@@ -3,7 +3,8 @@
 //! [`path`] is the unidirectional path tracer with next-event estimation
 //! and multiple importance sampling; [`randomwalk`] the brute-force
 //! volumetric reference for subsurface materials ([`kind`] picks one),
-//! [`diffuse_boundary`] its optional diffuse Fresnel boundary. Both read a
+//! [`diffuse_boundary`] its optional diffuse Fresnel boundary, [`walk_nee`]
+//! its light sampling through the smooth one. Both read a
 //! [`context`] built once per render. [`plan`] decides once per scene which
 //! effects exist; [`interaction`] turns an accel hit into local surface
 //! geometry; [`probe`] runs the BSSRDF's probe query and
@@ -12,7 +13,7 @@
 //! [`aov`] records what the passes measure; [`effects`] (with [`crate::stats`])
 //! tally ray queries and time per effect for `--stats`; `texturing` reads
 //! a textured material's parameters at a hit. `probe`,
-//! `control_variate`, `randomwalk` and `diffuse_boundary` exist only with
+//! `control_variate`, `randomwalk`, `diffuse_boundary` and `walk_nee` exist only with
 //! the `subsurface` feature (the default).
 
 mod analytic_nee;
@@ -47,6 +48,8 @@ mod state;
 #[cfg(feature = "subsurface")]
 mod subsurface;
 mod texturing;
+#[cfg(feature = "subsurface")]
+pub mod walk_nee;
 
 pub use crate::stats::{Counters, Effect, EFFECTS};
 pub use context::Context;

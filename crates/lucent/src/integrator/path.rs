@@ -17,7 +17,7 @@ use super::env_nee::{escaped, record_environment};
 use super::footprint::Cone;
 use super::lobe::{Bounce, Vertex};
 use super::nee::{emission_weight, record_direct, NeeAt};
-use super::scatter::{PointMaterial, Scatter, SubsurfaceScatter};
+use super::scatter::{PointMaterial, Scatter, SubsurfaceScatter, Through};
 use super::state::PathState;
 use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
@@ -109,9 +109,13 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
     let mut path = start;
     let mut point = PointMaterial::default();
     let max_depth = ctx.scene.settings.max_depth;
+    // A random walk's exit that the next hit's emission may be left to
+    // the walk's connection for (`super::walk_nee`).
+    let mut through: Option<Through> = None;
     for depth in start.depth..=max_depth {
         st.rng.start_bounce(depth);
         let nearest_hit = nearest::<R, T>(ctx, &path, depth, st);
+        let exit = through.take();
         if ctx.plan.analytic_lights {
             l += analytic_nee::found(ctx, &path, nearest_hit.map(|h| h.t), depth, st.rec);
         }
@@ -130,7 +134,9 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
         }
         // Le, MIS-weighted against next-event estimation.
         if let (Some(le), true) = (object.emission, si.front) {
-            l += emitted(ctx, &path, le, &at, hit.geom, st.rec);
+            if !connected(ctx, exit, &si, &hit, st.counters) {
+                l += emitted(ctx, &path, le, &at, hit.geom, st.rec);
+            }
         }
         if depth == max_depth {
             break;
@@ -139,7 +145,16 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
         let scatter =
             scatter_at::<R, T, S>(ctx, material, &at, &mut path, st, subsurface, &mut point);
         // Borrowed, not moved out: the vertex stays where it was built.
-        let (vertex, nee) = match next::<R, T>(ctx, &scatter, &at, &mut path, &mut l, st, stack) {
+        let (vertex, nee) = match next::<R, T>(
+            ctx,
+            &scatter,
+            &at,
+            &mut path,
+            &mut l,
+            st,
+            stack,
+            &mut through,
+        ) {
             Next::Vertex(v, nee) => (v, nee),
             Next::Bounce => {
                 if !roulette(depth, &mut path.beta, st.rng) {
@@ -182,6 +197,7 @@ fn follow<R: Recorder, T: Clock, S: SubsurfaceScatter>(
     not(feature = "subsurface"),
     allow(unused_variables, clippy::extra_unused_type_parameters)
 )]
+#[allow(clippy::too_many_arguments)]
 fn next<'v, 's, R: Recorder, T: Clock>(
     ctx: &Context,
     scatter: &'v Scatter<'s>,
@@ -190,6 +206,7 @@ fn next<'v, 's, R: Recorder, T: Clock>(
     l: &mut Vec3,
     st: &mut PathState<R>,
     stack: &mut Branches,
+    through: &mut Option<Through>,
 ) -> Next<'v, 's> {
     match scatter {
         Scatter::Vertex(v) => {
@@ -213,7 +230,52 @@ fn next<'v, 's, R: Recorder, T: Clock>(
         Scatter::Absorbed => Next::End,
         #[cfg(feature = "subsurface")]
         Scatter::Coated(c) => resolve::<R, T>(ctx, c, at, path, l, st, stack),
+        #[cfg(feature = "subsurface")]
+        Scatter::WalkLit {
+            light,
+            source,
+            exit,
+        } => {
+            if at.first {
+                path.event = Event::Subsurface;
+            }
+            *l += *light;
+            let found = aov::sampled(path.event, at.depth);
+            st.rec.light(*light, found, Source::Light(*source));
+            let Some((ray, t)) = exit else {
+                return Next::End;
+            };
+            let b = Bounce {
+                ray: *ray,
+                beta: path.beta,
+                prev: None,
+            };
+            path.go_on(b, path.from, at.cone_specular);
+            *through = *t;
+            Next::Bounce
+        }
     }
+}
+
+/// Whether the emission of the light triangle `hit` (at `si`), found
+/// straight after the walk's exit `exit`, is counted by the walk's
+/// connection through the boundary instead ([`super::walk_nee`]).
+#[inline(always)]
+#[cfg_attr(not(feature = "subsurface"), allow(unused_variables))]
+fn connected(
+    ctx: &Context,
+    exit: Option<Through>,
+    si: &Interaction,
+    hit: &Hit,
+    counters: &mut Counters,
+) -> bool {
+    #[cfg(feature = "subsurface")]
+    if let Some(t) = exit {
+        if ctx.lights.pdf_area(hit.geom, hit.prim) > 0.0 {
+            return super::walk_nee::covers(ctx, &t, si.p, counters);
+        }
+    }
+    false
 }
 
 /// Where `path` is at `hit`. The footprint after the vertex: specular

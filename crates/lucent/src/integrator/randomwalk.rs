@@ -41,10 +41,12 @@
 //! the full Fresnel interface, which is what those options approximate.
 //!
 //! **Light sampling.** Through the dielectric boundary light reaches the
-//! medium only by the walk refracting out and the path finding the light:
-//! a refracted direction is a delta, so no light can be sampled there, and
-//! small lights are noisy (relMSE×spp ≈ 87 on a 10 mm marble sphere under
-//! an 8 mm light, `docs/bssrdf.md` §7). Through the diffuse boundary the
+//! medium by the walk refracting out and the path finding the light: a
+//! refracted direction is a delta, so no light can be sampled at the exit,
+//! and small lights are noisy (`docs/bssrdf.md` §7). With `dielectric-nee`
+//! each scattering point also samples the lights through the boundary, by
+//! a refracted connection ([`super::walk_nee`]), and the walk's exits
+//! leave the paths the connection counts to it. Through the diffuse boundary the
 //! exit point is a path vertex with the exit lobe (`SubsurfaceLobe::WalkExit`),
 //! where the shared bounce loop samples the lights with MIS (≈ 0.5 on the
 //! same scene, for its own model, at the same cost per sample). Inside, Russian
@@ -66,6 +68,7 @@ use super::lobe::{Lobe, SubsurfaceLobe, Vertex};
 use super::path::trace;
 use super::scatter::{Scatter, SubsurfaceHit, SubsurfaceScatter};
 use super::state::{PathState, Scratch};
+use super::walk_nee::WalkLight;
 use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
@@ -144,7 +147,7 @@ fn walk_hit<'s>(
     // "outside", so a mesh wound inside-out still works.
     let n_out = if si.front { si.ng } else { -si.ng };
     match ss.boundary() {
-        WalkBoundary::Dielectric => {
+        WalkBoundary::Dielectric { connect } => {
             let frame = Frame::from_normal(n_out);
             let s = dielectric::sample(ss.eta(), frame.to_local(wo), rng.uniform());
             *beta *= s.weight;
@@ -154,6 +157,9 @@ fn walk_hit<'s>(
             }
             let inside = si.spawn(wi, ctx.ray_epsilon);
             let law = Boundary::Dielectric(ss.eta());
+            if connect {
+                return connected_walk(ctx, &medium, ss.eta(), inside, beta, rng, counters);
+            }
             match walk(ctx, &medium, law, inside, rng, counters) {
                 Some((WalkEnd::Refracted(exit), w)) => {
                     *beta *= w;
@@ -174,6 +180,38 @@ fn walk_hit<'s>(
             rng,
             counters,
         ),
+    }
+}
+
+/// A walk through the smooth dielectric of index `eta` from `inside`,
+/// sampling the lights through the boundary at its scattering points
+/// ([`super::walk_nee`]); `beta` is the path's throughput on entry.
+fn connected_walk<'s>(
+    ctx: &Context,
+    medium: &Medium,
+    eta: f32,
+    inside: Ray,
+    beta: &mut Vec3,
+    rng: &mut SampleRng,
+    counters: &mut Counters,
+) -> Scatter<'s> {
+    let mut nl = WalkLight::new(eta);
+    let law = Boundary::Dielectric(eta);
+    // The connections' light is the walk's (in the walk's throughput), so
+    // the path's throughput on entry weighs it.
+    let end = walk_lit(ctx, medium, law, inside, rng, counters, Some(&mut nl));
+    let light = *beta * throughput(&nl.light);
+    let exit = match end {
+        Some((WalkEnd::Refracted(exit), w)) => {
+            *beta *= w;
+            Some((exit, nl.exit))
+        }
+        _ => None,
+    };
+    Scatter::WalkLit {
+        light,
+        source: nl.source,
+        exit,
     }
 }
 
@@ -282,9 +320,25 @@ pub fn walk(
     ctx: &Context,
     m: &Medium,
     boundary: Boundary,
+    ray: Ray,
+    rng: &mut SampleRng,
+    counters: &mut Counters,
+) -> Option<(WalkEnd, Vec3)> {
+    walk_lit(ctx, m, boundary, ray, rng, counters, None)
+}
+
+/// [`walk`], and with `nee` (the smooth dielectric only) each scattering
+/// point samples the lights through the boundary ([`super::walk_nee`]),
+/// `nee` summing their light and recording the last scattering point
+/// before the walk leaves.
+fn walk_lit(
+    ctx: &Context,
+    m: &Medium,
+    boundary: Boundary,
     mut ray: Ray,
     rng: &mut SampleRng,
     counters: &mut Counters,
+    mut nee: Option<&mut WalkLight>,
 ) -> Option<(WalkEnd, Vec3)> {
     let sigma_t = m.sigma_t();
     let mut beta = [1.0f64; 3];
@@ -317,8 +371,18 @@ pub fn walk(
             if t >= t_max {
                 transmit(&mut beta, &sigma_t, &q, t_max)?;
                 match at_boundary(ctx, boundary, &ray, &hit, rng) {
-                    Ok((end, weight)) => return Some((end, weight * throughput(&beta))),
-                    Err(next) => ray = next,
+                    Ok((end, weight)) => {
+                        if let Some(nl) = nee.as_deref_mut() {
+                            nl.left(&hit);
+                        }
+                        return Some((end, weight * throughput(&beta)));
+                    }
+                    Err(next) => {
+                        if let Some(nl) = nee.as_deref_mut() {
+                            nl.reflected();
+                        }
+                        ray = next;
+                    }
                 }
                 continue;
             }
@@ -327,6 +391,9 @@ pub fn walk(
 
         // A real scattering event at distance t.
         scatter(&mut beta, m, &sigma_t, &q, t)?;
+        if let Some(nl) = nee.as_deref_mut() {
+            nl.at_scatter(ctx, m, p, ray.d, &beta, rng, counters);
+        }
         // The phase function is sampled exactly: its weight is 1.
         ray = Ray::new(p, sample_hg(ray.d, m.g, rng.uniform2()));
         if event >= WALK_RR_START {

@@ -92,4 +92,28 @@ pub(crate) enum Scatter<'a> {
     /// A subsurface hit under a coat, or with more than one vertex.
     #[cfg(feature = "subsurface")]
     Coated(super::coated::Coated<'a>),
+    /// A random walk that sampled lights through its boundary
+    /// ([`super::walk_nee`]): the light it found (the path's throughput
+    /// included) and, unless it was absorbed, the refracted ray it left
+    /// along, with the scattering point it left from. `source`: the light
+    /// triangle of the walk's last connection that brought light (the
+    /// passes attribute all of it there).
+    #[cfg(feature = "subsurface")]
+    WalkLit {
+        light: Vec3,
+        source: u32,
+        exit: Option<(Ray, Option<Through>)>,
+    },
+}
+
+/// A walk's exit straight after a scattering point `x`, through the
+/// triangle (`geom`, `prim`) of a boundary of index `eta`: emission its
+/// refracted ray finds next may be the connection's to count
+/// ([`super::walk_nee`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Through {
+    pub(crate) x: Vec3,
+    pub(crate) geom: u32,
+    pub(crate) prim: u32,
+    pub(crate) eta: f32,
 }

@@ -64,7 +64,7 @@ impl Default for EstimatorOptions {
             exit_sw: true,
             specular: true,
             roughness: 0.0,
-            boundary: WalkBoundary::Dielectric,
+            boundary: WalkBoundary::DIELECTRIC,
             curvature: CurvatureMode::Auto,
             lod: LodMode::Auto,
             lod_threshold: DEFAULT_THRESHOLD,
@@ -108,12 +108,13 @@ impl CurvatureMode {
 
 /// The boundary of a subsurface object in the random walk
 /// (`docs/bssrdf.md` §7, `crate::integrator::randomwalk`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WalkBoundary {
     /// The exact smooth dielectric: Fresnel reflection or refraction along
-    /// Snell's direction.
-    #[default]
-    Dielectric,
+    /// Snell's direction. `connect`: the walk also samples the lights
+    /// through the boundary at its scattering points
+    /// (`crate::integrator::walk_nee`; the same model, another estimator).
+    Dielectric { connect: bool },
     /// The same Fresnel probabilities, but transmission forgets the
     /// direction (`crate::integrator::diffuse_boundary`): a different model,
     /// whose exit point is a vertex where lights are sampled.
@@ -122,11 +123,21 @@ pub enum WalkBoundary {
     Diffuse { exit_nee: bool },
 }
 
+impl Default for WalkBoundary {
+    fn default() -> Self {
+        WalkBoundary::DIELECTRIC
+    }
+}
+
 impl WalkBoundary {
-    /// "dielectric" or "diffuse" (case-insensitive).
+    /// The exact smooth dielectric without light sampling through it.
+    pub const DIELECTRIC: WalkBoundary = WalkBoundary::Dielectric { connect: false };
+
+    /// "dielectric", "dielectric-nee" or "diffuse" (case-insensitive).
     pub fn parse(s: &str) -> Option<Self> {
         match s.to_ascii_lowercase().as_str() {
-            "dielectric" => Some(WalkBoundary::Dielectric),
+            "dielectric" => Some(WalkBoundary::Dielectric { connect: false }),
+            "dielectric-nee" => Some(WalkBoundary::Dielectric { connect: true }),
             "diffuse" => Some(WalkBoundary::Diffuse { exit_nee: true }),
             _ => None,
         }
@@ -134,7 +145,8 @@ impl WalkBoundary {
 
     pub fn name(self) -> &'static str {
         match self {
-            WalkBoundary::Dielectric => "dielectric",
+            WalkBoundary::Dielectric { connect: false } => "dielectric",
+            WalkBoundary::Dielectric { connect: true } => "dielectric-nee",
             WalkBoundary::Diffuse { exit_nee: true } => "diffuse",
             WalkBoundary::Diffuse { exit_nee: false } => "diffuse-no-nee",
         }
@@ -372,12 +384,13 @@ pub static OPTIONS: [EstimatorOption; 17] = [
     },
     EstimatorOption {
         name: "boundary",
-        values: &["dielectric", "diffuse"],
+        values: &["dielectric", "dielectric-nee", "diffuse"],
         research: &[],
         research_in_scenes: true,
         flag: true,
-        description: "Random-walk boundary: exact smooth dielectric; or diffuse Fresnel \
-                      transmission with light sampling at the exit (another model)",
+        description: "Random-walk boundary: exact smooth dielectric; the same with lights \
+                      sampled through it from the walk's scattering points; or diffuse \
+                      Fresnel transmission with light sampling at the exit (another model)",
         set: |o, s| {
             o.boundary = WalkBoundary::parse(s).ok_or_else(|| OPTIONS[8].expected(s))?;
             Ok(())

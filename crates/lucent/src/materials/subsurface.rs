@@ -436,7 +436,7 @@ mod tests {
         assert_eq!(out.probe().options().radius, RadiusSampler::Analytic);
         assert!(out.exit_sw() && !out.specular());
         assert_eq!(out.params(), ss.params());
-        assert_eq!(out.boundary(), WalkBoundary::Dielectric);
+        assert_eq!(out.boundary(), WalkBoundary::DIELECTRIC);
         let walk = apply(&Assignments::default().with("boundary", "Diffuse"), &out).unwrap();
         assert_eq!(walk.boundary(), WalkBoundary::Diffuse { exit_nee: true });
         assert!(walk != out && walk.exit_sw() && !walk.specular());

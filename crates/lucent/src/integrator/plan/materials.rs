@@ -249,7 +249,9 @@ pub(super) fn material_rows(scene: &Scene, opts: &PlanOptions, area_lights: bool
                 };
                 walk_material(ss, why, &mut mp);
                 mp.options = changed_options(ss);
-                if ss.boundary() == WalkBoundary::Dielectric && ss.params().medium.is_some() {
+                if matches!(ss.boundary(), WalkBoundary::Dielectric { .. })
+                    && ss.params().medium.is_some()
+                {
                     rows.specular_materials.push(mname.clone());
                     rows.specular_why
                         .push(format!("{mname}: the walk's dielectric boundary"));
@@ -473,7 +475,7 @@ fn walk_material(ss: &Subsurface, why: &str, mp: &mut MaterialPlan) {
         reason: why.into(),
     }];
     mp.coat = Some(match ss.boundary() {
-        WalkBoundary::Dielectric => choice(
+        WalkBoundary::Dielectric { .. } => choice(
             "dielectric",
             "the walk's exact Fresnel boundary replaces the coat (roughness, specular unused)",
         ),
@@ -483,7 +485,14 @@ fn walk_material(ss: &Subsurface, why: &str, mp: &mut MaterialPlan) {
         ),
     });
     mp.exit_lobe = Some(match ss.boundary() {
-        WalkBoundary::Dielectric => choice("refraction", "leaves along Snell's direction"),
+        WalkBoundary::Dielectric { connect: false } => {
+            choice("refraction", "leaves along Snell's direction")
+        }
+        WalkBoundary::Dielectric { connect: true } => choice(
+            "refraction",
+            "leaves along Snell's direction; lights sampled through the boundary from its \
+             scattering points",
+        ),
         WalkBoundary::Diffuse { exit_nee: true } => {
             choice("diffuse-exit", "exit lobe at the exit point, light-sampled")
         }
