@@ -55,6 +55,19 @@ impl Branch {
         self.from = from;
         self.cone = cone;
     }
+
+    /// Goes on along `ray` with the throughput it has and no previous
+    /// vertex (a specular continuation), still leaving the object it
+    /// leaves, with the footprint `cone`.
+    #[inline(always)]
+    pub(crate) fn straight_on(&mut self, ray: Ray, cone: Cone) {
+        let b = Bounce {
+            ray,
+            beta: self.beta,
+            prev: None,
+        };
+        self.go_on(b, self.from, cone);
+    }
 }
 
 /// Where a path is at a hit: the interaction, ωo, the distance along the

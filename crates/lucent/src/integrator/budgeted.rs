@@ -5,7 +5,7 @@
 //! budget no material walks, and every hit is diffusion's.
 
 use super::aov::Recorder;
-use super::path::trace;
+use super::path::sample;
 use super::randomwalk::RandomWalk;
 use super::scatter::{Scatter, SubsurfaceHit, SubsurfaceScatter};
 use super::state::{PathState, Scratch};
@@ -25,13 +25,7 @@ pub fn radiance<R: Recorder, T: Clock>(
     counters: &mut Counters,
     rec: &mut R,
 ) -> Vec3 {
-    let mut st = PathState {
-        rng,
-        scratch,
-        counters,
-        rec,
-    };
-    trace::<R, T, _>(ctx, camera_ray, &mut st, &mut Budgeted)
+    sample::<R, T, _>(ctx, camera_ray, rng, scratch, counters, rec, &mut Budgeted)
 }
 
 /// Diffusion, or the walk where the material's choice is the walk.

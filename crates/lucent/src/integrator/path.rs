@@ -15,7 +15,7 @@ use super::aov::{self, Event, Recorder, Source};
 use super::branch::{roulette, At, Branch, Branches, Next};
 use super::env_nee::{escaped, record_environment};
 use super::footprint::Cone;
-use super::lobe::{Bounce, Vertex};
+use super::lobe::Vertex;
 use super::nee::{emission_weight, record_direct, NeeAt};
 use super::scatter::{PointMaterial, Scatter, SubsurfaceScatter, Through};
 use super::state::PathState;
@@ -52,13 +52,35 @@ pub fn radiance<R: Recorder, T: Clock>(
     counters: &mut Counters,
     rec: &mut R,
 ) -> Vec3 {
+    sample::<R, T, _>(
+        ctx,
+        camera_ray,
+        rng,
+        scratch,
+        counters,
+        rec,
+        &mut Diffusion {},
+    )
+}
+
+/// One sample of L along `camera_ray` through the bounce loop, subsurface
+/// hits estimated by `subsurface`: what each integrator's `radiance` is.
+pub(crate) fn sample<R: Recorder, T: Clock, S: SubsurfaceScatter>(
+    ctx: &Context,
+    camera_ray: Ray,
+    rng: &mut SampleRng,
+    scratch: &mut Scratch,
+    counters: &mut Counters,
+    rec: &mut R,
+    subsurface: &mut S,
+) -> Vec3 {
     let mut st = PathState {
         rng,
         scratch,
         counters,
         rec,
     };
-    trace::<R, T, _>(ctx, camera_ray, &mut st, &mut Diffusion {})
+    trace::<R, T, S>(ctx, camera_ray, &mut st, subsurface)
 }
 
 /// The bounce loop both integrators share; `subsurface` handles hits on
@@ -219,12 +241,7 @@ fn next<'v, 's, R: Recorder, T: Clock>(
             if at.first {
                 path.event = *e;
             }
-            let b = Bounce {
-                ray: *ray,
-                beta: path.beta,
-                prev: None,
-            };
-            path.go_on(b, path.from, at.cone_specular);
+            path.straight_on(*ray, at.cone_specular);
             Next::Bounce
         }
         Scatter::Absorbed => Next::End,
@@ -245,12 +262,7 @@ fn next<'v, 's, R: Recorder, T: Clock>(
             let Some((ray, t)) = exit else {
                 return Next::End;
             };
-            let b = Bounce {
-                ray: *ray,
-                beta: path.beta,
-                prev: None,
-            };
-            path.go_on(b, path.from, at.cone_specular);
+            path.straight_on(*ray, at.cone_specular);
             *through = *t;
             Next::Bounce
         }

@@ -65,7 +65,7 @@ use super::aov::{Event, Recorder};
 use super::diffuse_boundary::DiffuseBoundary;
 use super::interaction::offset_along;
 use super::lobe::{Lobe, SubsurfaceLobe, Vertex};
-use super::path::trace;
+use super::path::sample;
 use super::scatter::{Scatter, SubsurfaceHit, SubsurfaceScatter};
 use super::state::{PathState, Scratch};
 use super::walk_nee::WalkLight;
@@ -98,13 +98,15 @@ pub fn radiance<R: Recorder, T: Clock>(
     counters: &mut Counters,
     rec: &mut R,
 ) -> Vec3 {
-    let mut st = PathState {
+    sample::<R, T, _>(
+        ctx,
+        camera_ray,
         rng,
         scratch,
         counters,
         rec,
-    };
-    trace::<R, T, _>(ctx, camera_ray, &mut st, &mut RandomWalk)
+        &mut RandomWalk,
+    )
 }
 
 /// The random walk as the bounce loop's estimator of subsurface hits (and
