@@ -747,41 +747,50 @@ fn diffuse_boundary_light_sampling_keeps_the_mean() {
     let (plain, c2, t2) = run(&make(false), IntegratorKind::RandomWalk, None);
     assert_eq!((c1.walks_escaped, c2.walks_escaped), (0, 0));
     assert_eq!((c1.nonfinite, c2.nonfinite), (0, 0));
-    let n = nee.pixels.len() as f64;
+    let (ma, _) = mean_and_error(&nee);
+    let (mb, _) = mean_and_error(&plain);
+    println!("with NEE {ma} ({t1:.2} s), without {mb} ({t2:.2} s)");
+    assert_same_mean(&nee, &plain);
+    let (r_nee, r_plain) = (roughness(&nee), roughness(&plain));
+    println!("roughness with NEE {r_nee}, without {r_plain}");
+    assert!(r_nee * 3.0 < r_plain, "{r_nee} vs {r_plain}");
+}
+
+/// Two estimators of one image agree: per channel, the mean over the
+/// pixels of their difference is within 4 of its standard errors and
+/// within 5 % of `a`'s mean.
+fn assert_same_mean(a: &Film, b: &Film) {
+    let n = a.pixels.len() as f64;
     let (mut mean, mut sq) = ([0f64; 3], [0f64; 3]);
-    for (a, b) in nee.pixels.iter().zip(&plain.pixels) {
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
         for k in 0..3 {
-            let d = (a[k] - b[k]) as f64;
+            let d = (p[k] - q[k]) as f64;
             mean[k] += d / n;
             sq[k] += d * d / n;
         }
     }
-    let (ma, _) = mean_and_error(&nee);
-    let (mb, _) = mean_and_error(&plain);
-    println!("with NEE {ma} ({t1:.2} s), without {mb} ({t2:.2} s)");
+    let (ma, _) = mean_and_error(a);
     for k in 0..3 {
         let se = ((sq[k] - mean[k] * mean[k]) / (n - 1.0)).sqrt();
         println!("channel {k}: difference {} ± {se}", mean[k]);
         assert!(mean[k].abs() < 4.0 * se, "channel {k}: {} ± {se}", mean[k]);
         assert!(mean[k].abs() < 0.05 * ma[k] as f64, "channel {k}");
     }
-    // The noise: the variance of each image about a smooth reference is not
-    // available here, so compare each image's pixel-to-pixel roughness
-    // (adjacent-pixel differences), dominated by sampling noise at 256 spp.
-    let rough = |f: &Film| {
-        let w = f.width as usize;
-        let mut s = 0.0;
-        for (i, p) in f.pixels.iter().enumerate() {
-            if i % w + 1 < w {
-                let q = f.pixels[i + 1];
-                s += ((p.x - q.x).powi(2) + (p.y - q.y).powi(2) + (p.z - q.z).powi(2)) as f64;
-            }
+}
+
+/// An image's pixel-to-pixel roughness (squared adjacent-pixel
+/// differences), dominated by sampling noise at a few hundred spp: the
+/// variance about a smooth reference is not available in these tests.
+fn roughness(f: &Film) -> f64 {
+    let w = f.width as usize;
+    let mut s = 0.0;
+    for (i, p) in f.pixels.iter().enumerate() {
+        if i % w + 1 < w {
+            let q = f.pixels[i + 1];
+            s += ((p.x - q.x).powi(2) + (p.y - q.y).powi(2) + (p.z - q.z).powi(2)) as f64;
         }
-        s
-    };
-    let (r_nee, r_plain) = (rough(&nee), rough(&plain));
-    println!("roughness with NEE {r_nee}, without {r_plain}");
-    assert!(r_nee * 3.0 < r_plain, "{r_nee} vs {r_plain}");
+    }
+    s
 }
 
 /// A sphere of a chromatic medium (η = 1.4) under a square light and a dim
@@ -846,38 +855,11 @@ fn light_through_the_smooth_boundary_keeps_the_mean() {
         .pixels
         .iter()
         .all(|p| p.is_finite() && p.min_element() >= 0.0));
-    let n = on.pixels.len() as f64;
-    let (mut mean, mut sq) = ([0f64; 3], [0f64; 3]);
-    for (a, b) in on.pixels.iter().zip(&off.pixels) {
-        for k in 0..3 {
-            let d = (a[k] - b[k]) as f64;
-            mean[k] += d / n;
-            sq[k] += d * d / n;
-        }
-    }
     let (ma, _) = mean_and_error(&on);
     let (mb, _) = mean_and_error(&off);
     println!("with the connection {ma} ({t1:.2} s), without {mb} ({t2:.2} s)");
-    for k in 0..3 {
-        let se = ((sq[k] - mean[k] * mean[k]) / (n - 1.0)).sqrt();
-        println!("channel {k}: difference {} ± {se}", mean[k]);
-        assert!(mean[k].abs() < 4.0 * se, "channel {k}: {} ± {se}", mean[k]);
-        assert!(mean[k].abs() < 0.05 * ma[k] as f64, "channel {k}");
-    }
-    // The noise, as in the diffuse boundary's test: adjacent-pixel
-    // differences, dominated by sampling noise at 256 spp.
-    let rough = |f: &Film| {
-        let w = f.width as usize;
-        let mut s = 0.0;
-        for (i, p) in f.pixels.iter().enumerate() {
-            if i % w + 1 < w {
-                let q = f.pixels[i + 1];
-                s += ((p.x - q.x).powi(2) + (p.y - q.y).powi(2) + (p.z - q.z).powi(2)) as f64;
-            }
-        }
-        s
-    };
-    let (r_on, r_off) = (rough(&on), rough(&off));
+    assert_same_mean(&on, &off);
+    let (r_on, r_off) = (roughness(&on), roughness(&off));
     println!("roughness with the connection {r_on}, without {r_off}");
     assert!(r_on * 2.0 < r_off, "{r_on} vs {r_off}");
 }
