@@ -3,6 +3,7 @@
 //! material of the same name overrides, ignored keys are listed on
 //! stderr, and a key lucent does not know is an error at its line.
 
+use std::path::Path;
 use std::process::Command;
 
 use lucent::film::Film;
@@ -32,6 +33,11 @@ fn render(mtl: &str, extra: &str) -> (Option<i32>, String, Option<Film>) {
     .save(d.join("gb.png"))
     .unwrap();
     let scene = format!("{VIEW}{extra}[[shapes]]\ntype = \"obj\"\nfile = \"two.obj\"\n");
+    render_scene(d, &scene)
+}
+
+/// Renders `scene` as `scene.toml` in `d`: exit code, stderr, the frame.
+fn render_scene(d: &Path, scene: &str) -> (Option<i32>, String, Option<Film>) {
     let path = d.join("scene.toml");
     std::fs::write(&path, scene).unwrap();
     let out = d.join("out.exr");
@@ -134,22 +140,7 @@ fn render_bumped(
         "{VIEW}[[lights]]\ntype = \"distant\"\ndirection = [-1, 0, -1]\nirradiance = [2, 2, 2]\n\
          {extra}[[shapes]]\ntype = \"obj\"\nfile = \"two.obj\"\n{shape_keys}"
     );
-    let path = d.join("scene.toml");
-    std::fs::write(&path, scene).unwrap();
-    let out = d.join("out.exr");
-    let res = Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .args(["render", "--quiet"])
-        .arg(&path)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .expect("run lucent");
-    let film = out.exists().then(|| Film::read_exr(&out).unwrap());
-    (
-        res.status.code(),
-        String::from_utf8_lossy(&res.stderr).into_owned(),
-        film,
-    )
+    render_scene(d, &scene)
 }
 
 /// The scene material `tex` reading `h.png` (linear) with `keys`.

@@ -155,18 +155,24 @@ fn unusable_textures_exit_2_naming_file_line_field_and_reason() {
         ),
     ];
     for (scene, setup, field, fragment) in rows {
-        let (code, stderr, written) = render(&scene, &[], setup);
-        assert_eq!(code, Some(2), "{fragment:?}: {stderr}");
-        assert!(
-            stderr.contains(fragment),
-            "stderr lacks {fragment:?}: {stderr}"
-        );
-        assert!(
-            stderr.contains("scene.toml:") && stderr.contains(&format!("field `{field}`")),
-            "no line or field {field}: {stderr}"
-        );
-        assert!(!written, "output written for {fragment:?}");
+        refused(&scene, setup, field, fragment);
     }
+}
+
+/// `scene` (with the files `setup` writes) exits 2 with `fragment` in its
+/// message, naming the scene file's line and `field`, and writes nothing.
+fn refused(scene: &str, setup: impl FnOnce(&Path), field: &str, fragment: &str) {
+    let (code, stderr, written) = render(scene, &[], setup);
+    assert_eq!(code, Some(2), "{fragment:?}: {stderr}");
+    assert!(
+        stderr.contains(fragment),
+        "stderr lacks {fragment:?}: {stderr}"
+    );
+    assert!(
+        stderr.contains("scene.toml:") && stderr.contains(&format!("field `{field}`")),
+        "no line or field {field}: {stderr}"
+    );
+    assert!(!written, "output written for {fragment:?}");
 }
 
 /// A roughness texture that cannot be used: declared sRGB (a roughness
@@ -199,17 +205,7 @@ fn unusable_roughness_textures_exit_2_naming_file_line_field_and_reason() {
         ),
     ];
     for (scene, field, fragment) in rows {
-        let (code, stderr, written) = render(&scene, &[], |d| png(&d.join("a.png"), 2, 2));
-        assert_eq!(code, Some(2), "{fragment:?}: {stderr}");
-        assert!(
-            stderr.contains(fragment),
-            "stderr lacks {fragment:?}: {stderr}"
-        );
-        assert!(
-            stderr.contains("scene.toml:") && stderr.contains(&format!("field `{field}`")),
-            "no line or field {field}: {stderr}"
-        );
-        assert!(!written, "output written for {fragment:?}");
+        refused(&scene, |d| png(&d.join("a.png"), 2, 2), field, fragment);
     }
 }
 
