@@ -33,6 +33,7 @@ pub mod effects;
 mod env_nee;
 pub mod footprint;
 mod glossy;
+mod hit_material;
 pub mod interaction;
 pub mod kind;
 mod lobe;

@@ -15,9 +15,10 @@ use super::aov::{self, Event, Recorder, Source};
 use super::branch::{roulette, At, Branch, Branches, Next};
 use super::env_nee::{escaped, record_environment};
 use super::footprint::Cone;
+use super::hit_material::{self, HitMaterial, PointMaterial};
 use super::lobe::Vertex;
 use super::nee::{emission_weight, record_direct, NeeAt};
-use super::scatter::{PointMaterial, Scatter, SubsurfaceScatter, Through};
+use super::scatter::{Scatter, SubsurfaceScatter, Through};
 use super::state::PathState;
 use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
@@ -326,12 +327,8 @@ fn emitted<R: Recorder>(
 /// What the material at `at` scatters into (`path.beta` scaled by it);
 /// `path.from` becomes the object a continuation leaves, where known
 /// (through a dielectric; a medium's exit is not culled from). A textured
-/// subsurface material's values at the hit are kept in `point`.
+/// material's values at the hit are kept in `point`.
 #[inline(always)]
-#[cfg_attr(
-    not(feature = "subsurface"),
-    allow(unused_variables, clippy::extra_unused_type_parameters)
-)]
 fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
     ctx: &'s Context,
     material: &'s Material,
@@ -341,44 +338,39 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
     subsurface: &mut S,
     point: &'s mut PointMaterial,
 ) -> Scatter<'s> {
-    match material {
-        Material::Diffuse { albedo } => {
-            Scatter::Vertex(diffuse_vertex(ctx, at.si, at.wo, *albedo, st.rec))
+    let Material::Textured(t) = material else {
+        let m = HitMaterial::untextured(material);
+        return scatter_as::<R, T, S>(ctx, m, at, path, st, subsurface);
+    };
+    let width = path.cone.width_at(at.t);
+    let hit = hit_material::textured(ctx, t, at.si, at.bary, at.wo, width, point);
+    let at = At { si: &hit.si, ..*at };
+    scatter_as::<R, T, S>(ctx, hit.material, &at, path, st, subsurface)
+}
+
+/// What the material `m`, its parameters fixed at `at`, turns into there.
+#[inline(always)]
+#[cfg_attr(not(feature = "subsurface"), allow(unused_variables))]
+fn scatter_as<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
+    ctx: &'s Context,
+    m: HitMaterial<'s>,
+    at: &At,
+    path: &mut Branch,
+    st: &mut PathState<R>,
+    subsurface: &mut S,
+) -> Scatter<'s> {
+    match m {
+        HitMaterial::Diffuse(albedo) => {
+            Scatter::Vertex(diffuse_vertex(ctx, at.si, at.wo, albedo, st.rec))
         }
-        Material::Textured(t) => {
-            let width = path.cone.width_at(at.t);
-            let r = super::texturing::resolve(ctx, t, at.si, at.bary, at.wo, width);
-            match (&t.base, r.albedo) {
-                (Material::Diffuse { albedo }, a) => Scatter::Vertex(diffuse_vertex(
-                    ctx,
-                    &r.si,
-                    at.wo,
-                    a.unwrap_or(*albedo),
-                    st.rec,
-                )),
-                #[cfg(feature = "subsurface")]
-                (Material::Subsurface(ss), _) => {
-                    let at = At { si: &r.si, ..*at };
-                    let ss = at_point(t, ss, &r, point);
-                    subsurface_at::<R, T, S>(ctx, ss, &at, path, st, subsurface)
-                }
-                (base, _) => {
-                    let at = At { si: &r.si, ..*at };
-                    match (&t.roughness, r.roughness) {
-                        (Some(map), Some(rough)) => rough_base::<R, T, S>(
-                            ctx, base, map, rough, &at, path, st, subsurface, point,
-                        ),
-                        _ => textured_base::<R, T, S>(ctx, base, &at, path, st, subsurface, point),
-                    }
-                }
-            }
+        HitMaterial::Dielectric(eta) => smooth_dielectric(ctx, eta, at, path, st.rng),
+        HitMaterial::RoughDielectric(d) => {
+            super::glossy::rough_dielectric(ctx, &d, at, path, st.rng)
         }
-        Material::Dielectric { eta } => smooth_dielectric(ctx, *eta, at, path, st.rng),
-        Material::RoughDielectric(d) => super::glossy::rough_dielectric(ctx, d, at, path, st.rng),
-        Material::Conductor(c) => super::glossy::conductor(ctx, c, at, path, st.rec),
-        Material::Plastic(p) => super::glossy::plastic(ctx, p, at, path, st.rng, st.rec),
+        HitMaterial::Conductor(c) => super::glossy::conductor(ctx, c, at, path, st.rec),
+        HitMaterial::Plastic(p) => super::glossy::plastic(ctx, p, at, path, st.rng, st.rec),
         #[cfg(feature = "subsurface")]
-        Material::Subsurface(ss) => subsurface_at::<R, T, S>(ctx, ss, at, path, st, subsurface),
+        HitMaterial::Subsurface(ss) => subsurface_at::<R, T, S>(ctx, ss, at, path, st, subsurface),
     }
 }
 
@@ -407,40 +399,6 @@ fn subsurface_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
     subsurface_hit::<R, T, S>(ctx, &h, &mut path.beta, st, subsurface)
 }
 
-/// The textured subsurface material `t` (base `ss`) with the parameters
-/// its textures give at the hit (`r`), kept in `point`; `ss` itself
-/// where they give no medium and no roughness (`docs/bssrdf.md` §13).
-#[cfg(feature = "subsurface")]
-#[inline(never)]
-fn at_point<'s>(
-    t: &crate::materials::Textured,
-    ss: &'s crate::materials::Subsurface,
-    r: &super::texturing::Resolved,
-    point: &'s mut PointMaterial,
-) -> &'s crate::materials::Subsurface {
-    let medium = match &t.medium {
-        Some(m) if r.albedo.is_some() || r.dmfp.is_some() => {
-            ss.at_point(m.params_at(ss.params(), r.albedo, r.dmfp))
-        }
-        _ => None,
-    };
-    let coat = t
-        .roughness
-        .as_ref()
-        .and_then(|map| map.steps.as_ref())
-        .zip(r.roughness);
-    match (medium, coat) {
-        (m, Some((steps, rough))) => {
-            let p = m.unwrap_or_else(|| ss.clone());
-            point
-                .subsurface
-                .insert(p.with_point_coat(rough, steps, ss.least_coat()))
-        }
-        (Some(p), None) => point.subsurface.insert(p),
-        (None, None) => ss,
-    }
-}
-
 /// A smooth dielectric of index `eta` hit at `at`: reflection or
 /// refraction, continuing the path.
 fn smooth_dielectric<'s>(
@@ -453,55 +411,6 @@ fn smooth_dielectric<'s>(
     let (next, e) = dielectric_bounce(ctx, eta, at.si, at.wo, &mut path.beta, rng);
     path.from = ctx.leaving_towards(at.si, next.d);
     Scatter::Continue(next, e)
-}
-
-/// The glossy `base` of a textured material at `at` with the roughness
-/// `rough` its map gives there (the material kept in `point`); a rough
-/// dielectric below the smooth threshold is the smooth interface. A base
-/// the loader gives no roughness map is scattered as it is.
-#[inline(never)]
-#[allow(clippy::too_many_arguments)]
-fn rough_base<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
-    ctx: &'s Context,
-    base: &'s Material,
-    map: &crate::materials::RoughnessMap,
-    rough: f32,
-    at: &At,
-    path: &mut Branch,
-    st: &mut PathState<R>,
-    subsurface: &mut S,
-    point: &'s mut PointMaterial,
-) -> Scatter<'s> {
-    match (base, &map.steps) {
-        (Material::Conductor(c), Some(steps)) => {
-            let c = point.conductor.insert(c.at_roughness(rough, steps));
-            super::glossy::conductor(ctx, c, at, path, st.rec)
-        }
-        (Material::Plastic(p), Some(steps)) => {
-            let p = point.plastic.insert(p.at_roughness(rough, steps));
-            super::glossy::plastic(ctx, p, at, path, st.rng, st.rec)
-        }
-        (Material::RoughDielectric(d), _) => match d.at_roughness(rough) {
-            Some(d) => super::glossy::rough_dielectric(ctx, &d, at, path, st.rng),
-            None => smooth_dielectric(ctx, d.eta, at, path, st.rng),
-        },
-        _ => textured_base::<R, T, S>(ctx, base, at, path, st, subsurface, point),
-    }
-}
-
-/// What the base of a textured material scatters into at `at` (its
-/// shading normal already the normal map's).
-#[inline(never)]
-fn textured_base<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
-    ctx: &'s Context,
-    base: &'s Material,
-    at: &At,
-    path: &mut Branch,
-    st: &mut PathState<R>,
-    subsurface: &mut S,
-    point: &'s mut PointMaterial,
-) -> Scatter<'s> {
-    scatter_at::<R, T, S>(ctx, base, at, path, st, subsurface, point)
 }
 
 /// The nearest hit along the path's ray, timed as the camera's (depth 0)

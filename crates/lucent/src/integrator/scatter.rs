@@ -29,18 +29,6 @@ pub(crate) struct SubsurfaceHit<'h, 's> {
     pub(crate) scattered: bool,
 }
 
-/// Where the bounce loop keeps, while a hit's scattering is in use, the
-/// material with the parameters a textured one has at that hit
-/// (`docs/bssrdf.md` §13): one of each kind per path, replaced at each
-/// such hit.
-#[derive(Default)]
-pub(crate) struct PointMaterial {
-    #[cfg(feature = "subsurface")]
-    pub(crate) subsurface: Option<Subsurface>,
-    pub(crate) conductor: Option<crate::materials::Conductor>,
-    pub(crate) plastic: Option<crate::materials::Plastic>,
-}
-
 /// An estimator of light transport through subsurface objects. The bounce
 /// loop is generic over it, so each implementation gets its own
 /// monomorphised loop.
