@@ -53,5 +53,6 @@ pub fn object(name: impl Into<String>, material: usize, emission: Option<Vec3>) 
         name: name.into(),
         material,
         emission,
+        walk: false,
     }
 }

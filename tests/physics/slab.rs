@@ -219,6 +219,7 @@ fn pencil_beam_profile_follows_a_times_r() {
                 name: "ring".into(),
                 material: black,
                 emission: Some(Vec3::splat(le)),
+                walk: false,
             });
             // 16 pixels estimate the standard error to ±18 %: at 32768 spp
             // it sat at 0.65–0.75 % of the mean, on the edge of the

@@ -1,8 +1,8 @@
 //! The path integrator's estimator of subsurface hits: the diffusion
 //! BSSRDF's probes ([`super::subsurface`]), or the random walk
-//! ([`super::randomwalk`]) at a material the accuracy budget gave it
+//! ([`super::randomwalk`]) at an object the accuracy budget gave it
 //! (`crate::integrator::plan::budget`, `docs/bssrdf.md` §14). Without a
-//! budget no material walks, and every hit is diffusion's.
+//! budget no object walks, and every hit is diffusion's.
 
 use super::aov::Recorder;
 use super::path::sample;
@@ -15,7 +15,7 @@ use crate::geometry::{Ray, Vec3};
 use crate::sampling::SampleRng;
 
 /// The radiance arriving along `camera_ray`: one sample of L, subsurface
-/// hits estimated as each material's choice says. Same contract as
+/// hits estimated as each object's choice says. Same contract as
 /// [`super::path::radiance`].
 pub fn radiance<R: Recorder, T: Clock>(
     ctx: &Context,
@@ -28,7 +28,7 @@ pub fn radiance<R: Recorder, T: Clock>(
     sample::<R, T, _>(ctx, camera_ray, rng, scratch, counters, rec, &mut Budgeted)
 }
 
-/// Diffusion, or the walk where the material's choice is the walk.
+/// Diffusion, or the walk where the object's choice is the walk.
 struct Budgeted;
 
 impl SubsurfaceScatter for Budgeted {
@@ -42,7 +42,7 @@ impl SubsurfaceScatter for Budgeted {
         beta: &mut Vec3,
         st: &mut PathState<R>,
     ) -> Scatter<'s> {
-        if hit.ss.options().walk {
+        if ctx.scene.objects[hit.si.geom as usize].walk {
             return RandomWalk.scatter(ctx, hit, beta, st);
         }
         Diffusion.scatter(ctx, hit, beta, st)

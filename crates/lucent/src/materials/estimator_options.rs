@@ -52,9 +52,6 @@ pub struct EstimatorOptions {
     /// The accuracy budget (`super::accuracy`): the largest predicted
     /// relative error allowed; None: the estimator as the options give it.
     pub accuracy: Option<f32>,
-    /// The random walk estimates this material's hits in the path
-    /// integrator: set only by the budget's choice, never by a key.
-    pub walk: bool,
 }
 
 impl Default for EstimatorOptions {
@@ -72,7 +69,6 @@ impl Default for EstimatorOptions {
             probe_pair: true,
             regularize: DEFAULT_REGULARIZE,
             accuracy: None,
-            walk: false,
         }
     }
 }
@@ -504,7 +500,7 @@ pub static OPTIONS: [EstimatorOption; 17] = [
         research_in_scenes: true,
         flag: true,
         description: "Accuracy budget: the largest predicted error of the object's image, as \
-                      a fraction (0.01) or per cent (1%); lucent picks per material the \
+                      a fraction (0.01) or per cent (1%); lucent picks per object the \
                       cheapest estimator (diffusion with the Burley or the tabulated profile, \
                       or the random walk) the error model predicts within it (off: the \
                       options as given)",

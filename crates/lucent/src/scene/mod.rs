@@ -100,6 +100,9 @@ pub struct Object {
     /// Emitted radiance from the front face (the side the geometric normal,
     /// from counter-clockwise winding, points to). None: not a light.
     pub emission: Option<Vec3>,
+    /// The accuracy budget gave its subsurface hits to the random walk
+    /// (`crate::integrator::plan::budget`); never set by a key.
+    pub walk: bool,
 }
 
 #[derive(Clone, Debug)]

@@ -172,6 +172,7 @@ pub(super) fn objects(
                 name,
                 material,
                 emission,
+                walk: false,
             },
         ));
     }

@@ -85,6 +85,7 @@ pub(super) fn object(
         name: sd.name.clone().unwrap_or(field),
         material: mat,
         emission,
+        walk: false,
     };
     Ok((mesh, object))
 }

@@ -128,11 +128,14 @@ fn sampling(scene: &Scene) -> Vec<(String, String)> {
         let crate::materials::Material::Subsurface(ss) = m.base() else {
             continue;
         };
-        let users: Vec<&str> = scene
+        let users: Vec<String> = scene
             .objects
             .iter()
             .filter(|o| o.material == i)
-            .map(|o| o.name.as_str())
+            .map(|o| match o.walk {
+                true => format!("{} (random walk)", o.name),
+                false => o.name.clone(),
+            })
             .collect();
         if !users.is_empty() {
             sampling.push((users.join(","), ss.sampling_description()));

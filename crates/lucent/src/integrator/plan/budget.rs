@@ -1,13 +1,14 @@
-//! The accuracy budget's choice (`docs/bssrdf.md` §14): for a subsurface
-//! material with `accuracy` set, the cheapest candidate estimator
-//! (diffusion with the Burley profile, with the tabulated profile, or the
-//! random walk) whose predicted error on every object using it is within
-//! the budget, from what the scene tells before rendering: each object's
-//! size in diffusion lengths of the material's widest channel and how
+//! The accuracy budget's choice (`docs/bssrdf.md` §14): for each object
+//! of a subsurface material with `accuracy` set, the cheapest candidate
+//! estimator (diffusion with the Burley profile, with the tabulated
+//! profile, or the random walk) whose predicted error there is within the
+//! budget, from what the scene tells before rendering: the object's size
+//! in diffusion lengths of the material's widest channel and how
 //! directional the scene's light is, read through the measured model
-//! ([`crate::bssrdf::error_model`]). [`decide`] is the choice written out
-//! (`--explain`); [`resolve`] makes it, once, on the scene a render or a
-//! plan uses.
+//! ([`crate::bssrdf::error_model`]). The objects that diffuse share the
+//! material's profile: the cheapest one within the budget on all of them.
+//! [`decide`] is the choice written out (`--explain`); [`resolve`] makes
+//! it, once, on the scene a render or a plan uses.
 
 use serde::{Deserialize, Serialize};
 
@@ -42,6 +43,9 @@ pub struct ObjectBudget {
     /// That size over the widest channel's diffusion length ℓd.
     pub size_ld: f64,
     pub candidates: Vec<CandidateRow>,
+    /// `burley`, `tabulated` or `walk`: the estimator at its hits.
+    pub chosen: String,
+    pub reason: String,
 }
 
 /// A material's choice under its budget.
@@ -51,9 +55,11 @@ pub struct BudgetPlan {
     pub budget: f32,
     /// `uniform` or `key`.
     pub lighting: String,
-    /// `burley`, `tabulated` or `walk`.
+    /// `burley` or `tabulated`: the profile of the objects that diffuse;
+    /// `walk` where every object walks.
     pub chosen: String,
     pub reason: String,
+    /// In the order of the scene's objects.
     pub objects: Vec<ObjectBudget>,
 }
 
@@ -67,32 +73,102 @@ pub fn decide(scene: &Scene, i: usize) -> Option<BudgetPlan> {
     let ld = widest_diffusion_length(ss)?;
     let model = ErrorModel::get().ok()?;
     let lighting = lighting(scene);
-    let objects: Vec<ObjectBudget> = (0..scene.objects.len())
+    let mut objects: Vec<ObjectBudget> = (0..scene.objects.len())
         .filter(|&o| scene.objects[o].material == i)
         .map(|o| object_budget(scene, o, ld, lighting, model))
         .collect();
     if objects.is_empty() {
         return None;
     }
+    for o in &mut objects {
+        let (pick, why) = cheapest(&[&*o], &ANY, budget);
+        (o.chosen, o.reason) = (Candidate::ALL[pick].name().into(), why);
+    }
+    let (chosen, reason) = material_choice(&mut objects, budget);
+    Some(BudgetPlan {
+        budget,
+        lighting: lighting.name().into(),
+        chosen,
+        reason,
+        objects,
+    })
+}
+
+/// Every candidate, and the diffusion ones, as indices into
+/// [`Candidate::ALL`].
+const ANY: [usize; 3] = [
+    Candidate::Burley as usize,
+    Candidate::Tabulated as usize,
+    Candidate::Walk as usize,
+];
+const DIFFUSION: [usize; 2] = [Candidate::Burley as usize, Candidate::Tabulated as usize];
+
+/// Among `candidates` (indices into [`Candidate::ALL`]), the cheapest whose
+/// predicted error on every one of `objects` is within `budget`, by the
+/// worst error and cost over them; the last one where none is. Why, in
+/// words.
+fn cheapest(objects: &[&ObjectBudget], candidates: &[usize], budget: f32) -> (usize, String) {
     let worst = |c: usize| -> (f64, f64) {
         let rows = objects.iter().map(|o| &o.candidates[c]);
         let e = rows.clone().map(|r| r.error).fold(0.0, f64::max);
         (e, rows.map(|r| r.cost).fold(0.0, f64::max))
     };
-    let mut order: Vec<usize> = (0..Candidate::ALL.len()).collect();
+    let mut order = candidates.to_vec();
     order.sort_by(|&a, &b| worst(a).1.total_cmp(&worst(b).1));
     let pick = order
         .iter()
         .copied()
         .find(|&c| worst(c).0 <= budget as f64)
-        .unwrap_or(Candidate::ALL.len() - 1);
-    Some(BudgetPlan {
-        budget,
-        lighting: lighting.name().into(),
-        chosen: Candidate::ALL[pick].name().into(),
-        reason: reason(&order, pick, &worst, budget),
-        objects,
-    })
+        .unwrap_or(*candidates.last().unwrap());
+    (pick, reason(&order, pick, &worst, budget))
+}
+
+/// The material's profile for its objects that diffuse, and why: the
+/// cheapest diffusion profile within the budget on all of them. An object
+/// that profile does not meet walks. Where all objects choose alike, the
+/// choice and reason are theirs.
+fn material_choice(objects: &mut [ObjectBudget], budget: f32) -> (String, String) {
+    let diffusing: Vec<&ObjectBudget> = objects
+        .iter()
+        .filter(|o| o.chosen != Candidate::Walk.name())
+        .collect();
+    if diffusing.is_empty() {
+        let all: Vec<&ObjectBudget> = objects.iter().collect();
+        let (_, why) = cheapest(&all, &ANY, budget);
+        return (Candidate::Walk.name().into(), why);
+    }
+    let (profile, why) = cheapest(&diffusing, &DIFFUSION, budget);
+    let name = Candidate::ALL[profile].name();
+    if objects.iter().all(|o| o.chosen == name) {
+        return (name.into(), why);
+    }
+    let mut walkers = Vec::new();
+    for o in objects.iter_mut() {
+        let row = &o.candidates[profile];
+        let (walk, within) = (Candidate::Walk.name(), row.error <= budget as f64);
+        if o.chosen != walk && o.chosen != name {
+            o.reason = format!(
+                "the material's {name} profile (its other objects need it) predicted \
+                 {:.1} % {} {:.1} % here; alone: {}",
+                100.0 * row.error,
+                if within { "≤" } else { ">" },
+                100.0 * budget,
+                o.reason
+            );
+            o.chosen = if within { name } else { walk }.into();
+        }
+        if o.chosen == walk {
+            walkers.push(o.object.clone());
+        }
+    }
+    let shared = format!("the objects that diffuse share the {name} profile: {why}");
+    match walkers.is_empty() {
+        true => (name.into(), shared),
+        false => (
+            name.into(),
+            format!("{shared}; the random walk at {}", walkers.join(", ")),
+        ),
+    }
 }
 
 /// Why `pick` was chosen: the cheaper candidates refused, by their worst
@@ -159,6 +235,8 @@ fn object_budget(
         size,
         size_ld,
         candidates,
+        chosen: String::new(),
+        reason: String::new(),
     }
 }
 
@@ -207,9 +285,9 @@ pub fn volume_radius(mesh: &Mesh) -> f64 {
     }
 }
 
-/// Makes every budget's choice in `scene`: the profile it chose, or the
-/// random walk at its hits (and then a watertight traversal, which the
-/// walk needs).
+/// Makes every budget's choice in `scene`: the profile its objects that
+/// diffuse share, and the random walk at the hits of those that walk (and
+/// then a watertight traversal, which the walk needs).
 pub fn resolve(scene: &mut Scene) -> Result<(), ParamError> {
     for i in 0..scene.materials.len() {
         let Some(plan) = decide(scene, i) else {
@@ -219,7 +297,6 @@ pub fn resolve(scene: &mut Scene) -> Result<(), ParamError> {
             continue;
         };
         let mut o = *ss.options();
-        o.walk = plan.chosen == Candidate::Walk.name();
         if plan.chosen == Candidate::Tabulated.name() {
             o.probe.profile = ProfileShape::Tabulated;
         } else if plan.chosen == Candidate::Burley.name() {
@@ -232,9 +309,13 @@ pub fn resolve(scene: &mut Scene) -> Result<(), ParamError> {
             }
             m => *m = Material::Subsurface(chosen),
         }
-        if o.walk {
-            scene.settings.traversal = Traversal::Watertight;
+        let users = scene.objects.iter_mut().filter(|u| u.material == i);
+        for (u, b) in users.zip(&plan.objects) {
+            u.walk = b.chosen == Candidate::Walk.name();
         }
+    }
+    if scene.objects.iter().any(|u| u.walk) {
+        scene.settings.traversal = Traversal::Watertight;
     }
     Ok(())
 }
@@ -305,7 +386,58 @@ mod tests {
         // and the choice is made on the scene: the walk at the thin one's hits
         let mut s = thin;
         resolve(&mut s).unwrap();
-        assert!(marble(&s).options().walk);
+        assert!(s.objects.iter().any(|o| o.name == "ball" && o.walk));
+        assert_eq!(s.settings.traversal, Traversal::Watertight);
+    }
+
+    /// The mistake: the choice made per material for its most demanding
+    /// object. Three marble spheres of one material under a key light, of
+    /// 0.35, 3.5 and 35 ℓd, at a budget of 5 %: only the walk meets it on
+    /// the small one, the tabulated profile on the middle one, Burley's on
+    /// the large one. The small one walks alone; the other two share the
+    /// tabulated profile, which both meet.
+    #[test]
+    fn each_object_walks_or_diffuses_by_its_own_size() {
+        let lamp = "[materials.lamp]\ntype = \"diffuse\"\nalbedo = [0, 0, 0]\n\
+                    [[shapes]]\nname = \"light\"\ntype = \"quad\"\nmaterial = \"lamp\"\n\
+                    emission = [10, 10, 10]\nrotate = [[90, 0, 1, 0]]\ntranslate = [-9, 0, 0]\n";
+        let ball = |name: &str, mm: f64, x: f64| {
+            format!(
+                "[[shapes]]\nname = \"{name}\"\ntype = \"sphere\"\nmaterial = \"marble\"\n\
+                 subdivisions = 3\nscale = {}\ntranslate = [{x}, 0, 0]\n",
+                mm / 100.0
+            )
+        };
+        let text = format!(
+            "units_per_mm = 0.01\n[camera]\nlook_from = [0, 0, 20]\nlook_at = [0, 0, 0]\n\
+             resolution = [8, 8]\n[materials.marble]\ntype = \"subsurface\"\n\
+             preset = \"marble\"\naccuracy = 0.05\n{lamp}{}{}{}",
+            ball("small", 3.0, -4.0),
+            ball("middle", 30.0, -2.0),
+            ball("large", 300.0, 4.0)
+        );
+        let mut s = crate::scene::load::load_str(&text, Path::new("objects.toml")).unwrap();
+        let plan = decide(&s, m(&s)).unwrap();
+        let chosen: Vec<(&str, &str)> = plan
+            .objects
+            .iter()
+            .map(|o| (o.object.as_str(), o.chosen.as_str()))
+            .collect();
+        assert_eq!(
+            chosen,
+            [
+                ("small", "walk"),
+                ("middle", "tabulated"),
+                ("large", "tabulated")
+            ],
+            "{:#?}",
+            plan.objects
+        );
+        assert_eq!(plan.chosen, "tabulated", "{}", plan.reason);
+        resolve(&mut s).unwrap();
+        let walks: Vec<bool> = s.objects.iter().map(|o| o.walk).collect();
+        assert_eq!(walks, [false, true, false, false]);
+        assert_eq!(marble(&s).options().probe.profile, ProfileShape::Tabulated);
         assert_eq!(s.settings.traversal, Traversal::Watertight);
     }
 

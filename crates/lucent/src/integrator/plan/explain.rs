@@ -315,7 +315,7 @@ fn traversal(scene: &Scene, opts: &PlanOptions) -> Choice {
         ),
         (_, Traversal::Watertight) if budget_walks(scene) => choice(
             "watertight",
-            "an accuracy budget chose the random walk for some material: no walk may slip \
+            "an accuracy budget chose the random walk for some object: no walk may slip \
              out of a closed medium through an edge that triangles share",
         ),
         (_, Traversal::Watertight) => choice(
@@ -333,19 +333,10 @@ fn traversal(scene: &Scene, opts: &PlanOptions) -> Choice {
     }
 }
 
-/// Whether an accuracy budget gave some material the random walk (which
+/// Whether an accuracy budget gave some object the random walk (which
 /// then made the traversal watertight, [`super::budget::resolve`]).
 fn budget_walks(scene: &Scene) -> bool {
-    #[cfg(feature = "subsurface")]
-    return scene.materials.iter().any(|m| match m.base() {
-        crate::materials::Material::Subsurface(ss) => ss.options().walk,
-        _ => false,
-    });
-    #[cfg(not(feature = "subsurface"))]
-    return {
-        let _ = scene;
-        false
-    };
+    scene.objects.iter().any(|o| o.walk)
 }
 
 /// The passes recorded besides the beauty.

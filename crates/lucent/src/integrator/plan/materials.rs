@@ -138,6 +138,13 @@ fn users(scene: &Scene, i: usize) -> Vec<String> {
         .collect()
 }
 
+/// Whether the accuracy budget gave every object using material `i` the
+/// random walk (some object uses it).
+fn all_walk(scene: &Scene, i: usize) -> bool {
+    let mut users = scene.objects.iter().filter(|o| o.material == i).peekable();
+    users.peek().is_some() && users.all(|o| o.walk)
+}
+
 /// Material `i`'s name in the scene file.
 fn material_name(scene: &Scene, i: usize) -> String {
     scene
@@ -242,7 +249,7 @@ pub(super) fn material_rows(scene: &Scene, opts: &PlanOptions, area_lights: bool
                 }];
             }
             #[cfg(feature = "subsurface")]
-            Material::Subsurface(ss) if walk || ss.options().walk => {
+            Material::Subsurface(ss) if walk || all_walk(scene, i) => {
                 let why = match walk {
                     true => "--integrator randomwalk: the medium simulated event by event",
                     false => "the accuracy budget's choice: the medium simulated event by event",

@@ -168,10 +168,15 @@ fn budget_rows(r: &mut String, b: &super::budget::BudgetPlan) {
             "  object",
             &o.object,
             &format!(
-                "size {:.3} = {:.2} ℓd; predicted {}{range}",
+                "{}: size {:.3} = {:.2} ℓd; predicted {}{range}{}",
+                o.chosen,
                 o.size,
                 o.size_ld,
-                c.join(", ")
+                c.join(", "),
+                match o.chosen == b.chosen {
+                    true => String::new(),
+                    false => format!("; {}", o.reason),
+                }
             ),
         );
     }
