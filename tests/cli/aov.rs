@@ -183,6 +183,32 @@ fn light_paths_and_light_groups_sum_to_the_beauty_with_both_integrators() {
     }
 }
 
+/// [`MIXED`] under the lookdev scene's studio map (group `sky`) instead of
+/// its constant sky, which only escaping rays find: the image's light
+/// sampled at every vertex (diffuse, coat, the probe's entry points) is
+/// filed in the passes too, so light paths and groups still sum to the
+/// beauty. Caught: the environment's light sample not recorded
+/// (`record_environment` without its `rec.light`).
+#[test]
+fn light_paths_and_light_groups_sum_to_the_beauty_under_an_environment_image() {
+    let text = MIXED.replace(
+        "radiance = [0.2, 0.25, 0.3]",
+        "file = \"lookdev/studio.exr\"\nintensity = 0.3",
+    );
+    let at = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/aov-test.toml");
+    let s = load_str(&text, &at).unwrap();
+    let groups = ["RGBA_default", "RGBA_key", "RGBA_sky"];
+    for integrator in [IntegratorKind::Path, IntegratorKind::RandomWalk] {
+        let out = render_with(&s, PassSet::all(), integrator, 2, None);
+        let what = format!("{integrator:?} under the image");
+        assert_sum_is_beauty(&out, &light_path_names(), &format!("{what}: light paths"));
+        assert_sum_is_beauty(&out, &groups, &format!("{what}: light groups"));
+        for name in light_path_names().into_iter().chain(groups) {
+            assert!(max(layer(&out, name)) > 0.0, "{what}: {name} is black");
+        }
+    }
+}
+
 /// [`MIXED`] with a sun (group `sun`), a sphere light (group `key`) and a
 /// spot light (no group: `default`) besides its emitters.
 fn mixed_with_lights() -> String {

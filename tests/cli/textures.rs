@@ -45,9 +45,14 @@ fn scene(def: &str, material_key: &str) -> String {
     )
 }
 
+/// Caught: a texture two materials share counted once per material
+/// (`Scene::textures` without its check for one already seen).
 #[test]
 fn a_textured_scene_renders_and_reports_its_texture_memory() {
-    let s = scene("file = \"a.png\"", "albedo_texture = \"t\"");
+    // a second material and shape read the same texture: held once
+    let s = scene("file = \"a.png\"", "albedo_texture = \"t\"")
+        + "[materials.n]\ntype = \"diffuse\"\nalbedo_texture = \"t\"\n\
+           [[shapes]]\ntype = \"sphere\"\nmaterial = \"n\"\nscale = 0.3\n";
     let (code, stderr, written) = render(&s, &["--stats"], |d| png(&d.join("a.png"), 16, 8));
     assert_eq!(code, Some(0), "{stderr}");
     assert!(written);

@@ -253,6 +253,44 @@ fn a_fifo_as_an_obj_mesh_is_refused_promptly_at_its_scene_line() {
     assert!(!exr.exists());
 }
 
+/// The image files a scene names: a FIFO as the environment map, a
+/// texture or an OBJ's material library is refused at once, naming the
+/// file and the field (or the OBJ line), nothing written. Caught: the
+/// environment image opened without the regular-file check (the loader
+/// blocks in `open` until the test kills it).
+#[test]
+fn a_fifo_as_an_environment_texture_or_mtl_file_is_refused_promptly() {
+    let env = SCENE.replace("radiance = [1, 1, 1]", "file = \"sky.exr\"\nintensity = 1");
+    let texture = SCENE.replace(
+        "albedo = [0.8, 0.8, 0.8]",
+        "albedo_texture = \"t\"\n[textures.t]\nfile = \"t.png\"",
+    );
+    let mtl = OBJ_SCENE.replace("material = \"white\"\n", "");
+    for (scene, fifo, field) in [
+        (env.as_str(), "sky.exr", "environment.file"),
+        (texture.as_str(), "t.png", "textures.t.file"),
+        (mtl.as_str(), "m.mtl", "mesh.obj:1"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_scene(dir.path(), scene);
+        fs::write(
+            dir.path().join("mesh.obj"),
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        mkfifo(&dir.path().join(fifo));
+        let exr = dir.path().join("out.exr");
+        let o = render_scene(&path, &exr);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{fifo}: {e}");
+        assert!(
+            e.contains(fifo) && e.contains(field) && e.contains("FIFO"),
+            "{fifo}: {e}"
+        );
+        assert!(!exr.exists(), "{fifo}: output written");
+    }
+}
+
 #[test]
 fn a_directory_or_device_as_the_scene_is_refused() {
     let dir = tempfile::tempdir().unwrap();

@@ -1,13 +1,16 @@
 //! `[environment]`: a constant radiance, or a latitude-longitude HDR image
 //! with its rotation, intensity and exposure (`docs/scene-format.md`,
 //! "`[environment]`"). An image that cannot be used is refused with the
-//! file and, for a bad texel, its column and row.
+//! file and, for a bad texel, its column and row; a file that is not a
+//! regular file (a FIFO would block the loader) before it is opened for
+//! decoding, as textures are.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use super::checked::{Cx, Res};
 use super::format::{EnvironmentDef, Spanned};
+use super::regular_file::open_regular;
 use crate::environment::{image, EnvMap, Environment};
 use crate::geometry::Vec3;
 
@@ -53,13 +56,15 @@ pub(crate) fn environment(
         None => 0.0,
     };
     let path = scene_dir.join(file.get_ref());
-    let texels = image::read(&path).map_err(|e| {
+    let refuse = |e: &dyn std::fmt::Display| {
         cx.err(
             file.span(),
             "environment.file",
             format!("environment image {}: {e}", path.display()),
         )
-    })?;
+    };
+    open_regular(&path).map_err(|e| refuse(&image::ImageError::Unreadable(e.to_string())))?;
+    let texels = image::read(&path).map_err(|e| refuse(&e))?;
     if scale == 0.0 {
         return Ok(None);
     }

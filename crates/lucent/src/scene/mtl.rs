@@ -148,7 +148,8 @@ fn colour(words: &[&str]) -> Result<Vec3, String> {
         [r, g, b] => Vec3::new(*r, *g, *b),
         _ => return Err(format!("expected r g b, found {} numbers", v.len())),
     };
-    if !(0.0..=1.0).contains(&c.min_element()) || !(0.0..=1.0).contains(&c.max_element()) {
+    // per component: min/max_element would pass over a NaN
+    if !c.to_array().iter().all(|x| (0.0..=1.0).contains(x)) {
         return Err(format!(
             "each component must be in [0, 1], found {} {} {}",
             c.x, c.y, c.z
@@ -230,8 +231,15 @@ mod tests {
             s.contains("a.mtl") && s.contains(":3") && s.contains("`map_Xyz`"),
             "{s}"
         );
-        let e = parse("newmtl a\nKd 2 1 1\n", Path::new("a.mtl")).unwrap_err();
-        assert!(e.to_string().contains("in [0, 1]"), "{e}");
+        for kd in ["2 1 1", "nan 0 0", "0 NaN 0", "0.5"] {
+            let r = parse(&format!("newmtl a\nKd {kd}\n"), Path::new("a.mtl"));
+            if kd == "0.5" {
+                assert_eq!(r.unwrap().materials[0].kd, Some(Vec3::splat(0.5)));
+                continue;
+            }
+            let e = r.unwrap_err();
+            assert!(e.to_string().contains("in [0, 1]"), "{kd}: {e}");
+        }
     }
 
     /// `map_Bump` and `bump` are height maps with their `-bm` multiplier,
