@@ -1,8 +1,10 @@
 //! The path integrator's estimator of subsurface hits: the diffusion
 //! BSSRDF's probes ([`super::subsurface`]), or the random walk
 //! ([`super::randomwalk`]) at an object the accuracy budget gave it
-//! (`crate::integrator::plan::budget`, `docs/bssrdf.md` §14). Without a
-//! budget no object walks, and every hit is diffusion's.
+//! (`crate::integrator::plan::budget`, `docs/bssrdf.md` §14). A render in
+//! which no object walks (`Plan::walks`) does not come here: it runs
+//! [`super::path::radiance`], diffusion at every hit, chosen once per
+//! render by [`super::IntegratorKind::radiance`].
 
 use super::aov::Recorder;
 use super::path::sample;

@@ -49,12 +49,12 @@ impl IntegratorKind {
         rec: &mut R,
     ) -> crate::geometry::Vec3 {
         match self {
-            // diffusion, or the walk where an accuracy budget chose it
+            // diffusion, or the walk where an accuracy budget chose it;
+            // a render where none did never asks a hit's material
             #[cfg(feature = "subsurface")]
-            IntegratorKind::Path => {
+            IntegratorKind::Path if ctx.plan.walks => {
                 super::budgeted::radiance::<R, T>(ctx, ray, rng, scratch, counters, rec)
             }
-            #[cfg(not(feature = "subsurface"))]
             IntegratorKind::Path => path::radiance::<R, T>(ctx, ray, rng, scratch, counters, rec),
             #[cfg(feature = "subsurface")]
             IntegratorKind::RandomWalk => {

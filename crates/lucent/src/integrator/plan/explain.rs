@@ -336,7 +336,7 @@ fn traversal(scene: &Scene, opts: &PlanOptions) -> Choice {
 /// Whether an accuracy budget gave some object the random walk (which
 /// then made the traversal watertight, [`super::budget::resolve`]).
 fn budget_walks(scene: &Scene) -> bool {
-    scene.objects.iter().any(|o| o.walk)
+    Plan::new(scene).walks
 }
 
 /// The passes recorded besides the beauty.

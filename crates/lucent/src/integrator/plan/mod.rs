@@ -38,6 +38,12 @@ pub struct Plan {
     pub environment_map: bool,
     /// Some object has a subsurface material: probe rays will be cast.
     pub subsurface: bool,
+    /// Some object's subsurface hits are estimated by the random walk (an
+    /// accuracy budget chose it, [`budget`]): the path integrator then asks
+    /// at each subsurface hit which estimator its object takes;
+    /// without one every hit is diffusion's, chosen once per render
+    /// ([`super::IntegratorKind::radiance`]).
+    pub walks: bool,
     /// The scene has `[[lights]]`: light-sample them where lights are
     /// sampled, and weigh what rays find of them by MIS.
     pub analytic_lights: bool,
@@ -58,6 +64,7 @@ impl Plan {
                 .objects
                 .iter()
                 .any(|o| scene.materials[o.material].is_subsurface()),
+            walks: scene.objects.iter().any(|o| o.walk),
             analytic_lights: !scene.lights.is_empty(),
             transparent: scene.output.file.transparent == Some(true),
         }
