@@ -61,8 +61,8 @@
 //! nearest surface needs no ray query (`docs/bssrdf.md` §7, "The walk's
 //! cost"): the samples are the same, with far fewer queries deep inside.
 //! Per event, the channel MIS weights cancel the hero's transmittance
-//! ([`ChannelMis`]: two `exp`, one division), one uniform picks the hero
-//! and its distance ([`pick_channel`]), and the phase function is
+//! (`ChannelMis`: two `exp`, one division), one uniform picks the hero
+//! and its distance (`pick_channel`), and the phase function is
 //! sampled in f32 ([`super::phase`]).
 
 use super::aov::{Event, Recorder};
