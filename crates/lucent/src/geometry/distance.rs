@@ -35,6 +35,8 @@ pub struct DistanceGrid {
     lo: Vec3,
     inv_h: f32,
     dims: [usize; 3],
+    /// `dims` as floats, for the lookup's range check.
+    cells: Vec3,
     /// Per cell (x fastest), the bound in scene units.
     bound: Vec<f32>,
 }
@@ -59,6 +61,7 @@ impl DistanceGrid {
             lo,
             inv_h: 1.0 / h,
             dims,
+            cells: Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32),
             bound: vec![f32::INFINITY; dims[0] * dims[1] * dims[2]],
         };
         grid.mark(meshes);
@@ -72,13 +75,17 @@ impl DistanceGrid {
     #[inline]
     pub fn bound(&self, p: Vec3) -> f32 {
         let c = (p - self.lo) * self.inv_h;
-        if c.is_nan() || c.min_element() < 0.0 {
+        let n = self.cells;
+        // NaN fails every comparison.
+        let inside = c.x >= 0.0 && c.y >= 0.0 && c.z >= 0.0 && c.x < n.x && c.y < n.y && c.z < n.z;
+        if !inside {
             return 0.0;
         }
-        let [x, y, z] = c.to_array().map(|v| v as usize);
-        if x >= self.dims[0] || y >= self.dims[1] || z >= self.dims[2] {
-            return 0.0;
-        }
+        // SAFETY: every coordinate is finite and in [0, dims), dims a few
+        // hundred at most, so it truncates to an index u32 represents.
+        let [x, y, z] = c
+            .to_array()
+            .map(|v| unsafe { v.to_int_unchecked::<u32>() } as usize);
         self.bound[(z * self.dims[1] + y) * self.dims[0] + x]
     }
 

@@ -39,6 +39,8 @@ pub mod kind;
 mod lobe;
 mod nee;
 pub mod path;
+#[cfg(feature = "subsurface")]
+pub mod phase;
 pub mod plan;
 #[cfg(feature = "subsurface")]
 pub mod probe;

@@ -60,18 +60,24 @@
 //! **Cost.** A flight shorter than the distance from its origin to the
 //! nearest surface needs no ray query (`docs/bssrdf.md` §7, "The walk's
 //! cost"): the samples are the same, with far fewer queries deep inside.
+//! Per event, the channel MIS weights cancel the hero's transmittance
+//! (`ChannelMis`: two `exp`, one division), one uniform picks the hero
+//! and its distance (`pick_channel`), and the phase function is
+//! sampled in f32 ([`super::phase`]).
 
 use super::aov::{Event, Recorder};
 use super::diffuse_boundary::DiffuseBoundary;
 use super::interaction::offset_along;
 use super::lobe::{Lobe, SubsurfaceLobe, Vertex};
 use super::path::sample;
+pub use super::phase::sample_hg;
 use super::scatter::{Scatter, SubsurfaceHit, SubsurfaceScatter};
 use super::state::{PathState, Scratch};
 use super::walk_nee::WalkLight;
 use super::{Clock, Context, Counters, Effect, Interaction};
 use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
+use crate::geometry::distance::DistanceGrid;
 use crate::geometry::{Frame, Ray, Vec3};
 use crate::materials::microfacet::reflect;
 use crate::materials::{dielectric, WalkBoundary};
@@ -343,6 +349,7 @@ fn walk_lit(
     mut nee: Option<&mut WalkLight>,
 ) -> Option<(WalkEnd, Vec3)> {
     let sigma_t = m.sigma_t();
+    let grid = ctx.distance_grid();
     let mut beta = [1.0f64; 3];
     for event in 0..MAX_WALK_EVENTS {
         // A walk with nothing left to carry (a black medium's first
@@ -351,12 +358,18 @@ fn walk_lit(
         if !(total > 0.0 && total.is_finite()) {
             return None;
         }
-        // Hero channel by throughput; q sums to 1 over live channels.
-        let q = beta.map(|b| b / total);
-        let c = pick_channel(&q, rng.uniform_f64());
-        let t = free_flight(sigma_t[c], rng.uniform_f64());
+        // Hero channel by throughput: channel k with probability
+        // q_k = β_k / total; the same uniform, rescaled, for the distance.
+        let (c, u) = pick_channel(&beta, total, rng.uniform_f64());
+        let t = free_flight(sigma_t[c], u);
+        let mis = ChannelMis {
+            beta: &mut beta,
+            sigma_t: &sigma_t,
+            hero: c,
+            total,
+        };
 
-        let p = if t < clear_flight(ctx, ray.o) {
+        let p = if t < clear_flight(ctx, grid, ray.o) {
             ray.at(t as f32)
         } else {
             counters.ray(Effect::Walk);
@@ -371,7 +384,7 @@ fn walk_lit(
             };
             let t_max = hit.t as f64;
             if t >= t_max {
-                transmit(&mut beta, &sigma_t, &q, t_max)?;
+                mis.transmit(t_max)?;
                 match at_boundary(ctx, boundary, &ray, &hit, rng) {
                     Ok((end, weight)) => {
                         if let Some(nl) = nee.as_deref_mut() {
@@ -392,18 +405,26 @@ fn walk_lit(
         };
 
         // A real scattering event at distance t.
-        scatter(&mut beta, m, &sigma_t, &q, t)?;
+        mis.scatter(&m.sigma_s, t)?;
         if let Some(nl) = nee.as_deref_mut() {
             nl.at_scatter(ctx, m, p, ray.d, &beta, rng, counters);
         }
         // The phase function is sampled exactly: its weight is 1.
-        ray = Ray::new(p, sample_hg(ray.d, m.g, rng.uniform2()));
+        ray = Ray::new(p, sample_hg(ray.d, m.g, rng.uniform2_packed()));
         if event >= WALK_RR_START {
-            let survive = beta.iter().copied().fold(0.0, f64::max).min(1.0);
-            if survive.is_nan() || survive <= 0.0 || rng.uniform_f64() >= survive {
+            // Roulette with the largest channel's throughput: a walk that
+            // survives carries 1 there again.
+            let survive = beta.iter().copied().fold(0.0, f64::max);
+            if survive.is_nan() || survive <= 0.0 {
                 return None;
             }
-            beta = beta.map(|b| b / survive);
+            if survive < 1.0 {
+                if rng.uniform_f64() >= survive {
+                    return None;
+                }
+                let inv = 1.0 / survive;
+                beta = beta.map(|b| b * inv);
+            }
         }
     }
     counters.walks_capped += 1;
@@ -415,8 +436,8 @@ fn walk_lit(
 /// the spawn margin of [`inside_point`] (once for the flight's own
 /// rounding, once for the accelerator's), or 0.
 #[inline]
-fn clear_flight(ctx: &Context, o: Vec3) -> f64 {
-    let Some(grid) = ctx.distance_grid() else {
+fn clear_flight(ctx: &Context, grid: Option<&DistanceGrid>, o: Vec3) -> f64 {
+    let Some(grid) = grid else {
         return 0.0;
     };
     let d = grid.bound(o);
@@ -427,41 +448,71 @@ fn clear_flight(ctx: &Context, o: Vec3) -> f64 {
     (d - 2.0 * margin) as f64
 }
 
-/// Weighs a flight that scattered at distance `t`: σs e^{−σt t} over the
-/// one-sample balance-heuristic pdf Σ_k q_k σt_k e^{−σt_k t}. None when
-/// that pdf is not positive (the walk ends).
-#[inline]
-fn scatter(
-    beta: &mut [f64; 3],
-    m: &Medium,
-    sigma_t: &[f64; 3],
-    q: &[f64; 3],
-    t: f64,
-) -> Option<()> {
-    let tr: [f64; 3] = std::array::from_fn(|k| (-sigma_t[k] * t).exp());
-    let pdf: f64 = (0..3).map(|k| q[k] * sigma_t[k] * tr[k]).sum();
-    if pdf.is_nan() || pdf <= 0.0 {
-        return None;
-    }
-    for k in 0..3 {
-        beta[k] *= m.sigma_s[k] * tr[k] / pdf;
-    }
-    Some(())
+/// The one-sample balance heuristic over the channels for one flight
+/// sampled from the hero channel's exponential (`docs/bssrdf.md` §7,
+/// "The walk's cost"): the pdf Σ_k q_k p_k(t) with q_k = β_k / total. Every
+/// channel's density carries the factor e^{−σt_c t} of the hero's, which
+/// cancels in the weights, so only the other channels' ratios
+/// e^{−(σt_k − σt_c) t} are computed: two `exp`, none for a channel of the
+/// hero's σt. The ratios stay below e^{σt_c t} ≤ 2^53 for any t the
+/// flight's 53-bit uniform gives (a transmitted flight stops sooner).
+struct ChannelMis<'a> {
+    beta: &'a mut [f64; 3],
+    sigma_t: &'a [f64; 3],
+    hero: usize,
+    total: f64,
 }
 
-/// Weighs a flight that reached the boundary at `t_max`: probability
-/// e^{−σt t_max} per channel, over Σ_k q_k e^{−σt_k t_max}.
-#[inline]
-fn transmit(beta: &mut [f64; 3], sigma_t: &[f64; 3], q: &[f64; 3], t_max: f64) -> Option<()> {
-    let tr: [f64; 3] = std::array::from_fn(|k| (-sigma_t[k] * t_max).exp());
-    let pdf: f64 = (0..3).map(|k| q[k] * tr[k]).sum();
-    if pdf.is_nan() || pdf <= 0.0 {
-        return None;
+impl ChannelMis<'_> {
+    /// e^{−σt_k t} / e^{−σt_c t} per channel k, c the hero.
+    #[inline]
+    fn ratios(&self, t: f64) -> [f64; 3] {
+        let st_c = self.sigma_t[self.hero];
+        std::array::from_fn(|k| {
+            if self.sigma_t[k] == st_c {
+                1.0
+            } else {
+                (-(self.sigma_t[k] - st_c) * t).exp()
+            }
+        })
     }
-    for k in 0..3 {
-        beta[k] *= tr[k] / pdf;
+
+    /// Weighs a flight that scattered at distance `t`: σs e^{−σt t} over the
+    /// pdf Σ_k q_k σt_k e^{−σt_k t}. None when that pdf is not positive
+    /// (the walk ends).
+    #[inline]
+    fn scatter(self, sigma_s: &[f64; 3], t: f64) -> Option<()> {
+        let r = self.ratios(t);
+        let b = &mut *self.beta;
+        let pdf = b[0] * self.sigma_t[0] * r[0]
+            + b[1] * self.sigma_t[1] * r[1]
+            + b[2] * self.sigma_t[2] * r[2];
+        let scale = self.total / pdf;
+        if !(scale.is_finite() && pdf > 0.0) {
+            return None;
+        }
+        for k in 0..3 {
+            b[k] *= sigma_s[k] * r[k] * scale;
+        }
+        Some(())
     }
-    Some(())
+
+    /// Weighs a flight that reached the boundary at `t_max`: probability
+    /// e^{−σt t_max} per channel, over Σ_k q_k e^{−σt_k t_max}.
+    #[inline]
+    fn transmit(self, t_max: f64) -> Option<()> {
+        let r = self.ratios(t_max);
+        let b = &mut *self.beta;
+        let pdf = b[0] * r[0] + b[1] * r[1] + b[2] * r[2];
+        let scale = self.total / pdf;
+        if !(scale.is_finite() && pdf > 0.0) {
+            return None;
+        }
+        for k in 0..3 {
+            b[k] *= r[k] * scale;
+        }
+        Some(())
+    }
 }
 
 fn throughput(beta: &[f64; 3]) -> Vec3 {
@@ -556,83 +607,31 @@ pub fn free_flight(sigma_t: f64, u: f64) -> f64 {
     }
 }
 
-/// The channel whose cumulative probability interval holds `u`.
-fn pick_channel(q: &[f64; 3], u: f64) -> usize {
-    let (mut acc, mut last) = (0.0, 0);
-    for (k, &qk) in q.iter().enumerate() {
-        if qk > 0.0 {
+/// The channel whose interval of the cumulative throughputs holds
+/// `u`·`total` (channel k with probability β_k / total), and where in
+/// that interval: a uniform in [0, 1) independent of the choice, with the
+/// bits of `u` the choice did not use (53 less log2(1/q_k), so 30 or more
+/// for any channel the walk picks more often than once in 10⁷).
+#[inline]
+fn pick_channel(beta: &[f64; 3], total: f64, u: f64) -> (usize, f64) {
+    let x = u * total;
+    let (mut lo, mut last) = (0.0, 0);
+    for (k, &bk) in beta.iter().enumerate() {
+        if bk > 0.0 {
+            if x < lo + bk {
+                return (k, within(x, lo, bk));
+            }
             last = k;
-            acc += qk;
-            if u < acc {
-                return k;
-            }
+            lo += bk;
         }
     }
-    // Rounding left u past the sum: the last live channel.
-    last
+    // Rounding left x past the sum: the last live channel.
+    (last, within(x, lo - beta[last], beta[last]))
 }
 
-/// Samples the Henyey–Greenstein phase function about the propagation
-/// direction `d`: p(θ) = (1 − g²) / (4π (1 + g² − 2g cos θ)^{3/2}), g > 0
-/// forward (pbrt-v4 §11.3.1, inverted CDF).
-pub fn sample_hg(d: Vec3, g: f64, u: [f32; 2]) -> Vec3 {
-    let u0 = u[0] as f64;
-    let cos = if g.abs() < 1e-3 {
-        1.0 - 2.0 * u0
-    } else {
-        let s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u0);
-        (1.0 + g * g - s * s) / (2.0 * g)
-    }
-    .clamp(-1.0, 1.0);
-    let sin = (1.0 - cos * cos).max(0.0).sqrt();
-    let phi = std::f64::consts::TAU * u[1] as f64;
-    let local = Vec3::new(
-        (sin * phi.cos()) as f32,
-        (sin * phi.sin()) as f32,
-        cos as f32,
-    );
-    Frame::from_normal(d).to_world(local).normalize()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sampling::Rng;
-
-    #[test]
-    fn henyey_greenstein_directions_have_its_legendre_moments() {
-        // The Henyey–Greenstein phase function's Legendre moments are g^l:
-        // E[cos θ] = g and E[P2(cos θ)] = g², θ the angle to the incoming
-        // direction. A wrong inverted CDF (e.g. the s term's division made
-        // a product) moves both far beyond 5 standard errors.
-        let d = Vec3::new(0.3, -0.5, 0.8).normalize();
-        let mut rng = Rng::from_key(17);
-        for g in [-0.7, 0.0005, 0.3, 0.9] {
-            let n = 200_000;
-            let (mut s1, mut s2, mut q1, mut q2) = (0.0, 0.0, 0.0, 0.0);
-            for _ in 0..n {
-                let u = [rng.uniform_f64() as f32, rng.uniform_f64() as f32];
-                let w = sample_hg(d, g, u);
-                assert!((w.length() - 1.0).abs() < 1e-5);
-                let c = w.dot(d) as f64;
-                let p2 = 1.5 * c * c - 0.5;
-                s1 += c;
-                q1 += c * c;
-                s2 += p2;
-                q2 += p2 * p2;
-            }
-            let nf = n as f64;
-            let (m1, m2) = (s1 / nf, s2 / nf);
-            let se1 = ((q1 / nf - m1 * m1) / nf).sqrt();
-            let se2 = ((q2 / nf - m2 * m2) / nf).sqrt();
-            assert!(
-                (m1 - g).abs() < 5.0 * se1 + 1e-4,
-                "g = {g}: E[cos] = {m1} ± {se1}"
-            );
-            assert!(
-                (m2 - g * g).abs() < 5.0 * se2 + 1e-4,
-                "g = {g}: E[P2] = {m2} ± {se2}"
-            );
-        }
-    }
+/// Where `x` lies in [lo, lo + width), as a uniform below 1.
+#[inline]
+fn within(x: f64, lo: f64, width: f64) -> f64 {
+    const BELOW_ONE: f64 = 1.0 - f64::EPSILON / 2.0;
+    ((x - lo) / width).clamp(0.0, BELOW_ONE)
 }
