@@ -78,7 +78,7 @@ mod tests {
         let mesh = Mesh::new(p.to_vec(), vec![[0, 1, 2], [3, 4, 5]], None);
         let n = EdgeNeighbours::new(&mesh);
         assert_eq!(n.of(0), [NONE, NONE, 1]);
-        assert_eq!(n.of(1), [NONE, NONE, 0]);
+        assert_eq!(n.of(1), [0, NONE, NONE]);
     }
 
     /// On a closed sphere every triangle has three distinct neighbours and
