@@ -258,7 +258,7 @@ pub(crate) fn covers(ctx: &Context, t: &Through, l: Vec3, counters: &mut Counter
 }
 
 /// The refracted paths from `x` to the light point `l` that a connection
-/// through a boundary of index `eta` counts ([`refractions`]), as (mesh,
+/// through a boundary of index `eta` counts (`refractions`), as (mesh,
 /// triangle, refraction point): to check them from outside.
 pub fn counted_paths(ctx: &Context, x: Vec3, l: Vec3, eta: f32) -> Vec<(u32, u32, Vec3)> {
     let mut counters = Counters::default();
@@ -268,7 +268,7 @@ pub fn counted_paths(ctx: &Context, x: Vec3, l: Vec3, eta: f32) -> Vec<(u32, u32
 
 /// Whether the walk leaves the emission its exit from `x` through
 /// triangle `prim` of mesh `geom` finds at `l` to the connection
-/// ([`covers`]).
+/// (`covers`).
 pub fn left_to_connection(ctx: &Context, x: Vec3, geom: u32, prim: u32, l: Vec3, eta: f32) -> bool {
     let t = Through { x, geom, prim, eta };
     covers(ctx, &t, l, &mut Counters::default())
