@@ -875,6 +875,81 @@ fn light_through_the_smooth_boundary_is_deterministic_across_thread_counts() {
     assert_eq!(c1, c2);
 }
 
+/// On a coarse ball (80 facets; the normal turns by ≈ 0.4 rad across each
+/// edge) a light point is often reached from a scattering point through
+/// two neighbouring facets. Every path the connection counts
+/// (`walk_nee::counted_paths`) is a refracted path: its point lies on its
+/// triangle, the segment from x meets that triangle first, and Snell's
+/// law there carries x's direction onto l. The walk leaves each of them
+/// to the connection (`walk_nee::covers`), so none counts twice; and
+/// paths through a neighbour are found (the facet's alone would leave
+/// them to the walk's heavy tail). A walk leaving only the first facet's
+/// exits to the connection, a neighbour solved on the wrong plane or not
+/// checked to hold its point, or no neighbours at all, fail here.
+#[test]
+fn connection_paths_are_refracted_paths_the_walk_leaves_to_it() {
+    use lucent::integrator::walk_nee::{counted_paths, left_to_connection};
+    use lucent::integrator::Context;
+    use lucent::sampling::Rng;
+    let eta = 1.4f32;
+    let params =
+        SubsurfaceParams::from_artist([0.8, 0.5, 0.3], [0.5, 0.3, 0.1], eta, Fit::Searchlight)
+            .unwrap();
+    let ball = scene(
+        vec![Part {
+            mesh: shapes::sphere(1),
+            material: with_boundary(params, WalkBoundary::Dielectric { connect: true }),
+            emission: None,
+        }],
+        None,
+        Camera::new(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 40.0, 8, 8),
+        1,
+        8,
+    );
+    let accel = accel::build(&ball.meshes, Backend::Bvh).unwrap();
+    let ctx = Context::new(&ball, accel.as_ref());
+    let mesh = &ball.meshes[0];
+    let mut rng = Rng::from_key(39);
+    let mut u = || rng.uniform_f64() as f32;
+    let (mut pairs, mut found, mut second) = (0, 0, 0);
+    while pairs < 4000 {
+        // x inside, towards the light; l on a square at z = 3
+        let x = Vec3::new(2.0 * u() - 1.0, 2.0 * u() - 1.0, u()) * 0.9;
+        if x.length() > 0.85 || x.length() < 0.3 {
+            continue;
+        }
+        let l = Vec3::new(0.6 * u() - 0.3, 0.6 * u() - 0.3, 3.0);
+        pairs += 1;
+        let paths = counted_paths(&ctx, x, l, eta);
+        found += paths.len().min(1);
+        second += paths.len().saturating_sub(1);
+        for (i, &(geom, prim, y)) in paths.iter().enumerate() {
+            assert!(
+                paths[..i].iter().all(|p| p.1 != prim),
+                "{x} {l}: twice {prim}"
+            );
+            let ng = mesh.face_normal(prim);
+            let n = if ng.dot(l - x) > 0.0 { ng } else { -ng };
+            let w1 = (y - x).normalize();
+            let hit = accel
+                .intersect(&lucent::geometry::Ray::new(x, w1), 0.0, f32::INFINITY)
+                .unwrap();
+            assert_eq!((hit.geom, hit.prim), (geom, prim), "{x} {l}: not first");
+            let tangent = w1 - n * w1.dot(n);
+            let out = tangent * eta + n * (1.0 - eta * eta * tangent.length_squared()).sqrt();
+            let to_l = (l - y).normalize();
+            assert!(out.dot(to_l) > 1.0 - 1e-6, "{x} {l}: {out} vs {to_l}");
+            assert!(
+                left_to_connection(&ctx, x, geom, prim, l, eta),
+                "{x} {l}: the walk counts {prim} too"
+            );
+        }
+    }
+    println!("{pairs} pairs: {found} with a path, {second} with a second");
+    assert!(found > pairs / 2, "{found} of {pairs}");
+    assert!(second * 50 > found, "{second} of {found}");
+}
+
 /// The dielectric boundary stays the default; the diffuse one is as
 /// deterministic across thread counts (its rejection sampling draws from
 /// the sample's own stream).

@@ -43,6 +43,22 @@ fn key(p: Vec3) -> [u32; 3] {
     ]
 }
 
+/// Vertices welded by position: per vertex, the rank of its position's
+/// key among the distinct keys (equal positions, equal ids).
+pub(crate) fn weld(pos: &[Vec3]) -> Vec<u32> {
+    let mut by_key: Vec<u32> = (0..pos.len() as u32).collect();
+    by_key.sort_unstable_by_key(|&v| key(pos[v as usize]));
+    let mut id = vec![0u32; pos.len()];
+    let mut next = 0u32;
+    for (r, &v) in by_key.iter().enumerate() {
+        if r > 0 && key(pos[v as usize]) != key(pos[by_key[r - 1] as usize]) {
+            next += 1;
+        }
+        id[v as usize] = next;
+    }
+    id
+}
+
 /// The sharp edges of `mesh` (module docs): each once, as its two end
 /// points, lower position key first, in the order of their keys.
 ///
@@ -54,17 +70,7 @@ fn key(p: Vec3) -> [u32; 3] {
 pub fn sharp_edges(mesh: &Mesh) -> Vec<[Vec3; 2]> {
     let cos_sharp = SHARP_ANGLE_DEG.to_radians().cos();
     let pos = mesh.positions();
-    // weld: id[v] = rank of v's position key among the distinct keys
-    let mut by_key: Vec<u32> = (0..pos.len() as u32).collect();
-    by_key.sort_unstable_by_key(|&v| key(pos[v as usize]));
-    let mut id = vec![0u32; pos.len()];
-    let mut next = 0u32;
-    for (r, &v) in by_key.iter().enumerate() {
-        if r > 0 && key(pos[v as usize]) != key(pos[by_key[r - 1] as usize]) {
-            next += 1;
-        }
-        id[v as usize] = next;
-    }
+    let id = weld(pos);
     /// One triangle's side: the edge (lower id, higher id) and the
     /// triangle's corners at those two ends.
     #[derive(Clone, Copy)]

@@ -2,7 +2,8 @@
 //! render: the scene, its accelerator, lights and plan, the per-mesh
 //! shading records, ray culling, the camera's footprint spread, per
 //! subsurface mesh its curvatures and curvature-correction factors, and
-//! (built when a random walk first needs it) the scene's distance bounds.
+//! (built when a random walk first needs them) the scene's distance bounds
+//! and the subsurface meshes' edge neighbours.
 
 #[cfg(feature = "subsurface")]
 use super::control_variate;
@@ -11,6 +12,8 @@ use super::footprint::CameraSpread;
 use super::interaction::{self, Interaction};
 use super::plan::Plan;
 use crate::accel::Accel;
+#[cfg(feature = "subsurface")]
+use crate::geometry::adjacency::EdgeNeighbours;
 #[cfg(feature = "subsurface")]
 use crate::geometry::curvature::{MeshCurvature, TriangleCurvature};
 #[cfg(feature = "subsurface")]
@@ -64,6 +67,11 @@ pub struct Context<'a> {
     /// first walk: a render without one never pays for it.
     #[cfg(feature = "subsurface")]
     distance: std::sync::OnceLock<Option<DistanceGrid>>,
+    /// Per mesh with a subsurface material, which of its triangles share
+    /// an edge ([`EdgeNeighbours`]), built at the first connection through
+    /// a walk's boundary (`super::walk_nee`).
+    #[cfg(feature = "subsurface")]
+    neighbours: std::sync::OnceLock<Vec<Option<EdgeNeighbours>>>,
 }
 
 impl<'a> Context<'a> {
@@ -105,6 +113,8 @@ impl<'a> Context<'a> {
             curvature,
             #[cfg(feature = "subsurface")]
             distance: std::sync::OnceLock::new(),
+            #[cfg(feature = "subsurface")]
+            neighbours: std::sync::OnceLock::new(),
         }
     }
 
@@ -114,6 +124,25 @@ impl<'a> Context<'a> {
     #[cfg(feature = "subsurface")]
     pub fn without_distance_bounds(&mut self) {
         self.distance = std::sync::OnceLock::from(None);
+    }
+
+    /// The edge neighbours of the triangles of mesh `geom`, when it has a
+    /// subsurface material; all such meshes' are built on first use.
+    #[cfg(feature = "subsurface")]
+    pub(crate) fn edge_neighbours(&self, geom: u32) -> Option<&EdgeNeighbours> {
+        self.neighbours
+            .get_or_init(|| {
+                let meshes = &self.scene.meshes;
+                (0..meshes.len())
+                    .map(|i| {
+                        self.curvature[i]
+                            .as_ref()
+                            .map(|_| EdgeNeighbours::new(&meshes[i]))
+                    })
+                    .collect()
+            })
+            .get(geom as usize)?
+            .as_ref()
     }
 
     /// The grid of lower bounds on the distance to the scene's triangles

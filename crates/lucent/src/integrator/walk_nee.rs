@@ -8,7 +8,10 @@
 //! variable in the plane of incidence ([`refraction_point`]); the solve
 //! starts on the triangle the straight line x → l meets first and moves
 //! to the triangle the segment x → y meets until the point lies on the
-//! triangle it was solved on (`facet`). Its
+//! triangle it was solved on (`facet`). A mesh's normal jumps at its
+//! edges, so a light point may also be reached through a neighbour of
+//! that facet; the neighbours across its three edges are tried too
+//! (`refractions`), and each path found counts. Each path's
 //! contribution is the phase function at x, the medium's transmittance
 //! over |x − y|, Fresnel transmittance times η² (radiance entering the
 //! denser medium), the light's emission and the generalized geometry term
@@ -16,12 +19,12 @@
 //!
 //! **Exact split.** The walk's own exits count emission found directly
 //! after a refraction that follows a scattering point x, except when the
-//! exit triangle is the facet the connection finds for x and l
-//! (`covers`): those paths
-//! are the connection's, every other path (through another triangle,
-//! after internal reflections, from the entry point without scattering)
-//! stays the walk's. Each path is counted by one estimator, so the sum is
-//! unbiased with no solution missed and no multiple-solution bias.
+//! exit triangle is one of those the connection finds paths through for
+//! x and l (`covers`): those paths are the connection's; every other path
+//! (through a triangle it does not find, after internal reflections, from
+//! the entry point without scattering) stays the walk's. Each path is
+//! counted by one estimator, so the sum is unbiased with no solution
+//! missed and no multiple-solution bias.
 
 use super::aov;
 use super::interaction::offset_along;
@@ -31,7 +34,9 @@ use super::{Context, Counters, Effect};
 use crate::accel::Hit;
 use crate::bssrdf::params::Medium;
 use crate::fresnel;
+use crate::geometry::adjacency;
 use crate::geometry::{Ray, Vec3};
+use crate::lights::LightSample;
 use crate::sampling::{Draw, SampleRng};
 
 /// Newton steps (bracketed) of the refraction point's solve: it converges
@@ -127,20 +132,63 @@ fn connect_probability(ctx: &Context, m: &Medium, x: Vec3) -> f64 {
     (-sigma * d).exp()
 }
 
+/// A refracted path from a scattering point to a light point: through
+/// triangle `prim` of mesh `geom` at `y`, whose unit normal `n` points to
+/// the light's side.
+#[derive(Clone, Copy, Debug)]
+struct Refraction {
+    geom: u32,
+    prim: u32,
+    y: Vec3,
+    n: Vec3,
+}
+
+/// The refracted paths a connection from `x` to `l` counts (see
+/// [`refractions`]): the facet's, then at most one per edge neighbour.
+struct Refractions {
+    found: [Option<Refraction>; 4],
+}
+
+impl Refractions {
+    fn iter(&self) -> impl Iterator<Item = &Refraction> {
+        self.found.iter().flatten()
+    }
+
+    /// Whether one of them passes through triangle `prim` of mesh `geom`.
+    fn through(&self, geom: u32, prim: u32) -> bool {
+        self.iter().any(|r| (r.geom, r.prim) == (geom, prim))
+    }
+}
+
+/// The refracted paths from `x` to the light point `l` the connection
+/// counts: the one on the facet [`facet`] finds, and where the facet's
+/// edge neighbours hold a second refraction point of their own
+/// ([`on_triangle`]), those too. A mesh's normal jumps at an edge, so the
+/// refracted directions of two neighbours overlap there and one light
+/// point can be reached through both. The same x and l give the same
+/// paths, which is what [`covers`] relies on.
+fn refractions(ctx: &Context, x: Vec3, l: Vec3, eta: f32, counters: &mut Counters) -> Refractions {
+    let mut found = [None; 4];
+    let Some(f) = facet(ctx, x, l, eta, counters) else {
+        return Refractions { found };
+    };
+    found[0] = Some(f);
+    if let Some(adj) = ctx.edge_neighbours(f.geom) {
+        for (slot, q) in found[1..].iter_mut().zip(adj.of(f.prim)) {
+            if q != adjacency::NONE {
+                *slot = on_triangle(ctx, x, l, eta, f.geom, q, counters);
+            }
+        }
+    }
+    Refractions { found }
+}
+
 /// The facet of a connection from `x` to the light point `l` and the
 /// refraction point on it: starting from the triangle the segment x → l
 /// meets first, the refraction point is solved on the current triangle's
 /// plane; when the segment from x to that point meets another triangle
-/// first, the solve moves to that one, at most [`FACET_STEPS`] times. The
-/// same steps for the same x and l give the same facet, which is what
-/// [`covers`] relies on. Returns the triangle, y and its outward normal.
-fn facet(
-    ctx: &Context,
-    x: Vec3,
-    l: Vec3,
-    eta: f32,
-    counters: &mut Counters,
-) -> Option<(Hit, Vec3, Vec3)> {
+/// first, the solve moves to that one, at most [`FACET_STEPS`] times.
+fn facet(ctx: &Context, x: Vec3, l: Vec3, eta: f32, counters: &mut Counters) -> Option<Refraction> {
     let to_l = l - x;
     let dist = to_l.length();
     if dist.is_nan() || dist <= 0.0 {
@@ -158,25 +206,77 @@ fn facet(
         counters.ray(Effect::Walk);
         let seen = ctx.accel.intersect(&Ray::new(x, w1), 0.0, f32::INFINITY)?;
         if (seen.geom, seen.prim) == (tri.geom, tri.prim) {
-            return Some((tri, y, n));
+            let (geom, prim) = (tri.geom, tri.prim);
+            return Some(Refraction { geom, prim, y, n });
         }
         (tri, p0) = (seen, x + w1 * seen.t);
     }
     None
 }
 
+/// The refracted path from `x` to `l` through triangle `prim` of mesh
+/// `geom`, when the refraction point on its plane lies on it and the
+/// segment from `x` meets it first (one ray query, asked only for a point
+/// on the triangle).
+fn on_triangle(
+    ctx: &Context,
+    x: Vec3,
+    l: Vec3,
+    eta: f32,
+    geom: u32,
+    prim: u32,
+    counters: &mut Counters,
+) -> Option<Refraction> {
+    let mesh = &ctx.scene.meshes[geom as usize];
+    let ng = mesh.face_normals()[prim as usize];
+    let n = if ng.dot(l - x) > 0.0 { ng } else { -ng };
+    let corners = mesh.triangle(prim);
+    let y = refraction_point(x, l, corners[0], n, eta)?;
+    if !within(y, corners, ng) {
+        return None;
+    }
+    counters.ray(Effect::Walk);
+    let seen = ctx
+        .accel
+        .intersect(&Ray::new(x, (y - x).normalize()), 0.0, f32::INFINITY)?;
+    ((seen.geom, seen.prim) == (geom, prim)).then_some(Refraction { geom, prim, y, n })
+}
+
+/// Whether `y`, on the plane of the triangle `[a, b, c]` with normal `ng`,
+/// lies inside it: on the same side of its three edges (either winding).
+fn within(y: Vec3, [a, b, c]: [Vec3; 3], ng: Vec3) -> bool {
+    let s = [(a, b), (b, c), (c, a)].map(|(p, q)| (q - p).cross(y - p).dot(ng));
+    s.iter().all(|&v| v >= 0.0) || s.iter().all(|&v| v <= 0.0)
+}
+
 /// Whether the walk's exit `t`, whose refracted ray found the emitter at
 /// `l` (a triangle the lights sample), is a path the connection counts:
-/// its exit triangle is the facet [`facet`] finds from its scattering
+/// its exit triangle is one of the [`refractions`] from its scattering
 /// point to `l`.
 pub(crate) fn covers(ctx: &Context, t: &Through, l: Vec3, counters: &mut Counters) -> bool {
-    facet(ctx, t.x, l, t.eta, counters)
-        .is_some_and(|(h, _, _)| (h.geom, h.prim) == (t.geom, t.prim))
+    refractions(ctx, t.x, l, t.eta, counters).through(t.geom, t.prim)
+}
+
+/// The refracted paths from `x` to the light point `l` that a connection
+/// through a boundary of index `eta` counts (`refractions`), as (mesh,
+/// triangle, refraction point): to check them from outside.
+pub fn counted_paths(ctx: &Context, x: Vec3, l: Vec3, eta: f32) -> Vec<(u32, u32, Vec3)> {
+    let mut counters = Counters::default();
+    let found = refractions(ctx, x, l, eta, &mut counters);
+    found.iter().map(|r| (r.geom, r.prim, r.y)).collect()
+}
+
+/// Whether the walk leaves the emission its exit from `x` through
+/// triangle `prim` of mesh `geom` finds at `l` to the connection
+/// (`covers`).
+pub fn left_to_connection(ctx: &Context, x: Vec3, geom: u32, prim: u32, l: Vec3, eta: f32) -> bool {
+    let t = Through { x, geom, prim, eta };
+    covers(ctx, &t, l, &mut Counters::default())
 }
 
 /// The in-scattered radiance at `x` (arriving along `d_in`) from one light
-/// sample through the boundary, per channel, and the light triangle; None
-/// when it brings none.
+/// sample through the boundary, summed over its [`refractions`], per
+/// channel, and the light triangle; None when it brings none.
 fn connect(
     ctx: &Context,
     m: &Medium,
@@ -187,7 +287,32 @@ fn connect(
     counters: &mut Counters,
 ) -> Option<([f64; 3], u32)> {
     let ls = draw_light(ctx, rng)?;
-    let (_, y, n) = facet(ctx, x, ls.point, eta, counters)?;
+    let mut sum = [0.0; 3];
+    let mut any = false;
+    for r in refractions(ctx, x, ls.point, eta, counters).iter() {
+        if let Some(c) = through_one(ctx, m, eta, x, d_in, &ls, r, counters) {
+            (0..3).for_each(|k| sum[k] += c[k]);
+            any = true;
+        }
+    }
+    any.then_some((sum, ls.index))
+}
+
+/// The in-scattered radiance at `x` from the light sample `ls` along the
+/// refracted path `r`, per channel; None when it is occluded or brings
+/// none.
+#[allow(clippy::too_many_arguments)]
+fn through_one(
+    ctx: &Context,
+    m: &Medium,
+    eta: f32,
+    x: Vec3,
+    d_in: Vec3,
+    ls: &LightSample,
+    r: &Refraction,
+    counters: &mut Counters,
+) -> Option<[f64; 3]> {
+    let (y, n) = (r.y, r.n);
     let g = refracted_geometry(x, y, ls.point, n, eta, ls.normal);
     if g.is_nan() || g <= 0.0 {
         return None;
@@ -209,9 +334,9 @@ fn connect(
     let phase = henyey_greenstein(m.g, d_in.dot(w1) as f64);
     let common = phase * (transmitted * eta * eta * g / ls.pdf_area) as f64;
     let sigma_t = m.sigma_t();
-    let c =
-        std::array::from_fn(|k| (-sigma_t[k] * d1 as f64).exp() * common * ls.radiance[k] as f64);
-    Some((c, ls.index))
+    Some(std::array::from_fn(|k| {
+        (-sigma_t[k] * d1 as f64).exp() * common * ls.radiance[k] as f64
+    }))
 }
 
 /// The Henyey–Greenstein phase function at the cosine `cos` between the
@@ -262,30 +387,32 @@ pub fn refraction_point(x: Vec3, l: Vec3, p0: Vec3, n: Vec3, eta: f32) -> Option
 /// l's. The left side rises and the right side falls in s, so the root is
 /// unique.
 fn solve_offset(eta: f64, h1: f64, h2: f64, d: f64) -> f64 {
-    let f = |s: f64| {
+    // the function and its derivative, sharing their square roots
+    // (q^{3/2} as q √q: powf costs several times a square root)
+    let f_df = |s: f64| {
         let r = d - s;
-        eta * s / (s * s + h1 * h1).sqrt() - r / (r * r + h2 * h2).sqrt()
-    };
-    let df = |s: f64| {
-        let r = d - s;
-        eta * h1 * h1 / (s * s + h1 * h1).powf(1.5) + h2 * h2 / (r * r + h2 * h2).powf(1.5)
+        let (q1, q2) = (s * s + h1 * h1, r * r + h2 * h2);
+        let (r1, r2) = (q1.sqrt(), q2.sqrt());
+        let f = eta * s / r1 - r / r2;
+        (f, eta * h1 * h1 / (q1 * r1) + h2 * h2 / (q2 * r2))
     };
     let (mut lo, mut hi) = (0.0, d);
     let mut s = d * h1 / (h1 + eta * h2);
     for _ in 0..SOLVE_STEPS {
-        let v = f(s);
+        let (v, dv) = f_df(s);
         if v < 0.0 {
             lo = s;
         } else {
             hi = s;
         }
-        let next = s - v / df(s);
+        let next = s - v / dv;
         let next = if next > lo && next < hi {
             next
         } else {
             0.5 * (lo + hi)
         };
-        if (next - s).abs() <= 1e-14 * d {
+        // far below the f32 the point is returned in
+        if (next - s).abs() <= 1e-10 * d {
             return next;
         }
         s = next;
