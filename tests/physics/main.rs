@@ -32,6 +32,8 @@ mod non_negative;
 #[cfg(feature = "subsurface")]
 mod pair_on_meshes;
 #[cfg(feature = "subsurface")]
+mod pair_paths;
+#[cfg(feature = "subsurface")]
 mod params_edges;
 #[cfg(feature = "subsurface")]
 mod probe_pair;

@@ -33,8 +33,8 @@ const SPP: u32 = 32;
 const SEEDS: u64 = 8;
 /// relMSE's ε (as the study's metrics).
 const EPS: f64 = 0.01;
-/// The pair's relMSE×spp against one probe's, at most (measured 0.58 on
-/// this frame; 0.59 at 96², docs/accuracy.md).
+/// The pair's relMSE×spp against one probe's, at most (measured 0.47 on
+/// this frame with the default `pair_paths = 2`; docs/accuracy.md).
 const MAX_RATIO: f64 = 0.8;
 
 /// scenes/smooth-bunny.toml at SIZE², with `options` added to the marble.

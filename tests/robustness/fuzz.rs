@@ -755,6 +755,7 @@ const OPTIONS: &[&str] = &[
     "--sampler",
     "--control-variate",
     "--probe-pair",
+    "--pair-paths",
     "--boundary",
     "-o",
 ];

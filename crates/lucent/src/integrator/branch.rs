@@ -15,8 +15,9 @@ pub(crate) const RR_START: u32 = 3;
 
 /// Paths waiting to be traced after the current one ends. A path pushes
 /// at most one branch per depth below the coat's split depth, and a branch
-/// starts one depth below the vertex that pushed it, so at most that many
-/// wait at once: the stack is never full.
+/// starts one depth below the vertex that pushed it; the pair's paths add
+/// at most three at the camera vertex (`subsurface::split`), which pushes
+/// nothing below it: the stack is never full.
 pub(crate) const MAX_BRANCHES: usize = 4;
 
 /// A path to trace: its ray, throughput, the last non-specular vertex and

@@ -22,6 +22,11 @@ pub(crate) struct Coated<'a> {
     /// ([`super::path::PAIR_DEPTH`]); when Some, light sampled at `entry`
     /// counts ½ too.
     pub(crate) pair: Option<Weighted<'a>>,
+    /// With `pair`: the paths that go on from each of the two entry points
+    /// (their throughputs already scaled by ½, the pair's share), or 0 when
+    /// this path goes on from `entry` alone, chosen from the two, and the
+    /// twin is only lit.
+    pub(crate) paths_each: u32,
     /// What the plane model drew ahead ([`Ahead`]).
     pub(crate) ahead: Ahead,
 }

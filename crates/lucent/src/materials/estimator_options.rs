@@ -21,6 +21,10 @@ use crate::error::ParamError;
 /// error with its bias counted (`docs/accuracy.md`, "Real meshes").
 pub const DEFAULT_REGULARIZE: f32 = 0.3;
 
+/// The default of [`EstimatorOptions::pair_paths`], chosen by time to
+/// error (`docs/accuracy.md`, "Real meshes: where the error lives").
+pub const DEFAULT_PAIR_PATHS: u32 = 2;
+
 /// Every sampling option of a subsurface material; `Default` is the
 /// recommended setting.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,6 +50,10 @@ pub struct EstimatorOptions {
     pub control_variate: bool,
     /// At the camera vertex, an antithetic pair of probes.
     pub probe_pair: bool,
+    /// At the camera vertex, with the pair, the paths that go on from its
+    /// entry points: 1 (from one, chosen), 2 (one from each) or 4 (two
+    /// from each).
+    pub pair_paths: u32,
     /// The coat's least roughness once the path has scattered off a
     /// non-specular lobe (0: the coat as given everywhere).
     pub regularize: f32,
@@ -67,6 +75,7 @@ impl Default for EstimatorOptions {
             lod_threshold: DEFAULT_THRESHOLD,
             control_variate: false,
             probe_pair: true,
+            pair_paths: DEFAULT_PAIR_PATHS,
             regularize: DEFAULT_REGULARIZE,
             accuracy: None,
         }
@@ -271,7 +280,7 @@ fn number<T: std::str::FromStr>(s: &str) -> Result<T, OptionError> {
 
 /// Every option, in the order the EXR header and a part's identity list
 /// them.
-pub static OPTIONS: [EstimatorOption; 17] = [
+pub static OPTIONS: [EstimatorOption; 18] = [
     EstimatorOption {
         name: "radius",
         values: &["analytic", "mixture"],
@@ -460,6 +469,21 @@ pub static OPTIONS: [EstimatorOption; 17] = [
             Ok(())
         },
         get: |o| o.probe_pair.to_string(),
+    },
+    EstimatorOption {
+        name: "pair_paths",
+        values: &["1", "2", "4"],
+        research: &[],
+        research_in_scenes: true,
+        flag: true,
+        description: "At the camera vertex, with the pair, the paths that go on from its entry \
+                      points: 1 from one of the two, chosen; 2, one from each; 4, two from each \
+                      (each weighted by their share)",
+        set: |o, s| {
+            o.pair_paths = choose("pair_paths", s, &[("1", 1), ("2", 2), ("4", 4)])?;
+            Ok(())
+        },
+        get: |o| o.pair_paths.to_string(),
     },
     EstimatorOption {
         name: "regularize",

@@ -303,6 +303,13 @@ impl Subsurface {
         self.options.probe_pair
     }
 
+    /// With the pair, the paths that go on from its entry points at the
+    /// camera vertex: 1, 2 or 4 (`integrator::subsurface`'s split).
+    #[inline]
+    pub fn pair_paths(&self) -> u32 {
+        self.options.pair_paths
+    }
+
     /// The level-of-detail rule.
     #[inline]
     pub fn lod(&self) -> &LodRule {

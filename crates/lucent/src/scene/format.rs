@@ -313,6 +313,7 @@ pub struct MaterialDef {
     // subsurface: variance reduction at the camera vertex
     pub control_variate: Option<Spanned<bool>>,
     pub probe_pair: Option<Spanned<bool>>,
+    pub pair_paths: Option<Spanned<i64>>,
     // subsurface: the coat's least roughness after a non-specular vertex
     pub regularize: Option<Spanned<f64>>,
     // subsurface: the diffusion profile's shape
@@ -392,6 +393,7 @@ impl MaterialDef {
             self.control_variate.as_ref().map(|x| x.span()),
         );
         add("probe_pair", self.probe_pair.as_ref().map(|x| x.span()));
+        add("pair_paths", self.pair_paths.as_ref().map(|x| x.span()));
         add("regularize", self.regularize.as_ref().map(|x| x.span()));
         add("profile", self.profile.as_ref().map(|x| x.span()));
         v

@@ -390,6 +390,8 @@ mod tests {
                 "true" => "false".to_string(),
                 "false" => "true".to_string(),
                 _ => match row.values.iter().chain(row.research).find(|v| **v != d) {
+                    // an integer-valued option's values are TOML integers
+                    Some(v) if v.parse::<i64>().is_ok() => v.to_string(),
                     Some(v) => format!("\"{v}\""),
                     None => "0.5".to_string(),
                 },

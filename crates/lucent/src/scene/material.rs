@@ -446,6 +446,7 @@ fn option_value(d: &MaterialDef, key: &str) -> Option<(String, std::ops::Range<u
     let s = |v: &Option<Spanned<String>>| v.as_ref().map(|v| (v.get_ref().clone(), v.span()));
     let b = |v: &Option<Spanned<bool>>| v.as_ref().map(|v| (v.get_ref().to_string(), v.span()));
     let f = |v: &Option<Spanned<f64>>| v.as_ref().map(|v| (v.get_ref().to_string(), v.span()));
+    let i = |v: &Option<Spanned<i64>>| v.as_ref().map(|v| (v.get_ref().to_string(), v.span()));
     match key {
         "radius" => s(&d.radius),
         "rmax_quantile" => f(&d.rmax_quantile),
@@ -461,6 +462,7 @@ fn option_value(d: &MaterialDef, key: &str) -> Option<(String, std::ops::Range<u
         "lod_threshold" => f(&d.lod_threshold),
         "control_variate" => b(&d.control_variate),
         "probe_pair" => b(&d.probe_pair),
+        "pair_paths" => i(&d.pair_paths),
         "regularize" => f(&d.regularize),
         "accuracy" => f(&d.accuracy),
         "profile" => s(&d.profile),

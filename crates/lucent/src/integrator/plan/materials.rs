@@ -303,12 +303,21 @@ fn channels(active: [bool; 3], reason: impl Into<String>) -> Channels {
 }
 
 /// Why the diffusion estimator samples as it does: probes (a pair below
-/// `pair_depth`) and the plane control variate below `cv_depth` (0 where
-/// the scene has no area light, though `asked` was more).
+/// `pair_depth`, `pair_paths` paths going on from it at the camera
+/// vertex) and the plane control variate below `cv_depth` (0 where the
+/// scene has no area light, though `asked` was more).
 #[cfg(feature = "subsurface")]
-fn diffusion_reason(pair_depth: u32, cv_depth: u32, area_lights: bool, asked: u32) -> String {
+fn diffusion_reason(
+    (pair_depth, pair_paths): (u32, u32),
+    cv_depth: u32,
+    area_lights: bool,
+    asked: u32,
+) -> String {
     let probes = if pair_depth > 0 {
-        format!("an antithetic pair at depth < {pair_depth} (probe_pair), one probe deeper")
+        format!(
+            "an antithetic pair at depth < {pair_depth} (probe_pair), {pair_paths} path(s) \
+             going on from it at the camera vertex (pair_paths), one probe deeper"
+        )
     } else {
         "one a hit".into()
     };
@@ -387,7 +396,12 @@ fn diffusion_methods(
                 pair_depth,
                 control_variate_depth: cv_depth,
                 curvature_correction: ss.curvature_correction().is_some(),
-                reason: diffusion_reason(pair_depth, cv_depth, area_lights, cv_asked),
+                reason: diffusion_reason(
+                    (pair_depth, ss.pair_paths()),
+                    cv_depth,
+                    area_lights,
+                    cv_asked,
+                ),
             }
         } else {
             SubsurfaceMethod::None {

@@ -25,6 +25,8 @@ use crate::sampling::Draw;
 pub(super) struct Entries<'s> {
     entry: Option<Vertex<'s>>,
     pair: Option<Weighted<'s>>,
+    /// [`Coated::paths_each`].
+    paths_each: u32,
     ahead: Ahead,
 }
 
@@ -38,6 +40,7 @@ impl<'s> Entries<'s> {
         Entries {
             entry,
             pair: None,
+            paths_each: 0,
             ahead,
         }
     }
@@ -50,6 +53,7 @@ impl<'s> Entries<'s> {
                 entry: Some(v),
                 pair: None,
                 ahead,
+                ..
             } if ahead.lights.is_none() => Scatter::Vertex(v),
             Entries {
                 entry: None, ahead, ..
@@ -66,6 +70,7 @@ impl<'s> Entries<'s> {
             reflected,
             entry: self.entry,
             pair: self.pair,
+            paths_each: self.paths_each,
             ahead: self.ahead,
         }
     }
@@ -128,7 +133,9 @@ pub(super) fn entries<'s, R: Recorder>(
     if !pair {
         return one_probe(ctx, &at, cv, lights, beta, st);
     }
-    self::pair(ctx, &at, beta, st)
+    // Paths split only at the camera vertex: the stack holds them.
+    let paths = if hit.depth == 0 { ss.pair_paths() } else { 1 };
+    self::pair(ctx, &at, paths, beta, st)
 }
 
 /// One probe from xo: its entry vertex, with the control variate's part.
@@ -170,12 +177,14 @@ fn one_probe<'s, R: Recorder>(
 
 /// The antithetic pair from xo: the twin's randoms are u's with the angle
 /// at φ + π (ProbeSampler::sample_probe_pair), which changes none of what
-/// entry_on_segment reads. The path goes on from one of the two, chosen
-/// with probability ½ (weight 2 × ½); light is sampled at both, each
-/// weighted ½.
+/// entry_on_segment reads. Light is sampled at both, each weighted ½. With
+/// `paths` 1 the path goes on from one of the two, chosen with probability
+/// ½ (weight 2 × ½); with 2 or 4, `paths / 2` go on from each, weighted
+/// ½ here and split further by [`super::split`].
 fn pair<'s, R: Recorder>(
     ctx: &Context,
     at: &ProbeAt<'_, 's>,
+    paths: u32,
     beta: &mut Vec3,
     st: &mut PathState<R>,
 ) -> Entries<'s> {
@@ -190,12 +199,15 @@ fn pair<'s, R: Recorder>(
     match (a, b) {
         (Some((va, wa)), Some((vb, wb))) => {
             let beta0 = *beta;
-            let (go, (other, w_other), w_go) = if st.rng.uniform() < 0.5 {
+            let paths_each = paths / 2;
+            let (go, (other, w_other), w_go) = if paths_each > 0 || st.rng.uniform() < 0.5 {
                 (va, (vb, wb), wa)
             } else {
                 (vb, (va, wa), wb)
             };
-            *beta = beta0 * w_go;
+            // Followed alone, the entry point stands for both (2 × ½).
+            let share = if paths_each > 0 { 0.5 } else { 1.0 };
+            *beta = share * beta0 * w_go;
             let twin = Weighted {
                 vertex: other,
                 beta: 0.5 * beta0 * w_other,
@@ -203,6 +215,7 @@ fn pair<'s, R: Recorder>(
             Entries {
                 entry: Some(go),
                 pair: Some(twin),
+                paths_each,
                 ahead,
             }
         }
