@@ -350,7 +350,10 @@ fn scatter_at<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
 
 /// What the material `m`, its parameters fixed at `at`, turns into there.
 #[inline(always)]
-#[cfg_attr(not(feature = "subsurface"), allow(unused_variables))]
+#[cfg_attr(
+    not(feature = "subsurface"),
+    allow(unused_variables, clippy::extra_unused_type_parameters)
+)]
 fn scatter_as<'s, R: Recorder, T: Clock, S: SubsurfaceScatter>(
     ctx: &'s Context,
     m: HitMaterial<'s>,
