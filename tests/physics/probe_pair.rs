@@ -1,8 +1,10 @@
 //! The two variance reductions of the probe estimator at the camera vertex
 //! on a smooth translucent sphere lit from the side, where the light at the
 //! entry point changes across the profile: the antithetic probe pair
-//! (`integrator::path`, `PAIR_DEPTH`) and the plane control variate
-//! (`control_variate = true`, `integrator::control_variate`). Each must
+//! (`integrator::path`, `PAIR_DEPTH`; the default, so the scene here asks
+//! for one plain probe where it compares against one) and the plane
+//! control variate (`control_variate = true`,
+//! `integrator::control_variate`). Each must
 //! (a) leave the mean
 //! where one plain probe puts it — both are unbiased estimators of the same
 //! integral — and (b) cut the per-sample variance of the lit body to well

@@ -23,13 +23,13 @@ use crate::scene::Scene;
 use crate::stats::Counters;
 
 /// Subsurface hits at depths below this, on materials with `probe_pair`
-/// on (off by default: the plane control variate takes most of the same
-/// noise without the second probe), sample two entry points from one
-/// probe's randoms, the second at the opposite angle φ + π (antithetic),
-/// and sample light at both, each weighted ½; the path goes on from one of
-/// them, chosen with probability ½ (`super::path`'s module docs). Light
-/// varying linearly across the profile cancels between the two. 1: the
-/// camera vertex (the default of [`Context::pair_depth`]).
+/// on (the default), sample two entry points from one probe's randoms,
+/// the second at the opposite angle φ + π (antithetic), and sample light
+/// at both, each weighted ½; the path goes on from each of them with
+/// weight ½ (`pair_paths = 2`, the default) or from one chosen with
+/// probability ½ (`pair_paths = 1`) (`docs/bssrdf.md` §5). Light varying
+/// linearly across the profile cancels between the two. 1: the camera
+/// vertex (the default of [`Context::pair_depth`]).
 pub const PAIR_DEPTH: u32 = 1;
 
 /// Everything an integrator reads while rendering; built once per render.
