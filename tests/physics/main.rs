@@ -9,6 +9,8 @@ mod common;
 #[cfg(feature = "subsurface")]
 mod albedo_table;
 #[cfg(feature = "subsurface")]
+mod bunny_seeds;
+#[cfg(feature = "subsurface")]
 mod coat;
 #[cfg(feature = "subsurface")]
 mod culling;
