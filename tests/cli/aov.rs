@@ -158,6 +158,16 @@ fn light_path_names() -> Vec<&'static str> {
     LIGHT_PATHS.iter().map(|p| p.name()).collect()
 }
 
+/// The light paths and the light groups `groups` each sum to the beauty
+/// of `out`, and, so that neither sum is vacuous, each of them gets light.
+fn assert_lit_passes_sum_to_the_beauty(out: &RenderOutput, groups: &[&str], what: &str) {
+    assert_sum_is_beauty(out, &light_path_names(), &format!("{what}: light paths"));
+    assert_sum_is_beauty(out, groups, &format!("{what}: light groups"));
+    for &name in light_path_names().iter().chain(groups) {
+        assert!(max(layer(out, name)) > 0.0, "{what}: {name} is black");
+    }
+}
+
 #[test]
 fn light_paths_and_light_groups_sum_to_the_beauty_with_both_integrators() {
     let s = scene(MIXED);
@@ -165,12 +175,7 @@ fn light_paths_and_light_groups_sum_to_the_beauty_with_both_integrators() {
     for integrator in [IntegratorKind::Path, IntegratorKind::RandomWalk] {
         let out = render_with(&s, PassSet::all(), integrator, 2, None);
         let what = format!("{integrator:?}");
-        assert_sum_is_beauty(&out, &light_path_names(), &format!("{what} light paths"));
-        assert_sum_is_beauty(&out, &groups, &format!("{what} light groups"));
-        // Not vacuous: every light path and group gets light in this scene.
-        for name in light_path_names().into_iter().chain(groups) {
-            assert!(max(layer(&out, name)) > 0.0, "{what}: {name} is black");
-        }
+        assert_lit_passes_sum_to_the_beauty(&out, &groups, &what);
         // The top row sees the sky only: all of it background, group sky.
         for x in 0..48 {
             for c in 0..3 {
@@ -201,11 +206,7 @@ fn light_paths_and_light_groups_sum_to_the_beauty_under_an_environment_image() {
     for integrator in [IntegratorKind::Path, IntegratorKind::RandomWalk] {
         let out = render_with(&s, PassSet::all(), integrator, 2, None);
         let what = format!("{integrator:?} under the image");
-        assert_sum_is_beauty(&out, &light_path_names(), &format!("{what}: light paths"));
-        assert_sum_is_beauty(&out, &groups, &format!("{what}: light groups"));
-        for name in light_path_names().into_iter().chain(groups) {
-            assert!(max(layer(&out, name)) > 0.0, "{what}: {name} is black");
-        }
+        assert_lit_passes_sum_to_the_beauty(&out, &groups, &what);
     }
 }
 
@@ -245,11 +246,7 @@ fn light_paths_and_light_groups_sum_to_the_beauty_with_sphere_spot_and_distant_l
     for integrator in [IntegratorKind::Path, IntegratorKind::RandomWalk] {
         let out = render_with(&s, PassSet::all(), integrator, 2, None);
         let what = format!("{integrator:?}");
-        assert_sum_is_beauty(&out, &light_path_names(), &format!("{what} light paths"));
-        assert_sum_is_beauty(&out, &groups, &format!("{what} light groups"));
-        for name in light_path_names().into_iter().chain(groups) {
-            assert!(max(layer(&out, name)) > 0.0, "{what}: {name} is black");
-        }
+        assert_lit_passes_sum_to_the_beauty(&out, &groups, &what);
     }
 }
 
