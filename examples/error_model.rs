@@ -18,16 +18,9 @@
 //! `scripts/error-model.sh` and `scripts/accuracy-check.sh` call it.
 
 use lucent::film::Film;
-use std::path::Path;
+use lucent_tools::image_sets::two_sets;
 
 const BANDS: usize = 4;
-
-fn read(path: &str) -> Film {
-    Film::read_exr(Path::new(path)).unwrap_or_else(|e| {
-        eprintln!("error: {path}: {e}");
-        std::process::exit(2)
-    })
-}
 
 /// Band index of every pixel of the object (None: not the object).
 fn bands(walk: &[Film]) -> Vec<Option<usize>> {
@@ -103,17 +96,11 @@ fn main() {
         eprintln!("usage: error_model EST.exr... -- WALK.exr...");
         std::process::exit(2)
     };
-    let est: Vec<Film> = args[..split].iter().map(|p| read(p)).collect();
-    let walk: Vec<Film> = args[split + 1..].iter().map(|p| read(p)).collect();
-    if est.is_empty() || walk.is_empty() {
-        eprintln!("error: no estimator or no walk image");
-        std::process::exit(2)
-    }
-    let size = |f: &Film| (f.width, f.height);
-    if est.iter().chain(&walk).any(|f| size(f) != size(&walk[0])) {
-        eprintln!("error: the images differ in size");
-        std::process::exit(2)
-    }
+    let (est, walk) = two_sets(&args[..split], &args[split + 1..], ["estimator", "walk"])
+        .unwrap_or_else(|e| {
+            eprintln!("error: {e}");
+            std::process::exit(2)
+        });
     let band = bands(&walk);
     let (d, w) = (band_means(&est, &band), band_means(&walk, &band));
     let (mut num, mut den, mut var) = (0.0, 0.0, 0.0);

@@ -20,9 +20,9 @@
 //! the far one.
 
 use lucent::film::Film;
+use lucent_tools::image_sets::two_sets;
 use std::fmt::Write as _;
 use std::io::Write as _;
-use std::path::Path;
 
 /// Which pixels belong to the body, and where it is.
 struct Body {
@@ -102,13 +102,6 @@ impl Body {
     }
 }
 
-fn read(path: &str) -> Film {
-    Film::read_exr(Path::new(path)).unwrap_or_else(|e| {
-        eprintln!("error: {path}: {e}");
-        std::process::exit(2)
-    })
-}
-
 /// Mean and standard error (pixels as independent) per channel of the
 /// pixels of `film` in `mask`.
 fn pixel_stats(film: &Film, mask: &[bool]) -> [(f64, f64); 3] {
@@ -180,17 +173,11 @@ fn main() {
             }
         })
         .collect();
-    let diff: Vec<Film> = args[3..split].iter().map(|p| read(p)).collect();
-    let walk: Vec<Film> = args[split + 1..].iter().map(|p| read(p)).collect();
-    if diff.is_empty() || walk.is_empty() {
-        eprintln!("error: no diffusion or no walk image");
-        std::process::exit(2)
-    }
-    let size = |f: &Film| (f.width, f.height);
-    if diff.iter().chain(&walk).any(|f| size(f) != size(&walk[0])) {
-        eprintln!("error: the images differ in size");
-        std::process::exit(2)
-    }
+    let (diff, walk) = two_sets(&args[3..split], &args[split + 1..], ["diffusion", "walk"])
+        .unwrap_or_else(|e| {
+            eprintln!("error: {e}");
+            std::process::exit(2)
+        });
     let body = Body::new(&walk, v[0], v[1], v[2]);
     let fourth = if body.r > 0.0 { "rim" } else { "top" };
     // the table is written at once, and a reader that stops early (a

@@ -29,6 +29,7 @@
 pub mod bench;
 #[cfg(feature = "subsurface")]
 pub mod halfspace;
+pub mod image_sets;
 pub mod plot;
 #[cfg(feature = "subsurface")]
 pub mod profile_table;
